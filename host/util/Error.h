@@ -1,0 +1,21 @@
+#pragma once
+// Errors at the host's edges. InputError is bad user input (exit status 2); its
+// message is one line that names the file, the key or grid, and the reason.
+#include <stdexcept>
+#include <string>
+
+namespace pyrolume {
+
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// "FILE: KEY: REASON" — the shape every input error message takes.
+inline InputError input_error(const std::string& file, const std::string& key, const std::string& reason) {
+  std::string msg = file;
+  if (!key.empty()) msg += ": " + key;
+  msg += ": " + reason;
+  return InputError(msg);
+}
+
+}  // namespace pyrolume
