@@ -1,0 +1,58 @@
+#include "support/TestSupport.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+namespace pyrolume::test {
+
+CliResult run_cli(const std::string& args) {
+  auto dir = temp_dir("cli");
+  auto out = dir / "stdout.txt", err = dir / "stderr.txt";
+  std::string cmd = std::string(PYROLUME_BIN) + " " + args + " >" + out.string() + " 2>" + err.string();
+  int raw = std::system(cmd.c_str());
+  CliResult r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  r.out = read_file(out);
+  r.err = read_file(err);
+  std::filesystem::remove_all(dir);
+  return r;
+}
+
+std::filesystem::path temp_dir(const std::string& tag) {
+  static std::atomic<int> counter{0};
+  std::random_device rd;
+  auto p = std::filesystem::temp_directory_path() /
+           ("pyrolume-" + tag + "-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + "-" +
+            std::to_string(rd() % 100000));
+  std::filesystem::remove_all(p);
+  std::filesystem::create_directories(p);
+  return p;
+}
+
+void write_file(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream f(p, std::ios::binary);
+  if (!f) throw std::runtime_error("cannot write " + p.string());
+  f << text;
+}
+
+std::string read_file(const std::filesystem::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+std::filesystem::path shared_data_dir() {
+  std::filesystem::path p = std::filesystem::path(PYROLUME_SHARED_DIR) / "data";
+  if (const char* env = std::getenv("PYROLUME_SHARED_DATA")) p = env;
+  return std::filesystem::exists(p) ? p : std::filesystem::path();
+}
+
+}  // namespace pyrolume::test

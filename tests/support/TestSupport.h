@@ -1,0 +1,25 @@
+#pragma once
+// Shared helpers for the ctest suites: run the CLI, make temp folders, write files.
+#include <filesystem>
+#include <string>
+
+namespace pyrolume::test {
+
+struct CliResult {
+  int status = -1;  // exit status of the pyrolume binary
+  std::string out, err;
+};
+
+// Runs PYROLUME_BIN with the given argument string (shell-quoted by the caller).
+CliResult run_cli(const std::string& args);
+
+// A fresh, empty folder under the system temp dir, unique per test.
+std::filesystem::path temp_dir(const std::string& tag);
+
+void write_file(const std::filesystem::path& p, const std::string& text);
+std::string read_file(const std::filesystem::path& p);
+
+// ../shared/data, or empty if absent.
+std::filesystem::path shared_data_dir();
+
+}  // namespace pyrolume::test
