@@ -1,6 +1,7 @@
 #pragma once
 // Blackbody emission: Planck's law -> CIE XYZ -> linear sRGB (docs/blackbody.md).
 #include <optional>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
@@ -12,7 +13,32 @@ namespace pyrolume::color {
 // CIE 1931 2° (observer 2) or CIE 1964 10° (observer 10) observer, optionally
 // chromatically adapted to a blackbody white at adapt_to_k. Finite and >= 0 for
 // every input (T <= 0, NaN, 1e6 ...).
+//   Seed:     Wien-peak-normalised spectrum -> XYZ -> sRGB, negatives clamped,
+//             scaled so the largest channel is 1 (0 where there is no light).
+//   Peak:     pbrt-v4's convention: XYZ = sum B(l,T)/B(l_max,T) · cmf(l) · 1 nm over
+//             360..830 nm (not divided by the integral of ybar), then sRGB,
+//             negatives clamped. 6500 K gives about (98.8, 93.1, 98.0).
+//   Physical: XYZ = sum B(l,T) [W·sr⁻¹·m⁻²·nm⁻¹] · cmf(l) · 1 nm, so Y is the
+//             ybar-weighted radiance in W·sr⁻¹·m⁻² (× 683 lm/W = cd/m²), then sRGB.
+// Throws std::invalid_argument for an observer other than 2 or 10, and for an
+// adapt_to_k that is not a temperature with visible light (NaN, <= 0, ~< 20 K).
 glm::dvec3 blackbody_rgb(double temperature_k, BlackbodyMode mode, int observer = 2,
                          std::optional<double> adapt_to_k = std::nullopt);
+
+// CIE XYZ of the mode's spectrum (Seed and Peak share the Wien-peak-normalised
+// spectrum), before adaptation. Zero for T <= 0, NaN, Inf, or no visible light.
+glm::dvec3 blackbody_xyz(double temperature_k, BlackbodyMode mode, int observer = 2);
+
+// CIE xy chromaticity of a blackbody at temperature_k for the observer (the
+// Planckian locus); NaN where the spectrum is zero over 360..830 nm.
+glm::dvec2 blackbody_xy(double temperature_k, int observer = 2);
+
+// Applies the von Kries/Bradford adaptation that maps the white of a blackbody at
+// adapt_to_k (same observer) to D65 (Nguyen et al. 2002; Fairchild 1998).
+glm::dvec3 adapt_blackbody_xyz(const glm::dvec3& xyz, double adapt_to_k, int observer = 2);
+
+// "seed" | "peak" | "physical".
+const char* to_string(BlackbodyMode mode);
+std::optional<BlackbodyMode> parse_blackbody_mode(std::string_view name);
 
 }  // namespace pyrolume::color

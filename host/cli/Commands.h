@@ -1,0 +1,34 @@
+#pragma once
+// The CLI's subcommands, kept out of main.cpp so tests can call them directly.
+#include <atomic>
+#include <optional>
+#include <string>
+
+namespace pyrolume {
+
+struct RenderArgs {
+  std::string scene, output, backend = "vulkan", stats;
+  std::optional<int> spp, width, height;
+  std::optional<uint32_t> seed;
+  double time_limit = 0.0;
+  bool variance = false;
+  int device = -1;
+};
+int run_render(const RenderArgs& args, const std::atomic<bool>& cancel);
+
+int run_devices(int device);
+
+struct BlackbodyArgs {
+  double from_k = 0, to_k = 0, step_k = 0;
+  std::string mode = "seed", png;
+  int observer = 2;
+};
+int run_blackbody(const BlackbodyArgs& args);
+
+struct CompareArgs {
+  std::string a, b;
+  std::optional<double> max_relmse, max_outliers;
+};
+int run_compare(const CompareArgs& args);
+
+}  // namespace pyrolume

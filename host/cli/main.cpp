@@ -1,0 +1,98 @@
+// pyrolume command line (contract: ../shared/DESIGN.md "Command line").
+// Exit status: 0 ok, 1 internal error, 2 bad input, 3 compare beyond limits,
+// 130/143 interrupted (the image so far is saved first).
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/Commands.h"
+#include "util/Error.h"
+
+namespace {
+std::atomic<bool> g_cancel{false};
+std::atomic<int> g_signal{0};
+extern "C" void on_signal(int sig) {
+  g_signal = sig;
+  g_cancel = true;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace pyrolume;
+  CLI::App app{"pyrolume: a renderer for fire, smoke and explosions (emissive participating media)"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "pyrolume 0.1.0");
+
+  RenderArgs render_args;
+  auto* render = app.add_subcommand("render", "Render a scene to EXR or PNG");
+  render->add_option("scene", render_args.scene, "Scene JSON file")->required();
+  render->add_option("-o,--output", render_args.output, "Output image (.exr linear float, .png sRGB)");
+  render->add_option("--backend", render_args.backend, "vulkan (default) or cpu")->check(CLI::IsMember({"vulkan", "cpu"}));
+  render->add_option("--spp", render_args.spp, "Samples per pixel (overrides film.spp)")->check(CLI::PositiveNumber);
+  render->add_option("--width", render_args.width, "Image width (overrides film.width)")->check(CLI::Range(1, 16384));
+  render->add_option("--height", render_args.height, "Image height (overrides film.height)")->check(CLI::Range(1, 16384));
+  render->add_option("--seed", render_args.seed, "Random seed (overrides film.seed)");
+  render->add_option("--time-limit", render_args.time_limit, "Stop after the pass that crosses SEC seconds")
+      ->check(CLI::NonNegativeNumber);
+  render->add_option("--stats", render_args.stats, "Write render statistics as JSON");
+  render->add_flag("--variance", render_args.variance, "EXR: add the per-pixel variance of the mean (variance.R/G/B)");
+  render->add_option("--device", render_args.device, "Vulkan device index (see `pyrolume devices`)")->check(CLI::NonNegativeNumber);
+
+  int devices_device = -1;
+  auto* devices = app.add_subcommand("devices", "List the Vulkan devices and which one is chosen");
+  devices->add_option("--device", devices_device, "Device index to mark as chosen")->check(CLI::NonNegativeNumber);
+
+  BlackbodyArgs bb;
+  auto* blackbody = app.add_subcommand("blackbody", "Print blackbody colours as CSV: kelvin,x,y,r,g,b");
+  blackbody->add_option("--from", bb.from_k, "First temperature, K")->required();
+  blackbody->add_option("--to", bb.to_k, "Last temperature, K (inclusive)")->required();
+  blackbody->add_option("--step", bb.step_k, "Step, K")->required();
+  blackbody->add_option("--mode", bb.mode, "seed | peak | physical")->check(CLI::IsMember({"seed", "peak", "physical"}));
+  blackbody->add_option("--observer", bb.observer, "2 (CIE 1931) or 10 (CIE 1964)")->check(CLI::IsMember({2, 10}));
+  blackbody->add_option("--png", bb.png, "Also draw the swatch strip to this PNG");
+
+  CompareArgs cmp;
+  auto* compare = app.add_subcommand("compare", "Compare image A against reference B: RMSE, relMSE, bias");
+  compare->add_option("a", cmp.a, "Test image")->required();
+  compare->add_option("b", cmp.b, "Reference image")->required();
+  compare->add_option("--max-relmse", cmp.max_relmse, "Exit 3 if relMSE exceeds X");
+  compare->add_option("--max-outliers", cmp.max_outliers, "Exit 3 if the fraction beyond 4 sigma exceeds F");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "pyrolume: " << e.what() << " (see --help)\n";
+    return 2;
+  }
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+
+  try {
+    if (*render) {
+      int status = run_render(render_args, g_cancel);
+      if (g_signal == SIGINT) return 130;
+      if (g_signal == SIGTERM) return 143;
+      return status;
+    }
+    if (*devices) return run_devices(devices_device);
+    if (*blackbody) return run_blackbody(bb);
+    if (*compare) return run_compare(cmp);
+  } catch (const InputError& e) {
+    std::cerr << "pyrolume: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "pyrolume: internal error: " << e.what() << "\n";
+    return 1;
+  }
+  return 1;
+}

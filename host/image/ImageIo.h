@@ -1,0 +1,37 @@
+#pragma once
+// Image files: EXR (linear float, the lossless format every render and compare
+// uses) and PNG (8-bit sRGB for looking at). Errors are InputError "FILE: REASON".
+#include <filesystem>
+
+#include "image/Image.h"
+
+namespace pyrolume {
+
+// sRGB OETF and its inverse, IEC 61966-2-1 (the piecewise curve, not gamma 2.2):
+//   encode: 12.92·L for L ≤ 0.0031308, else 1.055·L^(1/2.4) − 0.055
+//   decode: V/12.92 for V ≤ 0.04045, else ((V + 0.055)/1.055)^2.4
+// encode clamps to [0, 1] first (NaN → 0); decode expects V in [0, 1].
+float srgb_encode(float linear);
+float srgb_decode(float encoded);
+
+// linear → 8-bit sRGB after scaling by 2^exposure_stops: round(255·encode(L·2^e)).
+unsigned char srgb_encode_u8(float linear, double exposure_stops = 0.0);
+
+// Chooses the format by extension (case-insensitive):
+//   .exr  float32, ZIP, channels R, G, B (+ variance.R/G/B when img has variance);
+//         linear, exposure NOT applied.
+//   .png  8-bit sRGB RGB, exposure applied, variance dropped.
+// Atomic (see AtomicFile.h): a failure leaves no file at `file`.
+// Unknown extension, empty image, or an I/O failure → InputError.
+void write_image(const std::filesystem::path& file, const Image& img, double exposure_stops = 0.0);
+
+// Reads by content, not by extension:
+//   EXR: data window; R, G, B (missing ones read as 0); a Y-only file gives
+//        R = G = B = Y; A is ignored; variance.R/G/B loaded when all three exist.
+//        Half and uint channels are converted to float.
+//   PNG/JPG/BMP/TGA (via stb_image): sRGB decoded to linear (8- and 16-bit).
+//   Radiance .hdr (via stb_image): already linear.
+// Missing, unreadable or corrupt file → InputError naming the file and the reason.
+Image read_image(const std::filesystem::path& file);
+
+}  // namespace pyrolume

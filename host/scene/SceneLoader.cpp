@@ -1,0 +1,343 @@
+// Scene JSON (format v1) -> Scene, with strict validation: unknown keys, wrong
+// types and out-of-range values are errors that name the file and key path, so a
+// typo never silently renders something else.
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/Scene.h"
+#include "util/Error.h"
+
+namespace pyrolume {
+namespace {
+
+using json = nlohmann::json;
+
+// A JSON object being read: remembers which keys were consumed so leftovers are
+// reported as unknown.
+class Reader {
+ public:
+  Reader(const json& j, std::string path, const std::string& file) : j_(j), path_(std::move(path)), file_(file) {
+    if (!j_.is_object()) fail("", "expected an object");
+  }
+
+  [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
+    throw input_error(file_, key.empty() ? path_ : join(key), reason);
+  }
+  std::string join(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  bool has(const std::string& key) const { return j_.contains(key); }
+  const json& raw(const std::string& key) {
+    seen_.insert(key);
+    return j_.at(key);
+  }
+
+  double number(const std::string& key, double fallback) {
+    if (!has(key)) return fallback;
+    const json& v = raw(key);
+    if (!v.is_number()) fail(key, "expected a number, got " + type_name(v));
+    double d = v.get<double>();
+    if (!std::isfinite(d)) fail(key, "must be finite");
+    return d;
+  }
+  double number_required(const std::string& key) {
+    if (!has(key)) fail(key, "missing required key");
+    return number(key, 0.0);
+  }
+  int integer(const std::string& key, int fallback, int min_value, int max_value) {
+    if (!has(key)) return fallback;
+    const json& v = raw(key);
+    if (!v.is_number_integer() && !v.is_number_unsigned()) fail(key, "expected an integer, got " + type_name(v));
+    long long i = v.get<long long>();
+    if (i < min_value || i > max_value)
+      fail(key, "must be in [" + std::to_string(min_value) + ", " + std::to_string(max_value) + "], got " + std::to_string(i));
+    return static_cast<int>(i);
+  }
+  bool boolean(const std::string& key, bool fallback) {
+    if (!has(key)) return fallback;
+    const json& v = raw(key);
+    if (!v.is_boolean()) fail(key, "expected true or false, got " + type_name(v));
+    return v.get<bool>();
+  }
+  std::string string(const std::string& key, const std::string& fallback) {
+    if (!has(key)) return fallback;
+    const json& v = raw(key);
+    if (!v.is_string()) fail(key, "expected a string, got " + type_name(v));
+    return v.get<std::string>();
+  }
+  std::string choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed) {
+    std::string s = string(key, fallback);
+    for (const auto& a : allowed)
+      if (s == a) return s;
+    std::string list;
+    for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + ("\"" + a + "\"");
+    fail(key, "must be one of " + list + ", got \"" + s + "\"");
+  }
+  glm::dvec3 vec3(const std::string& key, glm::dvec3 fallback) {
+    if (!has(key)) return fallback;
+    const json& v = raw(key);
+    if (!v.is_array() || v.size() != 3) fail(key, "expected an array of 3 numbers");
+    glm::dvec3 r;
+    for (int i = 0; i < 3; ++i) {
+      if (!v[i].is_number()) fail(key, "expected an array of 3 numbers");
+      r[i] = v[i].get<double>();
+      if (!std::isfinite(r[i])) fail(key, "must be finite");
+    }
+    return r;
+  }
+  glm::dvec3 vec3_required(const std::string& key) {
+    if (!has(key)) fail(key, "missing required key");
+    return vec3(key, {});
+  }
+  glm::dvec3 nonnegative_rgb(const std::string& key, glm::dvec3 fallback) {
+    glm::dvec3 v = vec3(key, fallback);
+    if (v.x < 0 || v.y < 0 || v.z < 0) fail(key, "must be >= 0 in every channel");
+    return v;
+  }
+  Reader child(const std::string& key) {
+    seen_.insert(key);
+    return Reader(j_.at(key), join(key), file_);
+  }
+  // After reading: any key not consumed is a typo or unsupported.
+  void finish() const {
+    for (auto it = j_.begin(); it != j_.end(); ++it)
+      if (!seen_.count(it.key())) fail(it.key(), "unknown key");
+  }
+  const std::string& path() const { return path_; }
+
+  static std::string type_name(const json& v) { return v.type_name(); }
+
+ private:
+  const json& j_;
+  std::string path_;
+  const std::string& file_;
+  std::set<std::string> seen_;
+};
+
+std::filesystem::path resolve(const std::filesystem::path& base, const std::string& p) {
+  std::filesystem::path path(p);
+  return path.is_absolute() ? path : (base / path).lexically_normal();
+}
+
+Bounds read_bounds(Reader r) {
+  Bounds b;
+  bool sphere = r.has("sphere"), box = r.has("box");
+  if (sphere == box) r.fail("", "expected exactly one of \"sphere\" or \"box\"");
+  if (sphere) {
+    Reader s = r.child("sphere");
+    b.kind = Bounds::Kind::Sphere;
+    b.center = s.vec3_required("center");
+    b.radius = s.number_required("radius");
+    if (!(b.radius > 0)) s.fail("radius", "must be > 0");
+    s.finish();
+  } else {
+    Reader s = r.child("box");
+    b.kind = Bounds::Kind::Box;
+    b.min = s.vec3_required("min");
+    b.max = s.vec3_required("max");
+    if (!(b.min.x < b.max.x && b.min.y < b.max.y && b.min.z < b.max.z)) s.fail("max", "must exceed min on every axis");
+    s.finish();
+  }
+  r.finish();
+  return b;
+}
+
+BlackbodyMode read_blackbody(Reader& r) {
+  std::string m = r.choice("blackbody", "seed", {"seed", "peak", "physical"});
+  return m == "peak" ? BlackbodyMode::Peak : m == "physical" ? BlackbodyMode::Physical : BlackbodyMode::Seed;
+}
+
+Emission read_emission(Reader r, bool grid) {
+  Emission e;
+  e.is_grid = grid;
+  if (r.has("rgb")) e.rgb = r.nonnegative_rgb("rgb", {});
+  if (r.has("temperature_k")) {
+    if (grid) r.fail("temperature_k", "a vdb medium takes its temperature from its grid (see \"temperature\")");
+    double t = r.number("temperature_k", 0);
+    if (t < 0) r.fail("temperature_k", "must be >= 0 kelvin");
+    e.temperature_k = t;
+  }
+  if (e.rgb && e.temperature_k) r.fail("rgb", "give either rgb or temperature_k, not both");
+  e.scale = r.number("scale", 1.0);
+  if (e.scale < 0) r.fail("scale", "must be >= 0");
+  e.blackbody = read_blackbody(r);
+  e.observer = r.integer("observer", 2, 2, 10);
+  if (e.observer != 2 && e.observer != 10) r.fail("observer", "must be 2 (CIE 1931) or 10 (CIE 1964)");
+  if (r.has("adapt_to_k")) {
+    double a = r.number("adapt_to_k", 0);
+    if (!(a > 0)) r.fail("adapt_to_k", "must be > 0 kelvin");
+    e.adapt_to_k = a;
+  }
+  if (grid && e.rgb) e.is_grid = false;  // constant colour times density
+  r.finish();
+  return e;
+}
+
+Medium read_medium(Reader r, const std::filesystem::path& base, int index) {
+  Medium m;
+  m.name = r.string("name", "medium" + std::to_string(index));
+  std::string type = r.choice("type", "", {"homogeneous", "vdb"});
+  m.type = type == "vdb" ? Medium::Type::Vdb : Medium::Type::Homogeneous;
+  m.sigma_a = r.nonnegative_rgb("sigma_a", m.sigma_a);
+  m.sigma_s = r.nonnegative_rgb("sigma_s", m.sigma_s);
+  m.g = r.number("g", 0.0);
+  if (!(std::abs(m.g) < 1.0)) r.fail("g", "must satisfy |g| < 1");
+  if (m.type == Medium::Type::Homogeneous) {
+    if (!r.has("bounds")) r.fail("bounds", "missing required key (a homogeneous medium needs a sphere or box)");
+    m.bounds = read_bounds(r.child("bounds"));
+  } else {
+    if (r.has("bounds")) r.fail("bounds", "a vdb medium is bounded by its grids");
+    if (!r.has("file")) r.fail("file", "missing required key");
+    m.file = resolve(base, r.string("file", ""));
+    m.density_grid = r.string("density_grid", "");
+    m.temperature_grid = r.string("temperature_grid", "");
+    m.density_scale = r.number("density_scale", 1.0);
+    if (m.density_scale < 0) r.fail("density_scale", "must be >= 0");
+    m.downsample = r.integer("downsample", 1, 1, 64);
+    if (r.has("temperature")) {
+      Reader t = r.child("temperature");
+      m.temperature.scale = t.number("scale", 1.0);
+      m.temperature.offset = t.number("offset", 0.0);
+      m.temperature.cutoff_k = t.number("cutoff_k", 100.0);
+      if (m.temperature.cutoff_k < 0) t.fail("cutoff_k", "must be >= 0 kelvin");
+      t.finish();
+    }
+    if (r.has("transform")) {
+      Reader t = r.child("transform");
+      m.transform.translate = t.vec3("translate", m.transform.translate);
+      m.transform.rotate_deg = t.vec3("rotate_deg", m.transform.rotate_deg);
+      m.transform.scale = t.vec3("scale", m.transform.scale);
+      if (m.transform.scale.x == 0 || m.transform.scale.y == 0 || m.transform.scale.z == 0)
+        t.fail("scale", "must be non-zero on every axis");
+      t.finish();
+    }
+  }
+  if (r.has("emission")) m.emission = read_emission(r.child("emission"), m.type == Medium::Type::Vdb);
+  else m.emission.is_grid = false;
+  r.finish();
+  return m;
+}
+
+Shape read_shape(Reader r, const std::filesystem::path& base) {
+  Shape s;
+  if (!r.has("mesh")) r.fail("mesh", "missing required key");
+  s.mesh = resolve(base, r.string("mesh", ""));
+  if (r.has("material")) {
+    Reader m = r.child("material");
+    if (m.has("diffuse")) {
+      Reader d = m.child("diffuse");
+      s.albedo = d.nonnegative_rgb("rgb", s.albedo);
+      if (s.albedo.x > 1 || s.albedo.y > 1 || s.albedo.z > 1) d.fail("rgb", "albedo must be <= 1 in every channel");
+      if (d.has("texture")) s.texture = resolve(base, d.string("texture", ""));
+      d.finish();
+    }
+    m.finish();
+  }
+  r.finish();
+  return s;
+}
+
+}  // namespace
+
+Scene parse_scene(const std::string& json_text, const std::filesystem::path& file) {
+  const std::string fname = file.string();
+  json root;
+  try {
+    root = json::parse(json_text);
+  } catch (const json::parse_error& e) {
+    // nlohmann's message carries the byte offset; keep it on one line.
+    std::string what = e.what();
+    throw input_error(fname, "", "invalid JSON: " + what);
+  }
+  const std::filesystem::path base = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  Scene s;
+  s.file = file;
+  Reader r(root, "", fname);
+
+  if (r.has("camera")) {
+    Reader c = r.child("camera");
+    s.camera.position = c.vec3("position", s.camera.position);
+    s.camera.look_at = c.vec3("look_at", s.camera.look_at);
+    s.camera.up = c.vec3("up", s.camera.up);
+    s.camera.fov_deg = c.number("fov_deg", s.camera.fov_deg);
+    if (!(s.camera.fov_deg > 0 && s.camera.fov_deg < 180)) c.fail("fov_deg", "must be in (0, 180) degrees");
+    glm::dvec3 f = s.camera.look_at - s.camera.position;
+    if (glm::length(f) == 0) c.fail("look_at", "must differ from position");
+    if (glm::length(glm::cross(glm::normalize(f), s.camera.up)) < 1e-9) c.fail("up", "must not be parallel to the view direction");
+    c.finish();
+  }
+  if (r.has("film")) {
+    Reader f = r.child("film");
+    s.film.width = f.integer("width", s.film.width, 1, 16384);
+    s.film.height = f.integer("height", s.film.height, 1, 16384);
+    s.film.spp = f.integer("spp", s.film.spp, 1, 1 << 24);
+    s.film.exposure = f.number("exposure", s.film.exposure);
+    s.film.seed = static_cast<uint32_t>(f.integer("seed", static_cast<int>(s.film.seed), 0, 2147483647));
+    f.finish();
+  }
+  if (r.has("integrator")) {
+    Reader i = r.child("integrator");
+    s.integrator.max_depth = i.integer("max_depth", s.integrator.max_depth, 0, 100000);
+    s.integrator.mis = i.boolean("mis", s.integrator.mis);
+    s.integrator.emission_estimator = i.choice("emission_estimator", "absorption", {"absorption", "collision"});
+    s.integrator.majorant = i.choice("majorant", "grid", {"grid", "global"});
+    if (i.has("majorant_grid")) {
+      glm::dvec3 g = i.vec3("majorant_grid", {});
+      for (int k = 0; k < 3; ++k)
+        if (g[k] < 1 || g[k] > 1024 || g[k] != std::floor(g[k])) i.fail("majorant_grid", "expected 3 integers in [1, 1024]");
+      s.integrator.majorant_grid = glm::ivec3(g);
+    }
+    i.finish();
+  }
+  if (r.has("background")) {
+    Reader b = r.child("background");
+    s.background = b.nonnegative_rgb("rgb", s.background);
+    b.finish();
+  }
+  if (r.has("environment")) {
+    Reader e = r.child("environment");
+    Environment env;
+    if (!e.has("file")) e.fail("file", "missing required key");
+    env.file = resolve(base, e.string("file", ""));
+    env.scale = e.number("scale", 1.0);
+    if (env.scale < 0) e.fail("scale", "must be >= 0");
+    env.rotation_deg = e.number("rotation_deg", 0.0);
+    e.finish();
+    s.environment = env;
+  }
+  if (r.has("media")) {
+    const json& media = r.raw("media");
+    if (!media.is_array()) r.fail("media", "expected an array");
+    std::set<std::string> names;
+    for (size_t k = 0; k < media.size(); ++k) {
+      std::string path = "media[" + std::to_string(k) + "]";
+      Medium m = read_medium(Reader(media[k], path, fname), base, static_cast<int>(k));
+      if (!names.insert(m.name).second) throw input_error(fname, path + ".name", "duplicate medium name \"" + m.name + "\"");
+      s.media.push_back(std::move(m));
+    }
+  }
+  if (r.has("shapes")) {
+    const json& shapes = r.raw("shapes");
+    if (!shapes.is_array()) r.fail("shapes", "expected an array");
+    for (size_t k = 0; k < shapes.size(); ++k)
+      s.shapes.push_back(read_shape(Reader(shapes[k], "shapes[" + std::to_string(k) + "]", fname), base));
+  }
+  r.finish();
+  return s;
+}
+
+Scene load_scene(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    std::error_code ec;
+    bool exists = std::filesystem::exists(file, ec);
+    throw input_error(file.string(), "", exists ? "cannot be read" : "no such file");
+  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_scene(ss.str(), file);
+}
+
+}  // namespace pyrolume

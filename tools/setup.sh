@@ -1,0 +1,40 @@
+# Shared set-up for tools/demo and tools/test (sourced, not run): install the
+# Debian packages pyrolume needs when any is missing, then configure and build.
+set -euo pipefail
+
+PYROLUME_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+PYROLUME_BUILD="${PYROLUME_BUILD:-$PYROLUME_ROOT/build}"
+
+# Build tools, Vulkan (loader, headers, lavapipe, validation layers, glslang),
+# and the libraries the host uses.
+PYROLUME_PACKAGES=(
+  build-essential cmake ninja-build pkg-config
+  libvulkan-dev mesa-vulkan-drivers vulkan-tools vulkan-validationlayers glslang-tools
+  libopenexr-dev libglm-dev nlohmann-json3-dev libcli11-dev libstb-dev libgtest-dev
+)
+
+pyrolume_install_packages() {
+  local missing=()
+  for p in "${PYROLUME_PACKAGES[@]}"; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+      missing+=("$p")
+    fi
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "pyrolume: installing missing Debian packages: ${missing[*]}" >&2
+  local sudo=""
+  if [ "$(id -u)" -ne 0 ]; then
+    if command -v sudo >/dev/null 2>&1; then sudo="sudo"; else
+      echo "pyrolume: need root to install: apt-get install ${missing[*]}" >&2; exit 1
+    fi
+  fi
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get update -q >&2
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}" >&2
+}
+
+pyrolume_build() {
+  local jobs
+  jobs="$(nproc 2>/dev/null || echo 2)"
+  cmake -S "$PYROLUME_ROOT" -B "$PYROLUME_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release >&2
+  cmake --build "$PYROLUME_BUILD" -j "$jobs" >&2
+}
