@@ -54,6 +54,17 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
       throw input_error(args.stats, "", "stats folder does not exist");
   }
 
+  for (size_t i = 0; i < scene.media.size(); ++i)
+    if (scene.media[i].type == Medium::Type::Vdb)
+      throw input_error(scene.file.string(), "media[" + std::to_string(i) + "].type",
+                        "\"vdb\" media are not supported by this build yet");
+  // Accepted by the v1 format but not rendered yet: say so rather than ignore silently.
+  if (!scene.shapes.empty())
+    std::cerr << "pyrolume: warning: " << scene.file.string() << ": shapes: surfaces are not rendered yet; ignored\n";
+  if (scene.environment)
+    std::cerr << "pyrolume: warning: " << scene.file.string()
+              << ": environment: environment maps are not rendered yet; background.rgb is used\n";
+
   RenderSettings settings;
   settings.width = args.width.value_or(scene.film.width);
   settings.height = args.height.value_or(scene.film.height);

@@ -1,6 +1,8 @@
 #pragma once
 // Blackbody emission: Planck's law -> CIE XYZ -> linear sRGB (docs/blackbody.md).
+#include <iosfwd>
 #include <optional>
+#include <string>
 #include <string_view>
 
 #include <glm/glm.hpp>
@@ -40,5 +42,16 @@ glm::dvec3 adapt_blackbody_xyz(const glm::dvec3& xyz, double adapt_to_k, int obs
 // "seed" | "peak" | "physical".
 const char* to_string(BlackbodyMode mode);
 std::optional<BlackbodyMode> parse_blackbody_mode(std::string_view name);
+
+// `pyrolume blackbody`: prints CSV "kelvin,x,y,r,g,b" to `out` for T = from_k,
+// from_k + step_k, ... up to and including to_k (x, y: the CIE xy of the spectrum
+// for the observer, `nan` where it is zero; r, g, b: the mode's linear sRGB). With
+// png_path non-empty it also writes the swatch strip there (seed colours). Bad
+// arguments (NaN/Inf, negative, from > to, step <= 0, observer not 2|10, more than
+// kMaxBlackbodyRows rows, more swatches than the strip takes, an unwritable PNG
+// path): one line to `err`, nothing to `out`, returns 2. Otherwise returns 0.
+inline constexpr long kMaxBlackbodyRows = 1000000;
+int run_blackbody_command(double from_k, double to_k, double step_k, BlackbodyMode mode, int observer,
+                          const std::string& png_path, std::ostream& out, std::ostream& err);
 
 }  // namespace pyrolume::color

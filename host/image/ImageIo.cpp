@@ -16,6 +16,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <new>
 #include <ostream>
 #include <string>
 
@@ -195,7 +196,9 @@ void write_image(const fs::path& file, const Image& img, double exposure_stops) 
     });
   } catch (const InputError&) {
     throw;
-  } catch (const std::exception& e) {
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& e) {  // OpenEXR (Iex) and stb encoding failures
     throw input_error(file.string(), "", one_line(e.what()));
   }
 }
@@ -216,7 +219,7 @@ Image read_image(const fs::path& file) {
     return exr ? read_exr(file) : read_stb(file, bytes);
   } catch (const InputError&) {
     throw;
-  } catch (const std::exception& e) {
+  } catch (const std::exception& e) {  // Iex from a corrupt or truncated EXR; bad_alloc from a bogus size
     throw input_error(name, "", "cannot read EXR: " + one_line(e.what()));
   }
 }

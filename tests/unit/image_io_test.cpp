@@ -7,6 +7,7 @@
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <gtest/gtest.h>
+#include <half.h>
 #include <stb_image.h>
 
 #include <cmath>
@@ -180,13 +181,14 @@ TEST(ImageIo, ReadsHalfRgbaAndYOnlyAndOffsetDataWindow) {
   {
     Imath::Box2i win(Imath::V2i(5, 7), Imath::V2i(6, 7));
     Imf::Header h(win, win);
-    for (const char* n : {"R", "G", "B", "A"}) h.channels().insert(n, Imf::Channel(Imf::FLOAT));
-    std::vector<float> px = {0.5f, 0.25f, 2.0f, 1.0f, 4.0f, 0.0f, 0.125f, 0.5f};
+    for (const char* n : {"R", "G", "B", "A"}) h.channels().insert(n, Imf::Channel(Imf::HALF));
+    std::vector<Imath::half> px;
+    for (float v : {0.5f, 0.25f, 2.0f, 1.0f, 4.0f, 0.0f, 0.125f, 0.5f}) px.push_back(Imath::half(v));
     Imf::FrameBuffer fb;
     const char* names[4] = {"R", "G", "B", "A"};
-    char* base = (char*)px.data() - 5 * 4 * sizeof(float) - 7 * 2 * 4 * sizeof(float);
-    for (int c = 0; c < 4; ++c)
-      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 4 * sizeof(float), 8 * sizeof(float)));
+    const size_t hs = sizeof(Imath::half);
+    char* base = (char*)px.data() - 5 * 4 * hs - 7 * 2 * 4 * hs;  // absolute data-window addressing
+    for (int c = 0; c < 4; ++c) fb.insert(names[c], Imf::Slice(Imf::HALF, base + c * hs, 4 * hs, 8 * hs));
     Imf::OutputFile out((dir / "rgba.exr").c_str(), h);
     out.setFrameBuffer(fb);
     out.writePixels(1);
@@ -200,9 +202,9 @@ TEST(ImageIo, ReadsHalfRgbaAndYOnlyAndOffsetDataWindow) {
   {
     Imf::Header h(2, 1);
     h.channels().insert("Y", Imf::Channel(Imf::HALF));
-    std::vector<float> y = {0.75f, 3.0f};
+    std::vector<Imath::half> y = {Imath::half(0.75f), Imath::half(3.0f)};
     Imf::FrameBuffer fb;
-    fb.insert("Y", Imf::Slice(Imf::FLOAT, (char*)y.data(), sizeof(float), 2 * sizeof(float)));
+    fb.insert("Y", Imf::Slice(Imf::HALF, (char*)y.data(), sizeof(Imath::half), 2 * sizeof(Imath::half)));
     Imf::OutputFile out((dir / "y.exr").c_str(), h);
     out.setFrameBuffer(fb);
     out.writePixels(1);

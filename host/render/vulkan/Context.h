@@ -31,7 +31,7 @@ class Context {
     bool host_query_reset = false;
   };
 
-  explicit Context(const Options& options = {});
+  explicit Context(const Options& options);
   ~Context();
   // The debug messenger holds `this`: not copyable, not movable.
   Context(const Context&) = delete;
@@ -74,6 +74,8 @@ class Context {
                                                        const VkDebugUtilsMessengerCallbackDataEXT* data,
                                                        void* user);
 
+  // First: the messenger writes it until the instance is gone.
+  std::atomic<uint64_t> validation_messages_{0};
   // Declared in creation order: members are destroyed in reverse.
   UniqueInstance instance_;
   UniqueDebugMessenger messenger_;
@@ -89,7 +91,6 @@ class Context {
   double timestamp_period_ns_ = 0.0;
   bool validation_enabled_ = false;
   bool debug_utils_ = false;
-  std::atomic<uint64_t> validation_messages_{0};
 
   std::mutex submit_mutex_;
   UniqueCommandPool command_pool_;

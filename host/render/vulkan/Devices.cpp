@@ -1,5 +1,8 @@
 #include "render/vulkan/Devices.h"
 
+// Vulkan structs are written {.sType = ...}: the rest is zero by design.
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -40,8 +43,8 @@ DeviceInfo describe_device(VkPhysicalDevice device, uint32_t index) {
   info.api_version = props.apiVersion;
   // Driver properties are core in 1.2; the instance is 1.1+ so properties2 exists.
   if (props.apiVersion >= VK_API_VERSION_1_2) {
-    VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
-    VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &driver};
+    VkPhysicalDeviceDriverProperties driver{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+    VkPhysicalDeviceProperties2 props2{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &driver};
     vkGetPhysicalDeviceProperties2(device, &props2);
     info.driver_name = driver.driverName;
   }
@@ -66,10 +69,10 @@ std::vector<DeviceInfo> list_devices(VkInstance instance) {
 std::vector<DeviceInfo> list_devices() {
   uint32_t loader_version = VK_API_VERSION_1_0;
   vkEnumerateInstanceVersion(&loader_version);
-  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  VkApplicationInfo app{.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "pyrolume devices";
   app.apiVersion = loader_version >= VK_API_VERSION_1_3 ? VK_API_VERSION_1_3 : loader_version;
-  VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  VkInstanceCreateInfo ci{.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
   ci.pApplicationInfo = &app;
   // Portability drivers (MoltenVK) are listed only when asked for.
   uint32_t ext_count = 0;

@@ -1,0 +1,30 @@
+#pragma once
+// The blackbody swatch strip: one swatch per temperature, left to right, each the
+// seed-normalised colour (largest channel 1) display-encoded as sRGB, with its
+// temperature written underneath. The picture a person checks first.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+namespace pyrolume::color {
+
+struct SwatchStrip {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;  // 8-bit sRGB, row-major, top row first
+};
+
+// At most this many swatches (one pixel wide each at the limit).
+inline constexpr int kMaxSwatches = 16384;
+
+// Throws std::invalid_argument for an empty list, more than kMaxSwatches
+// temperatures, or a bad observer/adapt_to_k.
+SwatchStrip render_swatch_strip(const std::vector<double>& temperatures_k, int observer = 2,
+                                std::optional<double> adapt_to_k = std::nullopt);
+
+// Writes the strip as PNG through a temp file in the destination folder that is
+// renamed over `path` only once complete. Throws std::runtime_error naming the
+// path if it cannot be written.
+void write_swatch_strip_png(const std::filesystem::path& path, const SwatchStrip& strip);
+
+}  // namespace pyrolume::color

@@ -1,0 +1,44 @@
+#pragma once
+// The CPU reference renderer: plain, double precision, written independently of
+// the GLSL path so that it can catch the GPU path's mistakes (issue 2, part 3).
+// Homogeneous media (sphere / box bounds, overlapping media add), constant
+// background, the "absorption" emission estimator, Henyey–Greenstein scattering.
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "render/Backend.h"
+#include "scene/Scene.h"
+
+namespace pyrolume {
+
+class CpuRenderer : public Backend {
+ public:
+  // threads <= 0: std::thread::hardware_concurrency(). The image does not depend
+  // on the thread count (per-sample RNG streams, per-pixel sums in sample order).
+  explicit CpuRenderer(int threads = 0);
+
+  std::string name() const override { return "cpu"; }
+  std::string device_name() const override;  // "CPU reference (N threads)"
+  int threads() const { return threads_; }
+
+  // Throws std::runtime_error for what the reference cannot render yet (vdb
+  // media, environment maps, surfaces) and std::invalid_argument for bad settings.
+  RenderResult render(const Scene& scene, const RenderSettings& settings, const RenderControl& control) override;
+
+  // Samples per pixel per progressive pass (progress/cancel/time-limit granularity).
+  static constexpr int kPassSpp = 4;
+
+ private:
+  int threads_;
+};
+
+namespace cpu {
+
+// Camera ray through the continuous film position (fx, fy) in pixels, (0,0) =
+// top-left corner of the image, y down (DESIGN.md camera convention: vertical
+// fov, image x along normalize(cross(forward, up))). Returns a unit direction.
+glm::dvec3 camera_ray_direction(const Camera& camera, int width, int height, double fx, double fy);
+
+}  // namespace cpu
+}  // namespace pyrolume

@@ -1,0 +1,135 @@
+#include "render/vulkan/Pipeline.h"
+
+// Vulkan structs are written {.sType = ...}: the rest is zero by design.
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+
+#include <map>
+
+namespace pyrolume::vk {
+
+ComputePipeline::ComputePipeline(Context& ctx, const std::vector<uint32_t>& spirv,
+                                 const std::vector<Binding>& bindings, uint32_t push_constant_bytes,
+                                 const std::vector<std::pair<uint32_t, uint32_t>>& specialization,
+                                 const char* debug_name)
+    : bindings_(bindings), push_constant_bytes_(push_constant_bytes), name_(debug_name ? debug_name : "compute") {
+  const VkDevice dev = ctx.device();
+  if (spirv.empty()) throw VulkanError("ComputePipeline " + name_ + ": empty SPIR-V");
+
+  std::vector<VkDescriptorSetLayoutBinding> lb;
+  for (const Binding& b : bindings) lb.push_back({b.binding, b.type, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+  VkDescriptorSetLayoutCreateInfo sli{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  sli.bindingCount = uint32_t(lb.size());
+  sli.pBindings = lb.data();
+  VkDescriptorSetLayout sl = VK_NULL_HANDLE;
+  VK_CHECK(vkCreateDescriptorSetLayout(dev, &sli, nullptr, &sl));
+  set_layout_ = UniqueDescriptorSetLayout(sl, {dev});
+  ctx.set_name(sl, (name_ + " set layout").c_str());
+
+  VkPushConstantRange pcr{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_constant_bytes};
+  VkPipelineLayoutCreateInfo pli{.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pli.setLayoutCount = 1;
+  pli.pSetLayouts = &sl;
+  pli.pushConstantRangeCount = push_constant_bytes ? 1 : 0;
+  pli.pPushConstantRanges = &pcr;
+  VkPipelineLayout pl = VK_NULL_HANDLE;
+  VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &pl));
+  layout_ = UniquePipelineLayout(pl, {dev});
+  ctx.set_name(pl, (name_ + " layout").c_str());
+
+  // The module is only needed while the pipeline is created.
+  VkShaderModuleCreateInfo smi{.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  smi.codeSize = spirv.size() * sizeof(uint32_t);
+  smi.pCode = spirv.data();
+  VkShaderModule sm = VK_NULL_HANDLE;
+  VK_CHECK(vkCreateShaderModule(dev, &smi, nullptr, &sm));
+  UniqueShaderModule module(sm, {dev});
+  ctx.set_name(sm, name_.c_str());
+
+  std::vector<VkSpecializationMapEntry> entries;
+  std::vector<uint32_t> values;
+  for (auto [id, value] : specialization) {
+    entries.push_back({id, uint32_t(values.size() * sizeof(uint32_t)), sizeof(uint32_t)});
+    values.push_back(value);
+  }
+  VkSpecializationInfo spec{uint32_t(entries.size()), entries.data(), values.size() * sizeof(uint32_t),
+                            values.data()};
+
+  VkComputePipelineCreateInfo ci{.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  ci.stage = {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  ci.stage.module = sm;
+  ci.stage.pName = "main";
+  ci.stage.pSpecializationInfo = entries.empty() ? nullptr : &spec;
+  ci.layout = pl;
+  VkPipeline p = VK_NULL_HANDLE;
+  VK_CHECK(vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &ci, nullptr, &p));
+  pipeline_ = UniquePipeline(p, {dev});
+  ctx.set_name(p, name_.c_str());
+}
+
+void ComputePipeline::bind(VkCommandBuffer cmd, VkDescriptorSet set) const {
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.get());
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_.get(), 0, 1, &set, 0, nullptr);
+}
+
+void ComputePipeline::push(VkCommandBuffer cmd, const void* data, uint32_t bytes) const {
+  if (bytes > push_constant_bytes_)
+    throw VulkanError("ComputePipeline " + name_ + ": push of " + std::to_string(bytes) + " bytes exceeds its " +
+                      std::to_string(push_constant_bytes_) + "-byte push-constant block");
+  vkCmdPushConstants(cmd, layout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, data);
+}
+
+DescriptorSet::DescriptorSet(Context& ctx, const ComputePipeline& pipeline, const char* debug_name)
+    : device_(ctx.device()), bindings_(pipeline.bindings()) {
+  std::map<VkDescriptorType, uint32_t> counts;
+  for (const auto& b : bindings_) counts[b.type]++;
+  std::vector<VkDescriptorPoolSize> sizes;
+  for (auto [type, n] : counts) sizes.push_back({type, n});
+  VkDescriptorPoolCreateInfo pci{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pci.maxSets = 1;
+  pci.poolSizeCount = uint32_t(sizes.size());
+  pci.pPoolSizes = sizes.data();
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  VK_CHECK(vkCreateDescriptorPool(device_, &pci, nullptr, &pool));
+  pool_ = UniqueDescriptorPool(pool, {device_});
+  std::string name = debug_name ? debug_name : pipeline.name() + " set";
+  ctx.set_name(pool, name.c_str());
+
+  VkDescriptorSetLayout sl = pipeline.set_layout();
+  VkDescriptorSetAllocateInfo ai{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  ai.descriptorPool = pool;
+  ai.descriptorSetCount = 1;
+  ai.pSetLayouts = &sl;
+  VK_CHECK(vkAllocateDescriptorSets(device_, &ai, &set_));
+  ctx.set_name(set_, name.c_str());
+}
+
+VkDescriptorType DescriptorSet::type_of(uint32_t binding) const {
+  for (const auto& b : bindings_)
+    if (b.binding == binding) return b.type;
+  throw VulkanError("DescriptorSet: the pipeline has no binding " + std::to_string(binding));
+}
+
+void DescriptorSet::write_buffer(uint32_t binding, const Buffer& buffer, VkDeviceSize offset, VkDeviceSize range) {
+  VkDescriptorBufferInfo info{buffer.buffer(), offset, range};
+  VkWriteDescriptorSet w{.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  w.dstSet = set_;
+  w.dstBinding = binding;
+  w.descriptorCount = 1;
+  w.descriptorType = type_of(binding);
+  w.pBufferInfo = &info;
+  vkUpdateDescriptorSets(device_, 1, &w, 0, nullptr);
+}
+
+void DescriptorSet::write_image(uint32_t binding, VkImageView view, VkSampler sampler, VkImageLayout layout) {
+  VkDescriptorImageInfo info{sampler, view, layout};
+  VkWriteDescriptorSet w{.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  w.dstSet = set_;
+  w.dstBinding = binding;
+  w.descriptorCount = 1;
+  w.descriptorType = type_of(binding);
+  w.pImageInfo = &info;
+  vkUpdateDescriptorSets(device_, 1, &w, 0, nullptr);
+}
+
+}  // namespace pyrolume::vk

@@ -1,0 +1,79 @@
+#pragma once
+// A compute pipeline with one descriptor set and an optional push-constant
+// block, and a descriptor set allocated from its own pool.
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "render/vulkan/Context.h"
+#include "render/vulkan/Handles.h"
+#include "render/vulkan/Memory.h"
+
+namespace pyrolume::vk {
+
+class ComputePipeline {
+ public:
+  struct Binding {
+    uint32_t binding;
+    VkDescriptorType type;
+  };
+  // specialization: (constant_id, 32-bit value as a bit pattern). Every
+  // constant is 4 bytes: use std::bit_cast for floats, 0/1 for bools.
+  ComputePipeline(Context& ctx, const std::vector<uint32_t>& spirv, const std::vector<Binding>& bindings,
+                  uint32_t push_constant_bytes,
+                  const std::vector<std::pair<uint32_t, uint32_t>>& specialization, const char* debug_name);
+
+  VkPipeline pipeline() const { return pipeline_.get(); }
+  VkPipelineLayout layout() const { return layout_.get(); }
+  VkDescriptorSetLayout set_layout() const { return set_layout_.get(); }
+  const std::vector<Binding>& bindings() const { return bindings_; }
+  uint32_t push_constant_bytes() const { return push_constant_bytes_; }
+  const std::string& name() const { return name_; }
+
+  // Binds the pipeline and `set` (set = 0) for dispatch.
+  void bind(VkCommandBuffer cmd, VkDescriptorSet set) const;
+  // bytes must not exceed push_constant_bytes.
+  void push(VkCommandBuffer cmd, const void* data, uint32_t bytes) const;
+  template <typename T>
+  void push(VkCommandBuffer cmd, const T& value) const {
+    push(cmd, &value, uint32_t(sizeof(T)));
+  }
+
+ private:
+  std::vector<Binding> bindings_;
+  uint32_t push_constant_bytes_ = 0;
+  std::string name_;
+  UniqueDescriptorSetLayout set_layout_;
+  UniquePipelineLayout layout_;
+  UniquePipeline pipeline_;
+};
+
+// One descriptor set for a pipeline's set layout, from a pool of its own (freed
+// with it). Every binding must be written before the first dispatch.
+class DescriptorSet {
+ public:
+  DescriptorSet(Context& ctx, const ComputePipeline& pipeline, const char* debug_name = nullptr);
+
+  VkDescriptorSet set() const { return set_; }
+
+  void write_buffer(uint32_t binding, const Buffer& buffer, VkDeviceSize offset = 0,
+                    VkDeviceSize range = VK_WHOLE_SIZE);
+  void write_image(uint32_t binding, VkImageView view, VkSampler sampler,
+                   VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  void write_image(uint32_t binding, const SampledImage& image) {
+    write_image(binding, image.view(), image.sampler());
+  }
+
+ private:
+  VkDescriptorType type_of(uint32_t binding) const;
+
+  VkDevice device_ = VK_NULL_HANDLE;
+  std::vector<ComputePipeline::Binding> bindings_;
+  UniqueDescriptorPool pool_;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;  // freed with the pool
+};
+
+}  // namespace pyrolume::vk

@@ -1,0 +1,80 @@
+// The CLI turns bad input into one line on stderr naming the key, exit status 2,
+// and no output file.
+#include <gtest/gtest.h>
+
+#include "support/TestSupport.h"
+
+using namespace pyrolume::test;
+
+namespace {
+struct CliCase {
+  const char* label;
+  std::string scene;   // scene text, written to bad.json
+  std::string flags;   // extra flags
+  const char* expect;  // substring of stderr
+};
+
+class CliBadInput : public ::testing::TestWithParam<CliCase> {};
+
+const std::string kSphere = R"({"film": {"width": 8, "height": 8, "spp": 1},
+  "media": [{"type": "homogeneous", "bounds": {"sphere": {"center": [0,1,0], "radius": 1}}}]})";
+}  // namespace
+
+TEST_P(CliBadInput, ExitTwoNoOutput) {
+  const CliCase& c = GetParam();
+  auto dir = temp_dir("clibad");
+  write_file(dir / "bad.json", c.scene);
+  auto out = dir / "out.exr";
+  for (const char* backend : {"cpu", "vulkan"}) {
+    CliResult r = run_cli("render " + (dir / "bad.json").string() + " -o " + out.string() + " --backend " + backend +
+                          " " + c.flags);
+    EXPECT_EQ(r.status, 2) << c.label << " (" << backend << "): " << r.err;
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << "expected '" << c.expect << "' in: " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line expected: " << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    EXPECT_FALSE(std::filesystem::exists(out)) << "output written on bad input";
+  }
+  // No temp files left behind either.
+  for (auto& e : std::filesystem::directory_iterator(dir))
+    EXPECT_EQ(e.path().filename(), "bad.json") << "left behind: " << e.path();
+  std::filesystem::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, CliBadInput,
+    ::testing::Values(
+        CliCase{"unknown_key", R"({"film": {"spp": 4, "sppp": 3}})", "", "film.sppp: unknown key"},
+        CliCase{"negative_sigma",
+                R"({"media": [{"type": "homogeneous", "bounds": {"sphere": {"center": [0,0,0], "radius": 1}}, "sigma_s": [0,-1,0]}]})",
+                "", "media[0].sigma_s: must be >= 0"},
+        CliCase{"g_out_of_range",
+                R"({"media": [{"type": "homogeneous", "bounds": {"sphere": {"center": [0,0,0], "radius": 1}}, "g": 1}]})",
+                "", "media[0].g"},
+        CliCase{"spp_zero", R"({"film": {"spp": 0}})", "", "film.spp"},
+        CliCase{"wrong_type", R"({"film": {"height": [3]}})", "", "film.height: expected an integer"},
+        CliCase{"not_json", "this is not json", "", "invalid JSON"},
+        CliCase{"flag_spp_zero", kSphere, "--spp 0", "--spp"}),
+    [](const ::testing::TestParamInfo<CliCase>& info) { return std::string(info.param.label); });
+
+TEST(Cli, MissingSceneFile) {
+  CliResult r = run_cli("render /nonexistent/scene.json -o /tmp/never.exr --backend cpu");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("/nonexistent/scene.json: no such file"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists("/tmp/never.exr"));
+}
+
+TEST(Cli, UnknownBackend) {
+  CliResult r = run_cli("render x.json --backend metal");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--backend"), std::string::npos) << r.err;
+}
+
+TEST(Cli, UnknownImageType) {
+  auto dir = temp_dir("cliext");
+  write_file(dir / "s.json", kSphere);
+  CliResult r = run_cli("render " + (dir / "s.json").string() + " --backend cpu -o " + (dir / "x.tiff").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("x.tiff: unknown image type"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.tiff"));
+  std::filesystem::remove_all(dir);
+}

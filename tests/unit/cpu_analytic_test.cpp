@@ -1,0 +1,238 @@
+// CPU reference vs closed forms (issue 2: analytic tests), plus determinism,
+// progressive control and robustness of the reference itself.
+#include <atomic>
+#include <cmath>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+#include "render/cpu/CpuRenderer.h"
+#include "support/AnalyticScenes.h"
+#include "support/Stats.h"
+
+namespace pyrolume {
+namespace {
+
+using test::ZTestOptions;
+using test::ZTestReport;
+
+RenderSettings settings_for(const Scene& s) {
+  RenderSettings rs;
+  rs.width = s.film.width;
+  rs.height = s.film.height;
+  rs.spp = s.film.spp;
+  rs.seed = s.film.seed;
+  return rs;
+}
+
+RenderResult render(const Scene& s, int threads = 0) {
+  CpuRenderer r(threads);
+  return r.render(s, settings_for(s), {});
+}
+
+bool all_finite(const RenderResult& r) {
+  for (double v : r.sum)
+    if (!std::isfinite(v)) return false;
+  for (double v : r.sum_sq)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
+// Absorption-estimator samples are Le or background (Bernoulli-like): silhouette
+// pixels with few hits can show s² = 0 by chance, so pool (Stats.h explains).
+ZTestOptions pooled() {
+  ZTestOptions o;
+  o.pool3x3 = true;
+  return o;
+}
+
+TEST(CpuAnalytic, AbsorbingSphereMatchesClosedForm) {
+  Scene s = test::absorbing_sphere_scene();
+  RenderResult r = render(s);
+  EXPECT_EQ(r.spp, s.film.spp);
+  EXPECT_EQ(r.nonfinite_samples, 0u);
+  ZTestReport rep = test::ztest_against_exact(r, test::single_collision_exact(s), pooled());
+  EXPECT_TRUE(rep.ok) << rep.summary();
+  EXPECT_LE(rep.se_bias, 0.0025) << rep.summary();
+  std::printf("%s\n", rep.summary().c_str());
+}
+
+TEST(CpuAnalytic, AbsorbingBoxMatchesClosedForm) {
+  Scene s = test::absorbing_box_scene();
+  RenderResult r = render(s);
+  EXPECT_EQ(r.nonfinite_samples, 0u);
+  ZTestReport rep = test::ztest_against_exact(r, test::single_collision_exact(s), pooled());
+  EXPECT_TRUE(rep.ok) << rep.summary();
+  EXPECT_LE(rep.se_bias, 0.0025) << rep.summary();
+  std::printf("%s\n", rep.summary().c_str());
+}
+
+TEST(CpuAnalytic, MaxDepthZeroTreatsScatteringAsExtinction) {
+  Scene s = test::depth0_sphere_scene();
+  RenderResult r = render(s);
+  ZTestReport rep = test::ztest_against_exact(r, test::single_collision_exact(s), pooled());
+  EXPECT_TRUE(rep.ok) << rep.summary();
+  std::printf("%s\n", rep.summary().c_str());
+  // The same scene with scattering allowed is brighter (in-scattered emission):
+  // max_depth really truncates.
+  s.integrator.max_depth = 8;
+  ZTestReport deeper = test::ztest_against_exact(render(s), test::single_collision_exact(s), pooled());
+  EXPECT_FALSE(deeper.bias_ok) << deeper.summary();
+  EXPECT_GT(deeper.bias, 0.0);
+}
+
+TEST(CpuAnalytic, EquilibriumInsideLargeSphere) {
+  Scene s = test::equilibrium_sphere_scene();
+  RenderResult r = render(s);
+  glm::dvec3 Le = test::equilibrium_radiance(s);
+  ZTestReport rep = test::ztest_against_exact(r, [&](int, int) { return Le; });
+  EXPECT_TRUE(rep.ok) << rep.summary();
+  std::printf("%s\n", rep.summary().c_str());
+  // Expected collisions per channel walk until absorption: σt/σa (geometric).
+  double expect = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const Medium& m = s.media[0];
+    expect += (m.sigma_a[c] + m.sigma_s[c]) / m.sigma_a[c] / 3.0;
+  }
+  double per_sample = r.events / (double(r.width) * r.height * r.spp);
+  EXPECT_NEAR(per_sample, expect, 0.02 * expect);
+  EXPECT_EQ(r.density_lookups, 0.0);
+}
+
+TEST(CpuAnalytic, WhiteFurnaceConservesEnergy) {
+  Scene s = test::white_furnace_scene();
+  RenderResult r = render(s);
+  ZTestReport rep = test::ztest_against_exact(r, [&](int, int) { return s.background; });
+  EXPECT_TRUE(rep.ok) << rep.summary();
+}
+
+// The tests can fail: a 2 % brighter "exact" emission is rejected.
+TEST(CpuAnalytic, ZTestRejectsWrongExact) {
+  Scene s = test::absorbing_sphere_scene();
+  RenderResult r = render(s);
+  Scene wrong = s;
+  wrong.media[0].emission.scale *= 1.02;
+  ZTestReport rep = test::ztest_against_exact(r, test::single_collision_exact(wrong), pooled());
+  EXPECT_FALSE(rep.ok) << rep.summary();
+  EXPECT_FALSE(rep.bias_ok) << rep.summary();
+  // And a mirrored image (x flipped) fails per pixel.
+  auto exact = test::single_collision_exact(s);
+  ZTestReport mirrored =
+      test::ztest_against_exact(r, [&](int x, int y) { return exact(r.width - 1 - x, y); }, pooled());
+  EXPECT_FALSE(mirrored.fraction_ok) << mirrored.summary();
+}
+
+// Image x grows along cross(forward, up), y grows downwards (DESIGN.md), checked
+// without the test-side camera model.
+TEST(CpuAnalytic, CameraOrientation) {
+  Scene s = test::analytic_base_scene(32, 32, 4);
+  glm::dvec3 f = glm::normalize(s.camera.look_at - s.camera.position);
+  glm::dvec3 right = glm::normalize(glm::cross(f, s.camera.up));
+  s.media.push_back(test::homogeneous_sphere("b", right * 1.0 + glm::dvec3(0, 1.0, 0), 0.4, {50, 50, 50},
+                                             {0, 0, 0}, 0.0, glm::dvec3(1.0)));
+  RenderResult r = render(s);
+  double cx = 0, cy = 0, w = 0;
+  for (int y = 0; y < r.height; ++y)
+    for (int x = 0; x < r.width; ++x) {
+      double v = r.sum[(size_t(y) * r.width + x) * 3];
+      cx += v * (x + 0.5);
+      cy += v * (y + 0.5);
+      w += v;
+    }
+  ASSERT_GT(w, 0.0);
+  EXPECT_GT(cx / w, 0.6 * r.width);   // right half
+  EXPECT_LT(cy / w, 0.4 * r.height);  // top half
+}
+
+TEST(CpuRenderer, DeterministicAcrossThreadCounts) {
+  Scene s = test::chromatic_scattering_scene(24, 20, 8);
+  RenderResult a = render(s, 1), b = render(s, 2), c = render(s, 3);
+  ASSERT_EQ(a.sum.size(), b.sum.size());
+  EXPECT_TRUE(a.sum == b.sum && a.sum_sq == b.sum_sq);
+  EXPECT_TRUE(a.sum == c.sum && a.sum_sq == c.sum_sq);
+  EXPECT_EQ(a.events, b.events);
+  // A different seed or frame changes the image.
+  RenderSettings rs = settings_for(s);
+  rs.frame = 1;
+  EXPECT_FALSE(CpuRenderer(2).render(s, rs, {}).sum == a.sum);
+}
+
+TEST(CpuRenderer, GrazingAndBoundaryRaysStayFinite) {
+  // Camera on a sphere's surface and on a box's face plane, looking along the
+  // tangent plane: half the rays skim the boundary; plus a distant sphere whose
+  // silhouette many rays graze.
+  Scene s = test::analytic_base_scene(32, 32, 16);
+  s.camera.position = {0, 0, -1};
+  s.camera.look_at = {1, 0, -1};
+  s.background = {0.1, 0.2, 0.3};
+  s.media.push_back(test::homogeneous_sphere("s", {0, 0, 0}, 1.0, {1, 2, 3}, {1, 1, 1}, 0.9, glm::dvec3(1.0)));
+  s.media.push_back(test::homogeneous_box("b", {-2, -1, -1}, {2, 1, 0}, {0.5, 0.5, 0.5}, {2, 2, 2}, -0.9,
+                                          glm::dvec3(0.5)));
+  s.media.push_back(test::homogeneous_sphere("far", {3, 0, -1}, 1e-3, {1e6, 1e6, 1e6}, {0, 0, 0}, 0.0,
+                                             glm::dvec3(1.0)));
+  RenderResult r = render(s);
+  EXPECT_EQ(r.nonfinite_samples, 0u);
+  EXPECT_TRUE(all_finite(r));
+  // Extreme coefficients: near-zero and huge σ, |g| tiny and near 1.
+  s.media[0].sigma_s = {1e-12, 0, 1e8};
+  s.media[0].g = 1e-9;
+  s.media[1].g = 0.999999;
+  r = render(s);
+  EXPECT_EQ(r.nonfinite_samples, 0u);
+  EXPECT_TRUE(all_finite(r));
+}
+
+TEST(CpuRenderer, RejectsVdbMedia) {
+  Scene s = test::absorbing_sphere_scene(8, 8, 1);
+  s.media[0].type = Medium::Type::Vdb;
+  try {
+    render(s);
+    FAIL() << "expected an exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "cpu reference: vdb media not supported yet");
+  }
+}
+
+TEST(CpuRenderer, ProgressCancelAndTimeLimit) {
+  Scene s = test::absorbing_sphere_scene(16, 16, 64);
+  CpuRenderer cpu(2);
+  EXPECT_EQ(cpu.name(), "cpu");
+  EXPECT_NE(cpu.device_name().find("CPU reference (2 threads)"), std::string::npos);
+  std::vector<int> seen;
+  RenderControl ctl;
+  ctl.progress = [&](int done, int target) {
+    EXPECT_EQ(target, 64);
+    seen.push_back(done);
+  };
+  RenderResult full = cpu.render(s, settings_for(s), ctl);
+  ASSERT_FALSE(seen.empty());
+  EXPECT_EQ(seen.back(), 64);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_FALSE(full.cancelled);
+  EXPECT_EQ(full.backend, "cpu");
+  EXPECT_GE(full.seconds, 0.0);
+
+  std::atomic<bool> cancel{true};
+  RenderControl stop;
+  stop.cancel = &cancel;
+  RenderResult part = cpu.render(s, settings_for(s), stop);
+  EXPECT_TRUE(part.cancelled);
+  EXPECT_GT(part.spp, 0);
+  EXPECT_LT(part.spp, 64);
+  // The partial render's sums are a prefix of the full one's samples: the first
+  // pass of the full render gives exactly the same numbers.
+  RenderSettings first = settings_for(s);
+  first.spp = part.spp;
+  EXPECT_TRUE(cpu.render(s, first, {}).sum == part.sum);
+
+  RenderSettings limited = settings_for(s);
+  limited.spp = 1 << 20;
+  limited.time_limit = 0.05;
+  RenderResult timed = cpu.render(s, limited, {});
+  EXPECT_FALSE(timed.cancelled);
+  EXPECT_LT(timed.spp, limited.spp);
+  EXPECT_GT(timed.spp, 0);
+}
+
+}  // namespace
+}  // namespace pyrolume

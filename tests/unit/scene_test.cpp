@@ -1,0 +1,147 @@
+// Scene format v1: the DESIGN.md example parses; every malformed case names the key.
+#include <gtest/gtest.h>
+
+#include "scene/Scene.h"
+#include "support/TestSupport.h"
+#include "util/Error.h"
+
+using namespace pyrolume;
+
+namespace {
+
+const char* kDesignExample = R"({
+  "camera": {"position": [0, 1, -6], "look_at": [0, 1, 0], "up": [0, 1, 0], "fov_deg": 40},
+  "film": {"width": 640, "height": 360, "spp": 64, "exposure": 0.0, "seed": 1},
+  "integrator": {"max_depth": 8, "mis": true},
+  "background": {"rgb": [0, 0, 0]},
+  "environment": {"file": "sky.exr", "scale": 1.0, "rotation_deg": 0},
+  "media": [
+    {"name": "ball", "type": "homogeneous",
+     "bounds": {"sphere": {"center": [0, 1, 0], "radius": 1}},
+     "sigma_a": [1, 1, 1], "sigma_s": [0, 0, 0], "g": 0.0,
+     "emission": {"temperature_k": 1500, "scale": 1.0, "blackbody": "seed"}},
+    {"name": "fire", "type": "vdb", "file": "fire.vdb",
+     "density_grid": "density", "temperature_grid": "temperature",
+     "density_scale": 1.0, "sigma_a": [1, 1, 1], "sigma_s": [1, 1, 1], "g": 0.0,
+     "temperature": {"scale": 1.0, "offset": 0.0, "cutoff_k": 100},
+     "emission": {"scale": 1.0, "blackbody": "seed"},
+     "transform": {"translate": [0, 0, 0], "rotate_deg": [0, 0, 0], "scale": [1, 1, 1]}}
+  ],
+  "shapes": [
+    {"mesh": "terrain.obj", "material": {"diffuse": {"rgb": [0.5, 0.5, 0.5], "texture": "rock.png"}}}
+  ]
+})";
+
+// Parses text and returns the error message ("" when it parsed).
+std::string error_of(const std::string& text) {
+  try {
+    parse_scene(text, "bad.json");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string one_medium(const std::string& fields) {
+  return R"({"media": [{"type": "homogeneous", "bounds": {"sphere": {"center": [0,0,0], "radius": 1}})" + fields + "}]}";
+}
+
+}  // namespace
+
+TEST(Scene, DesignExampleParses) {
+  Scene s = parse_scene(kDesignExample, "/scenes/example.json");
+  EXPECT_EQ(s.film.width, 640);
+  EXPECT_EQ(s.film.spp, 64);
+  ASSERT_EQ(s.media.size(), 2u);
+  EXPECT_EQ(s.media[0].type, Medium::Type::Homogeneous);
+  EXPECT_EQ(s.media[0].bounds.kind, Bounds::Kind::Sphere);
+  ASSERT_TRUE(s.media[0].emission.temperature_k.has_value());
+  EXPECT_DOUBLE_EQ(*s.media[0].emission.temperature_k, 1500.0);
+  EXPECT_EQ(s.media[1].type, Medium::Type::Vdb);
+  EXPECT_EQ(s.media[1].file, std::filesystem::path("/scenes/fire.vdb"));  // relative to the scene's folder
+  EXPECT_EQ(s.media[1].temperature_grid, "temperature");
+  ASSERT_TRUE(s.environment.has_value());
+  EXPECT_EQ(s.environment->file, std::filesystem::path("/scenes/sky.exr"));
+  ASSERT_EQ(s.shapes.size(), 1u);
+  EXPECT_EQ(s.shapes[0].texture, std::filesystem::path("/scenes/rock.png"));
+}
+
+TEST(Scene, BoxBoundsAndDefaults) {
+  Scene s = parse_scene(R"({"media": [{"type": "homogeneous", "bounds": {"box": {"min": [0,0,0], "max": [1,2,3]}},
+                             "emission": {"rgb": [1, 0.5, 0.25], "scale": 2}}]})",
+                        "a.json");
+  ASSERT_EQ(s.media.size(), 1u);
+  EXPECT_EQ(s.media[0].bounds.kind, Bounds::Kind::Box);
+  EXPECT_EQ(s.media[0].bounds.max, glm::dvec3(1, 2, 3));
+  EXPECT_EQ(s.media[0].sigma_a, glm::dvec3(1.0));  // default
+  EXPECT_EQ(*s.media[0].emission.rgb, glm::dvec3(1, 0.5, 0.25));
+  EXPECT_DOUBLE_EQ(s.media[0].emission.scale, 2.0);
+  EXPECT_EQ(s.camera.fov_deg, 40.0);
+}
+
+struct BadCase {
+  const char* label;
+  std::string text;
+  const char* expect;  // substring of the message: the key path and reason
+};
+
+class SceneBadInput : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(SceneBadInput, NamesFileKeyAndReason) {
+  const BadCase& c = GetParam();
+  std::string msg = error_of(c.text);
+  ASSERT_FALSE(msg.empty()) << c.label << " was accepted";
+  EXPECT_NE(msg.find("bad.json"), std::string::npos) << msg;
+  EXPECT_NE(msg.find(c.expect), std::string::npos) << "expected '" << c.expect << "' in: " << msg;
+  EXPECT_EQ(msg.find('\n'), std::string::npos) << "message must be one line: " << msg;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, SceneBadInput,
+    ::testing::Values(
+        BadCase{"unknown top key", R"({"camrea": {}})", "camrea: unknown key"},
+        BadCase{"unknown nested key", R"({"film": {"widht": 3}})", "film.widht: unknown key"},
+        BadCase{"spp zero", R"({"film": {"spp": 0}})", "film.spp: must be in"},
+        BadCase{"width type", R"({"film": {"width": "big"}})", "film.width: expected an integer"},
+        BadCase{"negative sigma", one_medium(R"(, "sigma_a": [1, -1, 1])"), "media[0].sigma_a: must be >= 0"},
+        BadCase{"sigma_s short", one_medium(R"(, "sigma_s": [1, 1])"), "media[0].sigma_s: expected an array of 3"},
+        BadCase{"g one", one_medium(R"(, "g": 1.0)"), "media[0].g: must satisfy |g| < 1"},
+        BadCase{"g minus one", one_medium(R"(, "g": -1.5)"), "media[0].g"},
+        BadCase{"medium typo", one_medium(R"(, "sigma_t": [1,1,1])"), "media[0].sigma_t: unknown key"},
+        BadCase{"missing type", R"({"media": [{"bounds": {"sphere": {"center": [0,0,0], "radius": 1}}}]})",
+                "media[0].type"},
+        BadCase{"bad type", R"({"media": [{"type": "cloud"}]})", "media[0].type: must be one of"},
+        BadCase{"no bounds", R"({"media": [{"type": "homogeneous"}]})", "media[0].bounds: missing"},
+        BadCase{"radius zero",
+                R"({"media": [{"type": "homogeneous", "bounds": {"sphere": {"center": [0,0,0], "radius": 0}}}]})",
+                "media[0].bounds.sphere.radius: must be > 0"},
+        BadCase{"box inverted",
+                R"({"media": [{"type": "homogeneous", "bounds": {"box": {"min": [0,0,0], "max": [1,-1,1]}}}]})",
+                "media[0].bounds.box.max"},
+        BadCase{"both bounds",
+                R"({"media": [{"type": "homogeneous", "bounds": {"box": {"min": [0,0,0], "max": [1,1,1]}, "sphere": {"center": [0,0,0], "radius": 1}}}]})",
+                "media[0].bounds: expected exactly one"},
+        BadCase{"emission both", one_medium(R"(, "emission": {"rgb": [1,1,1], "temperature_k": 1000})"),
+                "media[0].emission.rgb: give either"},
+        BadCase{"negative temperature", one_medium(R"(, "emission": {"temperature_k": -3})"),
+                "media[0].emission.temperature_k: must be >= 0"},
+        BadCase{"blackbody mode", one_medium(R"(, "emission": {"temperature_k": 1000, "blackbody": "cie"})"),
+                "media[0].emission.blackbody: must be one of"},
+        BadCase{"fov", R"({"camera": {"fov_deg": 180}})", "camera.fov_deg"},
+        BadCase{"up parallel", R"({"camera": {"position": [0,0,0], "look_at": [0,1,0], "up": [0,1,0]}})", "camera.up"},
+        BadCase{"estimator", R"({"integrator": {"emission_estimator": "track"}})", "integrator.emission_estimator"},
+        BadCase{"max_depth", R"({"integrator": {"max_depth": -1}})", "integrator.max_depth"},
+        BadCase{"background", R"({"background": {"rgb": [0, 0, -1]}})", "background.rgb"},
+        BadCase{"duplicate names",
+                R"({"media": [{"name": "a", "type": "homogeneous", "bounds": {"sphere": {"center": [0,0,0], "radius": 1}}},
+                              {"name": "a", "type": "homogeneous", "bounds": {"sphere": {"center": [0,0,0], "radius": 1}}}]})",
+                "media[1].name: duplicate"},
+        BadCase{"vdb bounds", R"({"media": [{"type": "vdb", "file": "x.vdb", "bounds": {"sphere": {"center": [0,0,0], "radius": 1}}}]})",
+                "media[0].bounds"},
+        BadCase{"json syntax", R"({"film": {"spp": 4,}})", "invalid JSON"}),
+    [](const ::testing::TestParamInfo<BadCase>& info) {
+      std::string n = info.param.label;
+      for (auto& ch : n)
+        if (!isalnum(static_cast<unsigned char>(ch))) ch = '_';
+      return n;
+    });
