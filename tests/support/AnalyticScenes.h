@@ -269,14 +269,14 @@ inline glm::dvec3 pixel_average(const std::function<glm::dvec3(double fx, double
 // Exact expected pixel means of a single-medium, non-scattering (or max_depth 0)
 // scene, precomputed for the scene's film size; returns a lookup for
 // ztest_against_exact.
-inline std::function<glm::dvec3(int, int)> single_collision_exact(const Scene& s, int base = 8, int max_level = 7) {
+inline std::function<glm::dvec3(int, int)> single_collision_exact(const Scene& s, int base = 8, int max_level = 7, double steep_rel = 0.02) {
   const int W = s.film.width, H = s.film.height;
   auto img = std::make_shared<std::vector<glm::dvec3>>(size_t(W) * H);
   auto L = [&](double fx, double fy, int* sig) {
     return single_collision_radiance(s, s.camera.position, film_ray(s.camera, W, H, fx, fy), sig);
   };
   for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) (*img)[size_t(y) * W + x] = pixel_average(L, x, y, base, max_level);
+    for (int x = 0; x < W; ++x) (*img)[size_t(y) * W + x] = pixel_average(L, x, y, base, max_level, steep_rel);
   return [img, W](int x, int y) { return (*img)[size_t(y) * W + x]; };
 }
 

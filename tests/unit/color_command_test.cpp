@@ -19,12 +19,12 @@ using namespace pyrolume::color;
 
 namespace {
 
-struct Run {
+struct CommandRun {
   int status;
   std::string out, err;
 };
 
-Run run(double from, double to, double step, BlackbodyMode mode = BlackbodyMode::Seed, int observer = 2,
+CommandRun run(double from, double to, double step, BlackbodyMode mode = BlackbodyMode::Seed, int observer = 2,
         const std::string& png = "") {
   std::ostringstream out, err;
   const int status = run_blackbody_command(from, to, step, mode, observer, png, out, err);
@@ -48,7 +48,7 @@ std::vector<std::string> fields(const std::string& line) {
 }  // namespace
 
 TEST(BlackbodyCommand, HeaderAndInclusiveRange) {
-  Run r = run(1000, 2000, 250);
+  CommandRun r = run(1000, 2000, 250);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(r.err.empty());
   auto l = lines(r.out);
@@ -75,7 +75,7 @@ TEST(BlackbodyCommand, HeaderAndInclusiveRange) {
 }
 
 TEST(BlackbodyCommand, RowsMatchTheLibrary) {
-  Run r = run(3000, 3000, 1, BlackbodyMode::Peak, 10);
+  CommandRun r = run(3000, 3000, 1, BlackbodyMode::Peak, 10);
   ASSERT_EQ(r.status, 0);
   auto f = fields(lines(r.out)[1]);
   const glm::dvec2 xy = blackbody_xy(3000, 10);
@@ -88,7 +88,7 @@ TEST(BlackbodyCommand, RowsMatchTheLibrary) {
 TEST(BlackbodyCommand, HardTemperatures) {
   for (double T : {0.0, 1e-3, 1e6}) {
     for (auto mode : {BlackbodyMode::Seed, BlackbodyMode::Peak, BlackbodyMode::Physical}) {
-      Run r = run(T, T, 1, mode);
+      CommandRun r = run(T, T, 1, mode);
       ASSERT_EQ(r.status, 0) << T << ": " << r.err;
       auto f = fields(lines(r.out).at(1));
       ASSERT_EQ(f.size(), 6u);
@@ -112,7 +112,7 @@ TEST(BlackbodyCommand, BadArgumentsExit2WithOneLine) {
                         {0, 1000, nan, 2, "--step"},      {0, 1e6, 1e-3, 2, "--step"},     {1000, 2000, 100, 3, "--observer"},
                         {0, INFINITY, 1, 2, "--to"}};
   for (const Case& c : cases) {
-    Run r = run(c.from, c.to, c.step, BlackbodyMode::Seed, c.observer);
+    CommandRun r = run(c.from, c.to, c.step, BlackbodyMode::Seed, c.observer);
     EXPECT_EQ(r.status, 2) << c.key;
     EXPECT_TRUE(r.out.empty()) << c.key;
     EXPECT_NE(r.err.find(c.key), std::string::npos) << r.err;
@@ -123,7 +123,7 @@ TEST(BlackbodyCommand, BadArgumentsExit2WithOneLine) {
 TEST(BlackbodyCommand, SwatchStripPng) {
   const auto dir = test::temp_dir("swatch");
   const auto png = dir / "strip.png";
-  Run r = run(1000, 10000, 1500, BlackbodyMode::Physical, 2, png.string());  // 1000, 2500, ..., 10000: 7 swatches
+  CommandRun r = run(1000, 10000, 1500, BlackbodyMode::Physical, 2, png.string());  // 1000, 2500, ..., 10000: 7 swatches
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(lines(r.out).size(), 8u);
   int w = 0, h = 0, comp = 0;
@@ -159,7 +159,7 @@ TEST(BlackbodyCommand, SwatchStripPng) {
 
 TEST(BlackbodyCommand, UnwritablePngExits2AndPrintsNothing) {
   const auto dir = test::temp_dir("swatch-bad");
-  Run r = run(1000, 2000, 500, BlackbodyMode::Seed, 2, (dir / "missing" / "strip.png").string());
+  CommandRun r = run(1000, 2000, 500, BlackbodyMode::Seed, 2, (dir / "missing" / "strip.png").string());
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(r.out.empty());
   EXPECT_NE(r.err.find("--png"), std::string::npos) << r.err;

@@ -78,15 +78,15 @@ VKAPI_ATTR VkBool32 VKAPI_CALL Context::debug_callback(VkDebugUtilsMessageSeveri
     return VK_FALSE;
   std::string line = data && data->pMessage ? data->pMessage : "(no message)";
   std::replace(line.begin(), line.end(), '\n', ' ');
-  std::fprintf(stderr, "vulkan validation: %s\n", line.c_str());
-  // Loader chatter (GENERAL warnings, e.g. about an unrelated broken ICD manifest)
-  // says nothing about our API use; general errors and everything else count.
-  bool counts = (types & ~VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT) ||
-                (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT);
-  if (counts) {
-    static_cast<Context*>(user)->validation_messages_++;
-    g_total_validation_messages++;
+  // GENERAL-only messages come from the loader (e.g. a broken driver manifest):
+  // worth showing, but they say nothing about our API use, so they don't count.
+  if (!(types & ~VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT)) {
+    std::fprintf(stderr, "vulkan loader: %s\n", line.c_str());
+    return VK_FALSE;
   }
+  std::fprintf(stderr, "vulkan validation: %s\n", line.c_str());
+  static_cast<Context*>(user)->validation_messages_++;
+  g_total_validation_messages++;
   return VK_FALSE;
 }
 
