@@ -10,6 +10,7 @@ PYROLUME_BUILD="${PYROLUME_BUILD:-$PYROLUME_ROOT/build}"
 PYROLUME_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libvulkan-dev mesa-vulkan-drivers vulkan-tools vulkan-validationlayers glslang-tools
+  libopenvdb-dev libboost-iostreams-dev libnanovdb-dev libtbb-dev
   libopenexr-dev libglm-dev nlohmann-json3-dev libcli11-dev libstb-dev libgtest-dev
 )
 
