@@ -58,7 +58,7 @@ glm::dvec3 blackbody_rgb(double temperature_k, BlackbodyMode mode, int observer,
   glm::dvec3 xyz = blackbody_xyz(temperature_k, mode, observer);
   if (adapt_to_k) xyz = adapt_blackbody_xyz(xyz, *adapt_to_k, observer);
   // Clamp out-of-gamut (negative) channels: the Planckian locus leaves the sRGB
-  // triangle below ~1900 K (blue) and above ~10000 K (red stays positive).
+  // triangle below ~1900 K (blue < 0; green too below ~970 K).
   glm::dvec3 rgb = glm::max(xyz_to_linear_srgb(xyz), glm::dvec3(0.0));
   if (!std::isfinite(rgb.r) || !std::isfinite(rgb.g) || !std::isfinite(rgb.b)) return glm::dvec3(0.0);
   if (mode == BlackbodyMode::Seed) {

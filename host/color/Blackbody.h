@@ -23,7 +23,7 @@ namespace pyrolume::color {
 //   Physical: XYZ = sum B(l,T) [W·sr⁻¹·m⁻²·nm⁻¹] · cmf(l) · 1 nm, so Y is the
 //             ybar-weighted radiance in W·sr⁻¹·m⁻² (× 683 lm/W = cd/m²), then sRGB.
 // Throws std::invalid_argument for an observer other than 2 or 10, and for an
-// adapt_to_k that is not a temperature with visible light (NaN, <= 0, ~< 20 K).
+// adapt_to_k that is not a temperature with visible light (NaN, <= 0, below ~23 K).
 glm::dvec3 blackbody_rgb(double temperature_k, BlackbodyMode mode, int observer = 2,
                          std::optional<double> adapt_to_k = std::nullopt);
 

@@ -1,5 +1,6 @@
 // CPU reference vs closed forms (issue 2: analytic tests), plus determinism,
 // progressive control and robustness of the reference itself.
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <stdexcept>
@@ -79,6 +80,45 @@ TEST(CpuAnalytic, MaxDepthZeroTreatsScatteringAsExtinction) {
   ZTestReport deeper = test::ztest_against_exact(render(s), test::single_collision_exact(s), pooled());
   EXPECT_FALSE(deeper.bias_ok) << deeper.summary();
   EXPECT_GT(deeper.bias, 0.0);
+}
+
+// The closed-form pixel means are quadrature; a finer quadrature must agree far
+// below the render's standard errors, or the z-tests above would test it instead.
+TEST(CpuAnalytic, AnalyticQuadratureConverged) {
+  for (const Scene& s : {test::absorbing_sphere_scene(), test::absorbing_box_scene()}) {
+    test::PixelStats ps = test::pixel_stats(render(s), true);  // the SE the z-test uses
+    auto coarse = test::single_collision_exact(s);
+    auto fine = test::single_collision_exact(s, 12, 7, 0.025);
+    double worst = 0.0;
+    for (int y = 0; y < ps.height; ++y)
+      for (int x = 0; x < ps.width; ++x)
+        for (int c = 0; c < 3; ++c) {
+          double d = std::abs(coarse(x, y)[c] - fine(x, y)[c]);
+          double se = ps.se[(size_t(y) * ps.width + x) * 3 + c];
+          EXPECT_LE(d, 0.1 * se + 1e-12) << "pixel " << x << "," << y << " channel " << c;
+          if (se > 0) worst = std::max(worst, d / se);
+        }
+    std::printf("quadrature: max |coarse - fine| / SE = %.4f\n", worst);
+  }
+}
+
+// Scene (c), the CPU-vs-GPU scene: two CPU renders with different seeds agree
+// (ztest_images accepts a correct pair), while flipping the sign of every HG g
+// (the classic convention mistake) is detected at the same spp.
+TEST(CpuAnalytic, ChromaticScatteringSelfConsistentAndSensitiveToG) {
+  Scene s = test::chromatic_scattering_scene();
+  RenderResult a = render(s);
+  Scene s2 = s;
+  s2.film.seed = 12345;
+  RenderResult b = render(s2);
+  EXPECT_EQ(a.nonfinite_samples, 0u);
+  ZTestReport same = test::ztest_images(a, b, pooled());
+  EXPECT_TRUE(same.ok) << same.summary();
+  std::printf("%s\n", same.summary().c_str());
+  for (Medium& m : s2.media) m.g = -m.g;
+  ZTestReport flipped = test::ztest_images(render(s2), a, pooled());
+  EXPECT_FALSE(flipped.ok) << flipped.summary();
+  std::printf("g flipped: %s\n", flipped.summary().c_str());
 }
 
 TEST(CpuAnalytic, EquilibriumInsideLargeSphere) {

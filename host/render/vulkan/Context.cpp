@@ -246,6 +246,24 @@ Context::Context(const Options& options) {
   device_ = UniqueDevice(raw_device, {});
   vkGetDeviceQueue(device(), queue_family_, 0, &queue_);
 
+  // --- one-shot submission ---
+  VkCommandPoolCreateInfo pci{.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pci.queueFamilyIndex = queue_family_;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  VK_CHECK(vkCreateCommandPool(device(), &pci, nullptr, &pool));
+  command_pool_ = UniqueCommandPool(pool, {device()});
+  VkCommandBufferAllocateInfo cai{.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  cai.commandPool = pool;
+  cai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  cai.commandBufferCount = 1;
+  VK_CHECK(vkAllocateCommandBuffers(device(), &cai, &command_buffer_));
+  VkFenceCreateInfo fci{.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VkFence fence = VK_NULL_HANDLE;
+  VK_CHECK(vkCreateFence(device(), &fci, nullptr, &fence));
+  fence_ = UniqueFence(fence, {device()});
+
+  // Last, so that nothing after it can throw and leave a stale registry entry.
   if (debug_utils_) {
     auto fn = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
         vkGetInstanceProcAddr(instance(), "vkSetDebugUtilsObjectNameEXT"));
@@ -256,25 +274,8 @@ Context::Context(const Options& options) {
   }
   set_name(device(), "pyrolume device");
   set_name(queue_, "pyrolume compute queue");
-
-  // --- one-shot submission ---
-  VkCommandPoolCreateInfo pci{.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  pci.queueFamilyIndex = queue_family_;
-  VkCommandPool pool = VK_NULL_HANDLE;
-  VK_CHECK(vkCreateCommandPool(device(), &pci, nullptr, &pool));
-  command_pool_ = UniqueCommandPool(pool, {device()});
   set_name(pool, "one-shot command pool");
-  VkCommandBufferAllocateInfo cai{.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  cai.commandPool = pool;
-  cai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  cai.commandBufferCount = 1;
-  VK_CHECK(vkAllocateCommandBuffers(device(), &cai, &command_buffer_));
   set_name(command_buffer_, "one-shot command buffer");
-  VkFenceCreateInfo fci{.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  VkFence fence = VK_NULL_HANDLE;
-  VK_CHECK(vkCreateFence(device(), &fci, nullptr, &fence));
-  fence_ = UniqueFence(fence, {device()});
   set_name(fence, "one-shot fence");
 }
 

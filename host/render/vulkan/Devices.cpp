@@ -68,7 +68,8 @@ std::vector<DeviceInfo> list_devices(VkInstance instance) {
 
 std::vector<DeviceInfo> list_devices() {
   uint32_t loader_version = VK_API_VERSION_1_0;
-  vkEnumerateInstanceVersion(&loader_version);
+  if (vkEnumerateInstanceVersion(&loader_version) != VK_SUCCESS || loader_version < VK_API_VERSION_1_1)
+    throw NoDeviceError("the Vulkan loader is older than 1.1");
   VkApplicationInfo app{.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "pyrolume devices";
   app.apiVersion = loader_version >= VK_API_VERSION_1_3 ? VK_API_VERSION_1_3 : loader_version;

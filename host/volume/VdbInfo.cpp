@@ -1,0 +1,284 @@
+#include "volume/VdbInfo.h"
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <string>
+
+#include <nanovdb/NanoVDB.h>
+#include <nanovdb/util/IO.h>
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+
+#include "util/Error.h"
+#include "volume/VdbFile.h"
+
+namespace pyrolume {
+namespace {
+
+// What one grid block prints; unset fields print as unknown.
+struct GridReport {
+  std::string name, type, grid_class;
+  bool saved_as_half = false;
+  glm::dvec3 voxel_size{0.0};
+  glm::dmat4 index_to_world{1.0};
+  std::optional<uint64_t> active_voxels;
+  std::optional<glm::i64vec3> bbox_min, bbox_max;  // inclusive active-voxel box
+  std::optional<double> min_value, max_value;
+  std::string range_label = "values";  // "|values|" for vector grids (magnitudes)
+  uint64_t nonfinite = 0;
+  std::string note;  // why a field is missing
+};
+
+std::string vec3(const glm::dvec3& v) {
+  std::ostringstream s;
+  s << v.x << ' ' << v.y << ' ' << v.z;
+  return s.str();
+}
+
+std::string transform_text(const glm::dmat4& M) {
+  bool diagonal = true;
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r)
+      if (r != c && M[c][r] != 0.0) diagonal = false;
+  std::ostringstream s;
+  if (diagonal) {
+    s << "scale (" << vec3({M[0][0], M[1][1], M[2][2]}) << "), translation (" << vec3(glm::dvec3(M[3])) << ")";
+  } else {
+    // Rows of the column-vector matrix: world = M * (i, j, k, 1).
+    s << "matrix [";
+    for (int r = 0; r < 3; ++r) s << (r ? "; " : "") << M[0][r] << ' ' << M[1][r] << ' ' << M[2][r] << ' ' << M[3][r];
+    s << "]";
+  }
+  return s.str();
+}
+
+void print_report(const GridReport& g, std::ostream& out) {
+  out << "grid \"" << g.name << "\"\n";
+  out << "  type: " << g.type << (g.saved_as_half ? " (saved as half)" : "") << ", class: " << g.grid_class << "\n";
+  out << "  voxel size: (" << vec3(g.voxel_size) << ")\n";
+  out << "  transform: " << transform_text(g.index_to_world) << "\n";
+  out << "  active voxels: ";
+  if (g.active_voxels) out << *g.active_voxels << "\n";
+  else out << "unknown (not in metadata; use --values)\n";
+  const bool empty = g.active_voxels && *g.active_voxels == 0;
+  if (empty || !g.bbox_min || !g.bbox_max) {
+    const char* why = empty ? "empty" : "unknown (not in metadata; use --values)";
+    out << "  index bbox: " << why << "\n  world bbox: " << why << "\n";
+  } else {
+    const glm::i64vec3 lo = *g.bbox_min, hi = *g.bbox_max, d = hi - lo + int64_t(1);
+    out << "  index bbox: [" << lo.x << ' ' << lo.y << ' ' << lo.z << "]-[" << hi.x << ' ' << hi.y << ' ' << hi.z
+        << "] (" << d.x << " x " << d.y << " x " << d.z << ")\n";
+    // The outer voxel faces: voxel ijk covers index ijk +- 0.5 (cell-centred).
+    glm::dvec3 wlo(std::numeric_limits<double>::infinity()), whi(-std::numeric_limits<double>::infinity());
+    for (int c = 0; c < 8; ++c) {
+      glm::dvec3 q((c & 1) ? hi.x + 0.5 : lo.x - 0.5, (c & 2) ? hi.y + 0.5 : lo.y - 0.5,
+                   (c & 4) ? hi.z + 0.5 : lo.z - 0.5);
+      glm::dvec3 w(g.index_to_world * glm::dvec4(q, 1.0));
+      wlo = glm::min(wlo, w);
+      whi = glm::max(whi, w);
+    }
+    out << "  world bbox: [" << vec3(wlo) << "]-[" << vec3(whi) << "]\n";
+  }
+  out << "  " << g.range_label << ": ";
+  if (empty) out << "none (empty grid)";
+  else if (g.min_value && g.max_value) out << "[" << *g.min_value << ", " << *g.max_value << "]";
+  else out << "unknown (" << (g.note.empty() ? "not in metadata; use --values" : g.note) << ")";
+  if (g.nonfinite) out << ", " << g.nonfinite << " NaN/Inf voxels";
+  out << "\n";
+}
+
+// ---- OpenVDB ----
+
+template <class T>
+double magnitude(const T& v) {
+  if constexpr (std::is_arithmetic_v<T>) return double(v);
+  else return double(v.length());
+}
+
+// Exact statistics from the active voxels and tiles.
+template <class GridT>
+void scan_values(const GridT& grid, GridReport& r) {
+  using ValueT = typename GridT::ValueType;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  uint64_t bad = 0;
+  for (auto it = grid.tree().cbeginValueOn(); it; ++it) {
+    const double v = magnitude<ValueT>(*it);
+    if (!std::isfinite(v)) {
+      bad += it.getVoxelCount();
+      continue;
+    }
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  if (lo <= hi) {
+    r.min_value = lo;
+    r.max_value = hi;
+  }
+  r.nonfinite = bad;
+  if constexpr (!std::is_arithmetic_v<ValueT>) r.range_label = "|values|";
+}
+
+void fill_from_values(const openvdb::GridBase& g, GridReport& r) {
+  r.active_voxels = g.activeVoxelCount();
+  const openvdb::CoordBBox b = g.evalActiveVoxelBoundingBox();
+  if (!b.empty()) {
+    r.bbox_min = glm::i64vec3(b.min().x(), b.min().y(), b.min().z());
+    r.bbox_max = glm::i64vec3(b.max().x(), b.max().y(), b.max().z());
+  }
+  bool done = g.apply<openvdb::TypeList<openvdb::FloatGrid, openvdb::DoubleGrid, openvdb::Int32Grid, openvdb::Int64Grid,
+                                        openvdb::Vec3SGrid, openvdb::Vec3DGrid, openvdb::Vec3IGrid>>(
+      [&](const auto& typed) { scan_values(typed, r); });
+  if (!done) r.note = "no value range for " + r.type + " grids";
+}
+
+void fill_from_metadata(const openvdb::GridBase& g, GridReport& r) {
+  if (auto n = g.getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT))
+    r.active_voxels = uint64_t(n->value());
+  auto lo = g.getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
+  auto hi = g.getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
+  if (lo && hi) {
+    r.bbox_min = glm::i64vec3(lo->value().x(), lo->value().y(), lo->value().z());
+    r.bbox_max = glm::i64vec3(hi->value().x(), hi->value().y(), hi->value().z());
+  }
+  // OpenVDB writes no value statistics, so the range needs --values.
+}
+
+GridReport report_openvdb(const openvdb::GridBase& g, const std::string& file) {
+  GridReport r;
+  r.name = g.getName();
+  r.type = g.valueType();
+  r.grid_class = openvdb::GridBase::gridClassToString(g.getGridClass());
+  r.saved_as_half = g.saveFloatAsHalf();
+  const openvdb::Vec3d vs = g.voxelSize();
+  r.voxel_size = glm::dvec3(vs.x(), vs.y(), vs.z());
+  r.index_to_world = openvdb_index_to_world(g.transform(), file, r.name);
+  return r;
+}
+
+int info_openvdb(const std::string& file, bool values, std::ostream& out) {
+  ensure_openvdb_initialized();
+  try {
+    openvdb::io::File f(file);
+    f.open(/*delayLoad=*/false);
+    std::string creator;
+    if (auto meta = f.getMetadata())
+      if (auto c = (*meta)["creator"]) creator = c->str();
+    std::vector<std::string> names;
+    for (auto it = f.beginName(); it != f.endName(); ++it) names.push_back(*it);
+    out << "file \"" << file << "\": OpenVDB, file format " << f.version();
+    if (!creator.empty()) out << ", creator \"" << creator << "\"";
+    out << ", " << names.size() << (names.size() == 1 ? " grid\n" : " grids\n");
+    // Per grid, so that one unregistered grid type spoils only its own block.
+    for (const std::string& name : names) {
+      openvdb::GridBase::Ptr g;
+      try {
+        g = values ? f.readGrid(name) : f.readGridMetadata(name);
+      } catch (const openvdb::Exception& e) {
+        out << "grid \"" << name << "\"\n  unreadable: " << e.what() << "\n";
+        continue;
+      }
+      GridReport r = report_openvdb(*g, file);
+      if (values) fill_from_values(*g, r);
+      else fill_from_metadata(*g, r);
+      print_report(r, out);
+    }
+  } catch (const openvdb::Exception& e) {
+    throw input_error(file, "", std::string("cannot read as OpenVDB: ") + e.what());
+  }
+  return 0;
+}
+
+// ---- NanoVDB ----
+
+template <class BuildT>
+void nano_grid(const nanovdb::NanoGrid<BuildT>& grid, bool values, GridReport& r) {
+  r.index_to_world = nanovdb_index_to_world(grid);
+  if (!values) {
+    // NanoVDB keeps min/max of the active values in the root node (when the
+    // grid was built with stats).
+    if (grid.hasMinMax()) {
+      r.min_value = double(grid.tree().root().minimum());
+      r.max_value = double(grid.tree().root().maximum());
+    } else {
+      r.note = "not stored; use --values";
+    }
+    return;
+  }
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  const auto& b = grid.indexBBox();
+  auto acc = grid.getAccessor();
+  uint64_t n = 0;
+  if (grid.activeVoxelCount() > 0)
+    for (int k = b.min()[2]; k <= b.max()[2]; ++k)
+      for (int j = b.min()[1]; j <= b.max()[1]; ++j)
+        for (int i = b.min()[0]; i <= b.max()[0]; ++i) {
+          const nanovdb::Coord ijk(i, j, k);
+          if (!acc.isActive(ijk)) continue;
+          ++n;
+          const double v = double(acc.getValue(ijk));
+          if (!std::isfinite(v)) {
+            ++r.nonfinite;
+            continue;
+          }
+          lo = std::min(lo, v);
+          hi = std::max(hi, v);
+        }
+  r.active_voxels = n;
+  if (lo <= hi) {
+    r.min_value = lo;
+    r.max_value = hi;
+  }
+}
+
+int info_nanovdb(const std::string& file, bool values, std::ostream& out) {
+  std::vector<nanovdb::io::GridMetaData> metas;
+  try {
+    metas = nanovdb::io::readGridMetaData(file);
+  } catch (const std::exception& e) {
+    throw input_error(file, "", std::string("cannot read as NanoVDB: ") + e.what());
+  }
+  out << "file \"" << file << "\": NanoVDB, " << metas.size() << (metas.size() == 1 ? " grid\n" : " grids\n");
+  for (size_t n = 0; n < metas.size(); ++n) {
+    const auto& md = metas[n];
+    GridReport r;
+    r.name = md.gridName;
+    r.type = nanovdb::toStr(md.gridType);
+    r.grid_class = nanovdb::toStr(md.gridClass);
+    r.voxel_size = glm::dvec3(md.voxelSize[0], md.voxelSize[1], md.voxelSize[2]);
+    r.active_voxels = md.voxelCount;
+    if (md.voxelCount > 0) {
+      r.bbox_min = glm::i64vec3(md.indexBBox.min()[0], md.indexBBox.min()[1], md.indexBBox.min()[2]);
+      r.bbox_max = glm::i64vec3(md.indexBBox.max()[0], md.indexBBox.max()[1], md.indexBBox.max()[2]);
+    }
+    // The transform and the value range live in the grid itself, not in the
+    // file's metadata; a NanoVDB grid is read as one flat buffer, no tree build.
+    nanovdb::GridHandle<nanovdb::HostBuffer> h;
+    try {
+      h = nanovdb::io::readGrid<nanovdb::HostBuffer>(file, n);
+    } catch (const std::exception& e) {
+      r.note = std::string("grid unreadable: ") + e.what();
+    }
+    if (h) {
+      if (auto* g = h.grid<float>()) nano_grid(*g, values, r);
+      else if (auto* g = h.grid<double>()) nano_grid(*g, values, r);
+      else if (auto* g = h.grid<nanovdb::Fp16>()) nano_grid(*g, values, r);
+      else if (auto* g = h.grid<nanovdb::Fp8>()) nano_grid(*g, values, r);
+      else if (auto* g = h.grid<nanovdb::Fp4>()) nano_grid(*g, values, r);
+      else if (auto* g = h.grid<nanovdb::FpN>()) nano_grid(*g, values, r);
+      else r.note = "no value range for " + r.type + " grids";
+    }
+    print_report(r, out);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int run_info_command(const std::filesystem::path& file, bool values, std::ostream& out) {
+  return detect_volume_format(file) == VolumeFormat::NanoVdb ? info_nanovdb(file.string(), values, out)
+                                                             : info_openvdb(file.string(), values, out);
+}
+
+}  // namespace pyrolume

@@ -1,0 +1,383 @@
+// VDB -> dense arrays. Conventions (docs/volumes.md):
+//  - OpenVDB index space is cell-centred: voxel ijk's value is the field's value
+//    at the integer index point ijk (tools::BoxSampler interpolates between those
+//    points). The dense texel for ijk therefore has its centre at index ijk.
+//  - One dense texture per grid, each with its own index->world map. We do NOT
+//    resample temperature onto density's lattice (the seed's way): Blender writes
+//    `heat`/`flame` at other voxel sizes and half-voxel offsets, and resampling
+//    trilinearly onto another lattice and then interpolating again on the GPU
+//    blurs the field (a second low-pass, error O(h^2 |f''|) per resampling) and
+//    shifts sharp flame fronts. With one texture per grid the GPU lookup
+//    reproduces OpenVDB's BoxSampler on the original grid exactly (up to R16F
+//    rounding); the price is one extra world->index transform per lookup.
+//  - The dense box is the ACTIVE bounding box plus one voxel of zero padding, so
+//    trilinear lookups near the edge blend with the background (0) as BoxSampler
+//    does, with no clamp-to-border sampler needed.
+#include "volume/VdbLoader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <sstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <nanovdb/NanoVDB.h>
+#include <nanovdb/util/IO.h>
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+
+#include "util/Error.h"
+#include "volume/VdbFile.h"
+
+namespace pyrolume {
+
+glm::dmat4 medium_transform_matrix(const Transform& t) {
+  glm::dmat4 M(1.0);
+  M = glm::translate(M, t.translate);
+  M = glm::rotate(M, glm::radians(t.rotate_deg.z), glm::dvec3(0, 0, 1));
+  M = glm::rotate(M, glm::radians(t.rotate_deg.y), glm::dvec3(0, 1, 0));
+  M = glm::rotate(M, glm::radians(t.rotate_deg.x), glm::dvec3(1, 0, 0));
+  M = glm::scale(M, t.scale);
+  return M;  // = T * Rz * Ry * Rx * S
+}
+
+namespace {
+
+enum class Role { Density, Temperature };
+
+struct GridEntry {
+  std::string name;
+  std::string type;  // OpenVDB valueType() ("float", "vec3s", "int32") or NanoVDB toStr(GridType)
+};
+
+bool is_scalar_float_type(const std::string& t) {
+  // OpenVDB reads grids saved as half into FloatGrid, so "half" never shows up
+  // there; NanoVDB names its quantised float grids Float4/8/16/N.
+  static const char* ok[] = {"float", "double", "Half", "Float4", "Float8", "Float16", "FloatN"};
+  return std::any_of(std::begin(ok), std::end(ok), [&](const char* s) { return t == s; });
+}
+
+std::string role_key(Role role, const std::string& grid) {
+  return std::string(role == Role::Density ? "density" : "temperature") + " grid \"" + grid + "\"";
+}
+
+std::string list_grids(const std::vector<GridEntry>& entries) {
+  if (entries.empty()) return "the file has no grids";
+  std::ostringstream s;
+  s << "the file has:";
+  for (size_t i = 0; i < entries.size(); ++i)
+    s << (i ? ", " : " ") << '"' << entries[i].name << "\" (" << entries[i].type << ')';
+  return s.str();
+}
+
+const GridEntry* find_grid(const std::vector<GridEntry>& entries, const std::string& name) {
+  for (const auto& e : entries)
+    if (e.name == name) return &e;
+  return nullptr;
+}
+
+void require_scalar(const GridEntry& e, Role role, const std::string& file) {
+  if (is_scalar_float_type(e.type)) return;
+  const std::string what = role == Role::Density ? "a density grid" : "a temperature grid";
+  if (is_vector_type_name(e.type))
+    throw input_error(file, role_key(role, e.name),
+                      "is a vector grid (" + e.type + "); " + what + " must be scalar (float, half or double)");
+  throw input_error(file, role_key(role, e.name),
+                    "is a " + e.type + " grid; " + what + " must be scalar (float, half or double)");
+}
+
+// Which grids to read, by the scene's names or the defaults.
+struct GridChoice {
+  GridEntry density;
+  std::optional<GridEntry> temperature;
+};
+
+GridChoice choose_grids(const std::vector<GridEntry>& entries, const Medium& m, bool need_temperature,
+                        const std::string& file, std::vector<std::string>& warnings) {
+  GridChoice c;
+  const std::string dname = m.density_grid.empty() ? kDefaultDensityGrid : m.density_grid;
+  const GridEntry* d = find_grid(entries, dname);
+  if (!d) throw input_error(file, role_key(Role::Density, dname), "no such grid; " + list_grids(entries));
+  require_scalar(*d, Role::Density, file);
+  c.density = *d;
+  if (!need_temperature) return c;
+  if (!m.temperature_grid.empty()) {
+    const GridEntry* t = find_grid(entries, m.temperature_grid);
+    if (!t)
+      throw input_error(file, role_key(Role::Temperature, m.temperature_grid), "no such grid; " + list_grids(entries));
+    require_scalar(*t, Role::Temperature, file);
+    c.temperature = *t;
+    return c;
+  }
+  for (const char* name : kDefaultTemperatureGrids) {
+    if (const GridEntry* t = find_grid(entries, name)) {
+      require_scalar(*t, Role::Temperature, file);
+      c.temperature = *t;
+      return c;
+    }
+  }
+  warnings.push_back(file + ": no temperature grid (looked for \"temperature\", \"heat\", \"flame\"; " +
+                     list_grids(entries) + "): the medium does not emit; set temperature_grid to choose one");
+  return c;
+}
+
+int64_t floor_div(int64_t a, int64_t k) { return a >= 0 ? a / k : -((-a + k - 1) / k); }
+
+// Fills a DenseGrid from active voxels. With downsample k, coarse voxel J
+// averages the k^3 fine voxels k*J .. k*J + k-1 (inactive ones count as the
+// background 0); its centre, the mean of the fine centres, is fine index
+// k*J + (k-1)/2, which index_map() returns.
+class DenseBuilder {
+ public:
+  DenseBuilder(DenseGrid& out, const glm::i64vec3& bmin, const glm::i64vec3& bmax, int k, bool clamp_negative,
+               const std::string& file, Role role)
+      : out_(out), k_(k), clamp_negative_(clamp_negative) {
+    glm::i64vec3 cmin, cmax;
+    for (int a = 0; a < 3; ++a) {
+      cmin[a] = floor_div(bmin[a], k);
+      cmax[a] = floor_div(bmax[a], k);
+    }
+    const glm::i64vec3 dims = cmax - cmin + int64_t(3);  // + one padding texel each side
+    const uint64_t texels = uint64_t(dims.x) * uint64_t(dims.y) * uint64_t(dims.z);
+    // 2^32 texels is 16 GiB as float: past what any host or device here holds,
+    // and texel offsets would overflow 32-bit shader arithmetic.
+    if (dims.x > (1 << 30) || dims.y > (1 << 30) || dims.z > (1 << 30) || texels > (uint64_t(1) << 32)) {
+      std::ostringstream s;
+      s << "active bounding box of " << dims.x - 2 << " x " << dims.y - 2 << " x " << dims.z - 2
+        << " voxels is too large for a dense texture; use \"downsample\": k (box filter by k)";
+      throw input_error(file, role_key(role, out.name), s.str());
+    }
+    out_.origin = glm::ivec3(cmin - int64_t(1));
+    out_.dims = glm::ivec3(dims);
+    out_.values.assign(texels, 0.0f);
+  }
+
+  void add(int64_t i, int64_t j, int64_t k, double v) {
+    float f = float(v);
+    if (!std::isfinite(f)) {  // NaN, Inf, or a double beyond float range
+      ++nonfinite;
+      f = 0.0f;
+    } else if (f < 0.0f && clamp_negative_) {
+      ++negative;
+      f = 0.0f;
+    }
+    lo_ = std::min(lo_, f);
+    hi_ = std::max(hi_, f);
+    if (f == 0.0f) return;
+    const int64_t x = floor_div(i, k_) - out_.origin.x, y = floor_div(j, k_) - out_.origin.y,
+                  z = floor_div(k, k_) - out_.origin.z;
+    out_.values[(size_t(z) * size_t(out_.dims.y) + size_t(y)) * size_t(out_.dims.x) + size_t(x)] += f;
+  }
+
+  void add_box(const openvdb::CoordBBox& box, double v) {
+    for (int64_t k = box.min().z(); k <= box.max().z(); ++k)
+      for (int64_t j = box.min().y(); j <= box.max().y(); ++j)
+        for (int64_t i = box.min().x(); i <= box.max().x(); ++i) add(i, j, k, v);
+  }
+
+  void finish() {
+    if (k_ > 1) {
+      const float w = 1.0f / float(k_ * k_ * k_);
+      for (float& v : out_.values) v *= w;
+    }
+    if (lo_ <= hi_) {
+      out_.min_value = lo_;
+      out_.max_value = hi_;
+    }
+  }
+
+  // Coarse index -> fine index (identity for k = 1).
+  glm::dmat4 index_map() const {
+    glm::dmat4 D = glm::translate(glm::dmat4(1.0), glm::dvec3(0.5 * (k_ - 1)));
+    return glm::scale(D, glm::dvec3(double(k_)));
+  }
+
+  uint64_t nonfinite = 0, negative = 0;
+
+ private:
+  DenseGrid& out_;
+  int k_;
+  bool clamp_negative_;
+  float lo_ = std::numeric_limits<float>::infinity(), hi_ = -std::numeric_limits<float>::infinity();
+};
+
+void report_counts(const DenseBuilder& b, const std::string& file, Role role, const std::string& grid,
+                   std::vector<std::string>& warnings) {
+  if (b.nonfinite)
+    warnings.push_back(file + ": " + role_key(role, grid) + ": " + std::to_string(b.nonfinite) +
+                       " NaN/Inf voxels treated as 0");
+  if (b.negative)
+    warnings.push_back(file + ": " + role_key(role, grid) + ": " + std::to_string(b.negative) +
+                       " negative density voxels clamped to 0");
+}
+
+void warn_empty(const std::string& file, Role role, const std::string& grid, std::vector<std::string>& warnings) {
+  warnings.push_back(file + ": " + role_key(role, grid) + ": empty grid (no active voxels): " +
+                     (role == Role::Density ? "renders as no medium" : "the medium does not emit"));
+}
+
+// ---- OpenVDB ----
+
+template <class GridT>
+DenseGrid dense_from_openvdb(const GridT& grid, const Medium& m, Role role, const std::string& file,
+                             std::vector<std::string>& warnings) {
+  DenseGrid out;
+  out.name = grid.getName();
+  const glm::dmat4 grid_to_world = openvdb_index_to_world(grid.transform(), file, out.name);
+  const openvdb::CoordBBox bbox = grid.evalActiveVoxelBoundingBox();
+  if (grid.activeVoxelCount() == 0 || bbox.empty()) {
+    out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world;
+    out.world_to_index = glm::inverse(out.index_to_world);
+    warn_empty(file, role, out.name, warnings);
+    return out;
+  }
+  const auto& lo = bbox.min();
+  const auto& hi = bbox.max();
+  DenseBuilder b(out, {lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}, m.downsample, role == Role::Density, file,
+                 role);
+  // ValueOnCIter visits each active voxel once and each active tile once (as a box).
+  for (auto it = grid.tree().cbeginValueOn(); it; ++it) {
+    if (it.isVoxelValue()) {
+      const openvdb::Coord& c = it.getCoord();
+      b.add(c.x(), c.y(), c.z(), double(*it));
+    } else {
+      openvdb::CoordBBox box;
+      it.getBoundingBox(box);
+      b.add_box(box, double(*it));
+    }
+  }
+  b.finish();
+  report_counts(b, file, role, out.name, warnings);
+  out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world * b.index_map();
+  out.world_to_index = glm::inverse(out.index_to_world);
+  return out;
+}
+
+std::vector<GridEntry> openvdb_grid_entries(openvdb::io::File& f) {
+  std::vector<GridEntry> entries;
+  try {
+    for (const auto& g : *f.readAllGridMetadata()) entries.push_back({g->getName(), g->valueType()});
+    return entries;
+  } catch (const openvdb::Exception&) {
+    // A grid type this build has not registered makes readAllGridMetadata fail
+    // for the whole file; list names one by one so the rest stays readable.
+  }
+  entries.clear();
+  for (auto it = f.beginName(); it != f.endName(); ++it) {
+    std::string type = "unknown type";
+    try {
+      type = f.readGridMetadata(*it)->valueType();
+    } catch (const openvdb::Exception&) {
+    }
+    entries.push_back({*it, type});
+  }
+  return entries;
+}
+
+VolumeGrids load_openvdb(const Medium& m, bool need_temperature) {
+  ensure_openvdb_initialized();
+  const std::string file = m.file.string();
+  VolumeGrids out;
+  try {
+    openvdb::io::File f(file);
+    // No delayed loading: we touch every active voxel at once anyway, and a
+    // memory-mapped file would add its pages to the RSS we promise to bound.
+    f.open(/*delayLoad=*/false);
+    const GridChoice c = choose_grids(openvdb_grid_entries(f), m, need_temperature, file, out.warnings);
+    auto load = [&](const GridEntry& e, Role role) {
+      openvdb::GridBase::Ptr g = f.readGrid(e.name);  // only this grid's tree is read
+      out.tree_mem_bytes += g->baseTree().memUsage();
+      if (auto fg = openvdb::gridConstPtrCast<openvdb::FloatGrid>(g))
+        return dense_from_openvdb(*fg, m, role, file, out.warnings);
+      if (auto dg = openvdb::gridConstPtrCast<openvdb::DoubleGrid>(g))
+        return dense_from_openvdb(*dg, m, role, file, out.warnings);
+      throw input_error(file, role_key(role, e.name), "is a " + g->valueType() + " grid; expected float or double");
+    };  // the sparse tree is freed here, before the next grid is read
+    out.density = load(c.density, Role::Density);
+    if (c.temperature) out.temperature = load(*c.temperature, Role::Temperature);
+    f.close();
+  } catch (const openvdb::Exception& e) {
+    throw input_error(file, "", std::string("cannot read as OpenVDB: ") + e.what());
+  }
+  return out;
+}
+
+// ---- NanoVDB ----
+
+template <class BuildT>
+DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Medium& m, Role role,
+                             const std::string& file, std::vector<std::string>& warnings) {
+  DenseGrid out;
+  out.name = grid.gridName();
+  const glm::dmat4 grid_to_world = nanovdb_index_to_world(grid);
+  const auto& bbox = grid.indexBBox();  // bbox of the active values
+  if (grid.activeVoxelCount() == 0 || bbox.empty()) {
+    out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world;
+    out.world_to_index = glm::inverse(out.index_to_world);
+    warn_empty(file, role, out.name, warnings);
+    return out;
+  }
+  DenseBuilder b(out, {bbox.min()[0], bbox.min()[1], bbox.min()[2]}, {bbox.max()[0], bbox.max()[1], bbox.max()[2]},
+                 m.downsample, role == Role::Density, file, role);
+  auto acc = grid.getAccessor();
+  for (int k = bbox.min()[2]; k <= bbox.max()[2]; ++k)
+    for (int j = bbox.min()[1]; j <= bbox.max()[1]; ++j)
+      for (int i = bbox.min()[0]; i <= bbox.max()[0]; ++i) {
+        const nanovdb::Coord ijk(i, j, k);
+        if (acc.isActive(ijk)) b.add(i, j, k, double(acc.getValue(ijk)));
+      }
+  b.finish();
+  report_counts(b, file, role, out.name, warnings);
+  out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world * b.index_map();
+  out.world_to_index = glm::inverse(out.index_to_world);
+  return out;
+}
+
+VolumeGrids load_nanovdb(const Medium& m, bool need_temperature) {
+  const std::string file = m.file.string();
+  VolumeGrids out;
+  std::vector<nanovdb::io::GridMetaData> metas;
+  try {
+    metas = nanovdb::io::readGridMetaData(file);
+  } catch (const std::exception& e) {
+    throw input_error(file, "", std::string("cannot read as NanoVDB: ") + e.what());
+  }
+  std::vector<GridEntry> entries;
+  for (const auto& md : metas) entries.push_back({md.gridName, nanovdb::toStr(md.gridType)});
+  const GridChoice c = choose_grids(entries, m, need_temperature, file, out.warnings);
+  auto load = [&](const GridEntry& e, Role role) {
+    nanovdb::GridHandle<nanovdb::HostBuffer> h;
+    try {
+      h = nanovdb::io::readGrid<nanovdb::HostBuffer>(file, e.name);
+    } catch (const std::exception& ex) {
+      // Includes files written with the BLOSC/ZIP codecs, which need
+      // NANOVDB_USE_BLOSC/ZIP and their libraries at build time.
+      throw input_error(file, role_key(role, e.name), std::string("cannot read NanoVDB grid: ") + ex.what());
+    }
+    if (!h) throw input_error(file, role_key(role, e.name), "cannot read NanoVDB grid");
+    out.tree_mem_bytes += h.size();
+    if (auto* g = h.grid<float>()) return dense_from_nanovdb(*g, m, role, file, out.warnings);
+    if (auto* g = h.grid<double>()) return dense_from_nanovdb(*g, m, role, file, out.warnings);
+    if (auto* g = h.grid<nanovdb::Fp16>()) return dense_from_nanovdb(*g, m, role, file, out.warnings);
+    if (auto* g = h.grid<nanovdb::Fp8>()) return dense_from_nanovdb(*g, m, role, file, out.warnings);
+    if (auto* g = h.grid<nanovdb::Fp4>()) return dense_from_nanovdb(*g, m, role, file, out.warnings);
+    if (auto* g = h.grid<nanovdb::FpN>()) return dense_from_nanovdb(*g, m, role, file, out.warnings);
+    throw input_error(file, role_key(role, e.name), "NanoVDB grid type " + e.type + " is not supported");
+  };
+  out.density = load(c.density, Role::Density);
+  if (c.temperature) out.temperature = load(*c.temperature, Role::Temperature);
+  return out;
+}
+
+}  // namespace
+
+VolumeGrids load_volume(const Medium& m, bool need_temperature) {
+  const std::string file = m.file.string();
+  if (m.downsample < 1) throw input_error(file, "downsample", "must be >= 1");
+  return detect_volume_format(m.file) == VolumeFormat::NanoVdb ? load_nanovdb(m, need_temperature)
+                                                               : load_openvdb(m, need_temperature);
+}
+
+}  // namespace pyrolume

@@ -1,0 +1,28 @@
+#pragma once
+// Loads the grids a `type: vdb` medium names from an OpenVDB (.vdb) or NanoVDB
+// (.nvdb) file into dense arrays (docs/volumes.md).
+#include <glm/glm.hpp>
+
+#include "scene/Scene.h"
+#include "volume/DenseGrid.h"
+
+namespace pyrolume {
+
+// Names tried, in order, when a medium gives no temperature_grid.
+inline constexpr const char* kDefaultTemperatureGrids[] = {"temperature", "heat", "flame"};
+inline constexpr const char* kDefaultDensityGrid = "density";
+
+// Reads only the density grid (and, when need_temperature, the temperature
+// grid) named by the medium, each into its own DenseGrid with its own
+// index->world map, the medium transform composed on top.
+// Throws InputError (file, grid, reason) for a missing/unreadable file, a
+// missing grid (the message lists the grids present) or a non-scalar grid.
+// Recoverable oddities (empty grid, NaN/Inf, negative density) come back as
+// VolumeGrids::warnings.
+VolumeGrids load_volume(const Medium& m, bool need_temperature);
+
+// The medium's `transform` as a matrix: T * Rz * Ry * Rx * S, i.e. scale first,
+// then rotate about X, Y, Z (degrees, right-handed), then translate.
+glm::dmat4 medium_transform_matrix(const Transform& t);
+
+}  // namespace pyrolume

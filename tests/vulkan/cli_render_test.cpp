@@ -1,0 +1,113 @@
+// `pyrolume render` end to end, as a user runs it: outputs, stats, closing line,
+// interruption.
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "image/ImageIo.h"
+#include "support/TestSupport.h"
+
+using namespace pyrolume;
+using namespace pyrolume::test;
+
+namespace {
+const char* kScene = R"({
+  "camera": {"position": [0, 0, -4], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 40},
+  "film": {"width": 24, "height": 16, "spp": 8, "seed": 3},
+  "background": {"rgb": [0.1, 0.1, 0.1]},
+  "media": [{"name": "ball", "type": "homogeneous", "bounds": {"sphere": {"center": [0, 0, 0], "radius": 1}},
+             "sigma_a": [1, 1, 1], "sigma_s": [0.5, 0.5, 0.5], "g": 0.2, "emission": {"rgb": [1, 0.5, 0.2]}}]
+})";
+}  // namespace
+
+class CliRender : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(CliRender, WritesExrWithVarianceStatsAndSummary) {
+  const std::string backend = GetParam();
+  auto dir = temp_dir("render");
+  write_file(dir / "s.json", kScene);
+  CliResult r = run_cli("render " + (dir / "s.json").string() + " -o " + (dir / "o.exr").string() + " --backend " +
+                        backend + " --spp 16 --width 20 --height 10 --variance --stats " + (dir / "st.json").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("validation"), std::string::npos) << r.err;
+  // One closing line on stdout: path, resolution, spp, seconds, Msamples/s, device.
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+  EXPECT_NE(r.out.find("20x10, 16 spp"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Msamples/s"), std::string::npos) << r.out;
+
+  Image img = read_image(dir / "o.exr");
+  EXPECT_EQ(img.width, 20);  // CLI flags override the film
+  EXPECT_EQ(img.height, 10);
+  ASSERT_TRUE(img.has_variance());
+  double centre = img.at(10, 5, 0), corner = img.at(0, 0, 0);
+  EXPECT_GT(centre, 0.3);                  // the emissive ball fills the centre
+  EXPECT_NEAR(corner, 0.1, 1e-6);          // background seen directly, no variance
+  EXPECT_GT(img.var_at(10, 5, 0), 0.0);
+
+  auto stats = nlohmann::json::parse(read_file(dir / "st.json"));
+  for (const char* key : {"backend", "device", "width", "height", "spp", "seconds", "load_seconds", "samples_per_second",
+                          "peak_rss_mb", "density_lookups_per_ray", "lookups_per_second", "events_per_path",
+                          "nonfinite_samples"})
+    EXPECT_TRUE(stats.contains(key)) << key;
+  EXPECT_EQ(stats["backend"], backend);
+  EXPECT_EQ(stats["spp"], 16);
+  EXPECT_GT(stats["events_per_path"].get<double>(), 0.0);
+  EXPECT_EQ(stats["nonfinite_samples"], 0);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_P(CliRender, PngIsSrgbWithExposure) {
+  const std::string backend = GetParam();
+  auto dir = temp_dir("png");
+  write_file(dir / "s.json", kScene);
+  CliResult a = run_cli("render " + (dir / "s.json").string() + " -o " + (dir / "a.png").string() + " --backend " + backend);
+  ASSERT_EQ(a.status, 0) << a.err;
+  Image img = read_image(dir / "a.png");  // decoded back to linear
+  EXPECT_NEAR(img.at(0, 0, 1), 0.1, 0.004);
+  // film.exposure = +1 stop doubles the PNG's linear values (EXR stays linear).
+  std::string brighter = kScene;
+  brighter.replace(brighter.find("\"seed\": 3"), 9, "\"seed\": 3, \"exposure\": 1");
+  write_file(dir / "b.json", brighter);
+  CliResult b = run_cli("render " + (dir / "b.json").string() + " -o " + (dir / "b.png").string() + " --backend " + backend);
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_NEAR(read_image(dir / "b.png").at(0, 0, 1), 0.2, 0.006);
+  std::filesystem::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, CliRender, ::testing::Values("vulkan", "cpu"));
+
+// SIGINT mid-render: the image so far is saved, the exit status is 130.
+TEST(CliInterrupt, SigintSavesImageAndExits130) {
+  auto dir = temp_dir("sigint");
+  write_file(dir / "s.json", kScene);
+  std::string out = (dir / "o.exr").string();
+  pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    int devnull = open("/dev/null", O_WRONLY);
+    dup2(devnull, 1);
+    dup2(devnull, 2);
+    std::string scene = (dir / "s.json").string();
+    execl(PYROLUME_BIN, PYROLUME_BIN, "render", scene.c_str(), "-o", out.c_str(), "--spp", "10000000", "--width",
+          "64", "--height", "64", static_cast<char*>(nullptr));
+    _exit(99);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  ASSERT_TRUE(std::filesystem::exists(out));
+  Image img = read_image(out);
+  EXPECT_EQ(img.width, 64);
+  EXPECT_GT(img.at(32, 32, 0), 0.3);
+  std::filesystem::remove_all(dir);
+}
