@@ -120,7 +120,10 @@ void write_swatch_strip_png(const std::filesystem::path& path, const SwatchStrip
   namespace fs = std::filesystem;
   // Write beside the destination, then rename: a failed run leaves no partial PNG.
   const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
-  const fs::path tmp = dir / ("." + path.filename().string() + ".tmp-" + std::to_string(::getpid()));
+  std::string tmp_name = ".";  // built with += : GCC 12 warns falsely (-Wrestrict) on "." + string
+  tmp_name += path.filename().string();
+  tmp_name += ".tmp-" + std::to_string(::getpid());
+  const fs::path tmp = dir / tmp_name;
   bool ok = false;
   {
     std::ofstream f(tmp, std::ios::binary | std::ios::trunc);

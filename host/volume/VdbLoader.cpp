@@ -258,7 +258,8 @@ DenseGrid dense_from_openvdb(const GridT& grid, const Medium& m, Role role, cons
 std::vector<GridEntry> openvdb_grid_entries(openvdb::io::File& f) {
   std::vector<GridEntry> entries;
   try {
-    for (const auto& g : *f.readAllGridMetadata()) entries.push_back({g->getName(), g->valueType()});
+    const openvdb::GridPtrVecPtr grids = f.readAllGridMetadata();  // keep alive across the loop
+    for (const auto& g : *grids) entries.push_back({g->getName(), g->valueType()});
     return entries;
   } catch (const openvdb::Exception&) {
     // A grid type this build has not registered makes readAllGridMetadata fail

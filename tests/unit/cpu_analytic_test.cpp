@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "color/Blackbody.h"
 #include "render/cpu/CpuRenderer.h"
 #include "support/AnalyticScenes.h"
 #include "support/Stats.h"
@@ -137,6 +138,21 @@ TEST(CpuAnalytic, EquilibriumInsideLargeSphere) {
   double per_sample = r.events / (double(r.width) * r.height * r.spp);
   EXPECT_NEAR(per_sample, expect, 0.02 * expect);
   EXPECT_EQ(r.density_lookups, 0.0);
+}
+
+// emission.temperature_k: Le = scale × color::blackbody_rgb(T, mode, observer,
+// adapt_to_k); equilibrium makes the pixel value exactly that.
+TEST(CpuAnalytic, BlackbodyEmissionInEquilibrium) {
+  Scene s = test::equilibrium_sphere_scene(8, 8, 64);
+  Emission& e = s.media[0].emission;
+  e.rgb.reset();
+  e.temperature_k = 1800.0;
+  e.scale = 3.0;
+  e.blackbody = BlackbodyMode::Seed;
+  glm::dvec3 Le = 3.0 * color::blackbody_rgb(1800.0, BlackbodyMode::Seed, 2, std::nullopt);
+  ASSERT_GT(Le.r, 0.0);
+  ZTestReport rep = test::ztest_against_exact(render(s), [&](int, int) { return Le; });
+  EXPECT_TRUE(rep.ok) << rep.summary();
 }
 
 TEST(CpuAnalytic, WhiteFurnaceConservesEnergy) {

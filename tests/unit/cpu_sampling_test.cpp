@@ -22,7 +22,7 @@ double hg_cdf(double mu, double g) {
   return (1.0 - g * g) / (2.0 * g) * (1.0 / std::sqrt(1.0 + g * g - 2.0 * g * mu) - 1.0 / (1.0 + g));
 }
 
-const double kGs[] = {-0.95, -0.7, -0.3, -1e-4, 0.0, 1e-4, 5e-3, 0.3, 0.7, 0.95};
+const double kGs[] = {-0.95, -0.7, -0.3, -1e-4, 0.0, 1e-4, 5e-4, 5e-3, 0.3, 0.7, 0.95};
 
 TEST(CpuSampling, HgPdfIsNormalisedAndMatchesCdf) {
   for (double g : kGs) {
@@ -78,6 +78,22 @@ TEST(CpuSampling, SampleHgChiSquareAndMeanCosine) {
       // E[cos θ] = g for HG; the sample mean's SD is <= 1/sqrt(N).
       EXPECT_NEAR(mean_cos, g, 5.0 / std::sqrt(double(N))) << "g " << g;
     }
+}
+
+// |g| tiny: still exactly HG (not pbrt-v4's isotropic stand-in). The mean cosine
+// of HG is g; integrate the inverse CDF over u (midpoint rule, smooth integrand).
+TEST(CpuSampling, SampleHgSmallGIsExact) {
+  for (double g : {1e-6, -3e-5, 4e-4}) {
+    const int n = 200000;
+    double mean = 0.0;
+    for (int i = 0; i < n; ++i) mean += sample_hg_cos_theta(g, (i + 0.5) / n) / n;
+    EXPECT_NEAR(mean, g, 1e-9 + 1e-3 * std::abs(g)) << "g " << g;
+  }
+  // Continuous across the branch switch at |g| = kHgSmallG.
+  for (double u : {0.01, 0.3, 0.77, 0.999}) {
+    EXPECT_NEAR(sample_hg_cos_theta(kHgSmallG * (1 - 1e-9), u), sample_hg_cos_theta(kHgSmallG, u), 1e-9);
+    EXPECT_NEAR(sample_hg_cos_theta(-kHgSmallG * (1 - 1e-9), u), sample_hg_cos_theta(-kHgSmallG, u), 1e-9);
+  }
 }
 
 TEST(CpuSampling, SampleHgExtremeInputsStayFinite) {

@@ -11,10 +11,11 @@
 
 namespace pyrolume::cpu {
 
-// Below this |g| the HG inversion formula loses precision (1/(2g) blows up while
-// its bracket cancels); HG with g -> 0 is isotropic, so sample that instead.
-// Same threshold as pbrt-v4 SampleHenyeyGreenstein.
-inline constexpr double kHgIsotropicEps = 1e-3;
+// Below this |g| the textbook HG inversion loses precision: (1 + g² − s²) cancels
+// while 1/(2g) blows up. pbrt-v4 (SampleHenyeyGreenstein) samples isotropically
+// there; the reference instead uses an algebraically equal form without the
+// cancellation (see sample_hg_cos_theta), so it stays exactly HG for every g.
+inline constexpr double kHgSmallG = 1e-3;
 
 // Henyey–Greenstein phase function, in the *propagation* convention:
 // cos_theta = dot(incoming travel direction, outgoing travel direction), so g > 0
@@ -28,13 +29,17 @@ inline double hg_pdf(double cos_theta, double g) {
 }
 
 // Inverse CDF of cos θ under HG (propagation convention), u in [0, 1):
-//   cos θ = (1 + g² − ((1 − g²) / (1 − g + 2 g u))²) / (2 g)
-// (pbrt-v4 SampleHenyeyGreenstein, sec. 11.3.1, with cos θ → −cos θ for wo).
-// u = 0 gives cos θ = −1, u → 1 gives cos θ = 1.
+//   cos θ = (1 + g² − s²) / (2 g),  s = (1 − g²) / (1 − g + 2 g u)
+// (pbrt-v4 SampleHenyeyGreenstein, sec. 11.3.1, there with cos θ → −cos θ for wo).
+// u = 0 gives cos θ = −1, u → 1 gives cos θ = 1. For |g| < kHgSmallG the same
+// expression with ξ = 2u − 1, expanded and divided through by 2g:
+//   cos θ = (ξ + g(3 + ξ²)/2 + g²ξ + g³(ξ² − 1)/2) / (1 + gξ)²
+// which has no cancellation and tends to the isotropic ξ as g → 0.
 inline double sample_hg_cos_theta(double g, double u) {
   double cos_theta;
-  if (std::abs(g) < kHgIsotropicEps) {
-    cos_theta = 2.0 * u - 1.0;
+  if (std::abs(g) < kHgSmallG) {
+    double xi = 2.0 * u - 1.0, d = 1.0 + g * xi;
+    cos_theta = (xi + 0.5 * g * (3.0 + xi * xi) + g * g * xi + 0.5 * g * g * g * (xi * xi - 1.0)) / (d * d);
   } else {
     double s = (1.0 - g * g) / (1.0 - g + 2.0 * g * u);
     cos_theta = (1.0 + g * g - s * s) / (2.0 * g);
