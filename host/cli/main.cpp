@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/Commands.h"
+#include "render/vulkan/Devices.h"
 #include "util/Error.h"
 
 namespace {
@@ -88,6 +89,9 @@ int main(int argc, char** argv) {
     if (*blackbody) return run_blackbody(bb);
     if (*compare) return run_compare(cmp);
   } catch (const InputError& e) {
+    std::cerr << "pyrolume: " << e.what() << "\n";
+    return 2;
+  } catch (const vk::NoDeviceError& e) {
     std::cerr << "pyrolume: " << e.what() << "\n";
     return 2;
   } catch (const std::exception& e) {

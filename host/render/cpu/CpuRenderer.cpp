@@ -170,8 +170,6 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   auto load_start = Clock::now();
   if (settings.width <= 0 || settings.height <= 0 || settings.spp <= 0)
     throw std::invalid_argument("cpu reference: width, height and spp must be positive");
-  if (scene.environment) throw std::runtime_error("cpu reference: environment maps not supported yet");
-  if (!scene.shapes.empty()) throw std::runtime_error("cpu reference: surfaces not supported yet");
   {
     glm::dvec3 f = scene.camera.look_at - scene.camera.position;
     if (!(glm::length(glm::cross(f, scene.camera.up)) > 0.0))

@@ -23,7 +23,8 @@ class CpuRenderer : public Backend {
   int threads() const { return threads_; }
 
   // Throws std::runtime_error for what the reference cannot render yet (vdb
-  // media, environment maps, surfaces) and std::invalid_argument for bad settings.
+  // media) and std::invalid_argument for bad settings. Surfaces and environment maps are not
+  // rendered yet: they are ignored (the CLI warns), as on the Vulkan backend.
   RenderResult render(const Scene& scene, const RenderSettings& settings, const RenderControl& control) override;
 
   // Samples per pixel per progressive pass (progress/cancel/time-limit granularity).

@@ -1,0 +1,51 @@
+#pragma once
+// One scene on one device, ready to accumulate samples: the uploaded constants
+// and media, the pipeline and the per-pixel accumulation buffer. `render` and the
+// preview window both drive it, pass by pass.
+#include <vector>
+
+#include "render/Render.h"
+#include "render/vulkan/Context.h"
+#include "render/vulkan/Memory.h"
+#include "render/vulkan/Pipeline.h"
+#include "scene/Scene.h"
+#include "shared/gpu_types.h"
+
+namespace pyrolume {
+
+class RenderSession {
+ public:
+  RenderSession(vk::Context& ctx, const Scene& scene, const RenderSettings& settings);
+
+  // Re-upload what the scene changes (camera, media parameters) and restart
+  // the accumulation. The image size stays as constructed.
+  void update(const Scene& scene);
+  // Zero the accumulation; the next pass starts at sample 0 again.
+  void reset();
+  // Record one pass of `spp` samples per pixel into cmd (the caller submits).
+  // Passes must be submitted in the order they were recorded.
+  void record_pass(VkCommandBuffer cmd, int spp);
+  // Record, submit and wait.
+  void run_pass(int spp);
+
+  int spp_done() const { return spp_done_; }
+  int width() const { return settings_.width; }
+  int height() const { return settings_.height; }
+  // AccumTexel per pixel (shaders/shared/gpu_types.h), row 0 = top.
+  const vk::Buffer& accumulation() const { return accum_; }
+  // Read the sums and counters back into result (sum, sum_sq, spp, counters).
+  void read(RenderResult& result);
+
+ private:
+  void upload_scene(const Scene& scene);
+
+  vk::Context& ctx_;
+  RenderSettings settings_;
+  vk::Buffer frame_buffer_, media_buffer_, accum_;
+  vk::ComputePipeline pipeline_;
+  vk::DescriptorSet set_;
+  int spp_done_ = 0;
+  bool needs_clear_ = true;
+};
+
+}  // namespace pyrolume
