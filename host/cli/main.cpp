@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/Commands.h"
+#include "preview/Preview.h"
 #include "render/vulkan/Devices.h"
 #include "util/Error.h"
 
@@ -41,6 +42,15 @@ int main(int argc, char** argv) {
   render->add_option("--stats", render_args.stats, "Write render statistics as JSON");
   render->add_flag("--variance", render_args.variance, "EXR: add the per-pixel variance of the mean (variance.R/G/B)");
   render->add_option("--device", render_args.device, "Vulkan device index (see `pyrolume devices`)")->check(CLI::NonNegativeNumber);
+
+  PreviewArgs pv;
+  auto* preview = app.add_subcommand("preview", "Open a window that shows the render converging");
+  preview->add_option("scene", pv.scene, "Scene JSON file")->required();
+  preview->add_option("--frames", pv.frames, "Show N display frames, save --screenshot, exit")->check(CLI::PositiveNumber);
+  preview->add_option("--screenshot", pv.screenshot, "PNG of what the window shows (with --frames)");
+  preview->add_option("--device", pv.device, "Vulkan device index")->check(CLI::NonNegativeNumber);
+  preview->add_option("--width", pv.width, "Window width (overrides film.width)")->check(CLI::Range(16, 16384));
+  preview->add_option("--height", pv.height, "Window height (overrides film.height)")->check(CLI::Range(16, 16384));
 
   int devices_device = -1;
   auto* devices = app.add_subcommand("devices", "List the Vulkan devices and which one is chosen");
@@ -85,6 +95,7 @@ int main(int argc, char** argv) {
       if (g_signal == SIGTERM) return 143;
       return status;
     }
+    if (*preview) return run_preview_command(pv);
     if (*devices) return run_devices(devices_device);
     if (*blackbody) return run_blackbody(bb);
     if (*compare) return run_compare(cmp);
