@@ -1,8 +1,9 @@
 #version 460
-// Per-pixel path tracing of emissive participating media (homogeneous spheres
-// and boxes), one progressive pass per dispatch. Estimator: the seed's
-// "absorption" estimator — a path that is absorbed collects Le; it scatters by
-// Henyey–Greenstein; escaping paths see the background.
+// Per-pixel path tracing of emissive participating media, one progressive pass
+// per dispatch. Homogeneous spheres/boxes and grid (vdb) media, delta tracking
+// against per-cell majorants (a coarse grid walked by 3D DDA), the "absorption"
+// or "collision" emission estimator, Henyey–Greenstein scattering; escaping
+// paths see the background.
 #extension GL_GOOGLE_include_directive : require
 
 #include "shared/gpu_types.h"
@@ -12,92 +13,277 @@
 
 layout(local_size_x = WORKGROUP_SIZE_X, local_size_y = WORKGROUP_SIZE_Y) in;
 
+// Specialisation: a scene without grids/scattering/emission compiles none of that code.
+layout(constant_id = SPEC_HAS_GRIDS) const bool HAS_GRIDS = true;
+layout(constant_id = SPEC_HAS_SCATTERING) const bool HAS_SCATTERING = true;
+layout(constant_id = SPEC_HAS_EMISSION) const bool HAS_EMISSION = true;
+layout(constant_id = SPEC_COLLISION_ESTIMATOR) const bool COLLISION_ESTIMATOR = false;
+layout(constant_id = SPEC_DEBUG_MODE) const uint DEBUG_MODE = DEBUG_NONE;
+
 layout(std140, set = 0, binding = BINDING_FRAME) uniform FrameBlock { FrameConstants frame; };
 layout(std430, set = 0, binding = BINDING_MEDIA) readonly buffer MediaBlock { GpuMedium media[]; };
 layout(std430, set = 0, binding = BINDING_ACCUM) buffer AccumBlock { AccumTexel accum[]; };
+layout(std430, set = 0, binding = BINDING_GRIDS) readonly buffer GridBlock { GpuGrid grids[]; };
+layout(std430, set = 0, binding = BINDING_MAJORANTS) readonly buffer MajorantBlock { float majorants[]; };
+layout(set = 0, binding = BINDING_DENSITY) uniform sampler3D density_tex[MAX_GRIDS];
+layout(set = 0, binding = BINDING_TEMPERATURE) uniform sampler3D temperature_tex[MAX_GRIDS];
+layout(set = 0, binding = BINDING_BLACKBODY) uniform sampler1D blackbody_tex[MAX_GRIDS];
 layout(push_constant) uniform PassBlock { PassConstants pass_constants; };
+
+const float INF = 1.0 / 0.0;
 
 float avg3(vec3 v) { return (v.x + v.y + v.z) * (1.0 / 3.0); }
 float max3(vec3 v) { return max(v.x, max(v.y, v.z)); }
+float min3(vec3 v) { return min(v.x, min(v.y, v.z)); }
 
 struct PathStats {
   float events;   // real collisions: absorptions + scatterings
-  float lookups;  // density texture lookups (none for homogeneous media)
+  float lookups;  // density texture lookups
 };
+
+// Texture arrays are indexed with constants only (no dependence on
+// dynamically-uniform indexing, which lavapipe and older GPUs handle poorly).
+float density_at(uint slot, vec3 tc) {
+  switch (slot) {
+    case 0u: return textureLod(density_tex[0], tc, 0.0).r;
+    case 1u: return textureLod(density_tex[1], tc, 0.0).r;
+    case 2u: return textureLod(density_tex[2], tc, 0.0).r;
+    default: return textureLod(density_tex[3], tc, 0.0).r;
+  }
+}
+float temperature_at(uint slot, vec3 tc) {
+  switch (slot) {
+    case 0u: return textureLod(temperature_tex[0], tc, 0.0).r;
+    case 1u: return textureLod(temperature_tex[1], tc, 0.0).r;
+    case 2u: return textureLod(temperature_tex[2], tc, 0.0).r;
+    default: return textureLod(temperature_tex[3], tc, 0.0).r;
+  }
+}
+vec3 blackbody_at(uint slot, float s) {
+  switch (slot) {
+    case 0u: return textureLod(blackbody_tex[0], s, 0.0).rgb;
+    case 1u: return textureLod(blackbody_tex[1], s, 0.0).rgb;
+    case 2u: return textureLod(blackbody_tex[2], s, 0.0).rgb;
+    default: return textureLod(blackbody_tex[3], s, 0.0).rgb;
+  }
+}
+
+vec3 density_texel(GpuGrid g, vec3 p) {
+  vec4 p1 = vec4(p, 1.0);
+  return vec3(dot(g.density_row0, p1), dot(g.density_row1, p1), dot(g.density_row2, p1));
+}
+vec3 density_texel_dir(GpuGrid g, vec3 d) {
+  vec4 d0 = vec4(d, 0.0);
+  return vec3(dot(g.density_row0, d0), dot(g.density_row1, d0), dot(g.density_row2, d0));
+}
+
+// Emitted radiance Le of grid medium m at world point x (DESIGN.md: T = (v − offset)·scale,
+// no emission at or below cutoff_k; the LUT is uniform in ln T).
+vec3 grid_le(GpuMedium m, uint slot, vec3 x) {
+  uint mode = uint(m.emission.w);
+  if (mode == EMIT_CONSTANT) return m.emission.rgb;
+  if (mode != EMIT_TEMPERATURE) return vec3(0.0);
+  GpuGrid g = grids[slot];
+  vec4 p1 = vec4(x, 1.0);
+  vec3 u = vec3(dot(g.temperature_row0, p1), dot(g.temperature_row1, p1), dot(g.temperature_row2, p1));
+  float value = temperature_at(slot, u / g.temperature_dims.xyz);
+  float T = (value - g.temperature_map.x) * g.temperature_map.y;
+  if (!(T > g.temperature_map.z) || !(T >= g.blackbody_lut.z)) return vec3(0.0);
+  return m.emission.rgb * blackbody_at(slot, log(T) * g.blackbody_lut.x + g.blackbody_lut.y);
+}
+
+// The media's extent along a ray: [t_enter, t_exit], (-1,-1) when missed.
+void media_spans(vec3 o, vec3 d, out vec2 span[MAX_MEDIA], out bool any_hit) {
+  any_hit = false;
+  for (uint i = 0u; i < frame.image.z; ++i) {
+    GpuMedium m = media[i];
+    uint shape = uint(m.sigma_a.w);
+    vec2 t;
+    bool hit;
+    if (shape == SHAPE_SPHERE) {
+      hit = intersect_sphere(o, d, m.bounds0.xyz, m.bounds0.w, t);
+    } else if (shape == SHAPE_BOX) {
+      hit = intersect_box(o, d, m.bounds0.xyz, m.bounds1.xyz, t);
+    } else {
+      // The texel box [0, dims] in texel space; t is the same there (affine map).
+      GpuGrid g = grids[uint(m.bounds0.x)];
+      hit = intersect_box(density_texel(g, o), density_texel_dir(g, d), vec3(0.0), g.density_dims.xyz, t);
+    }
+    span[i] = hit ? t : vec2(-1.0);
+    any_hit = any_hit || hit;
+  }
+}
+
+// Majorant of grid medium m over the DDA cell the ray is in at t, and the t at
+// which the ray leaves that cell. Stateless: the cell is found at t + a small
+// nudge along the ray, so a point on a face belongs to the cell being entered.
+float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, inout float t_next) {
+  GpuGrid g = grids[uint(m.bounds0.x)];
+  vec3 u = density_texel(g, o + t * d);
+  vec3 du = density_texel_dir(g, d);
+  vec3 cs = g.majorant_cell.xyz;
+  vec3 inv_du = 1.0 / du;
+  float nudge = 1e-4 * min3(cs) / max(max3(abs(du)), 1e-30);
+  ivec3 res = ivec3(g.majorant_res.xyz);
+  ivec3 cell = clamp(ivec3(floor((u + du * nudge) / cs)), ivec3(0), res - 1);
+  vec3 bound = (vec3(cell) + step(vec3(0.0), du)) * cs;
+  vec3 tx = (bound - u) * inv_du;  // ±inf on axes the ray runs parallel to
+  float t_exit = t + max(min3(mix(tx, vec3(INF), isnan(tx))), nudge);
+  t_next = min(t_next, t_exit);
+  uint index = g.majorant_res.w + uint((cell.z * res.y + cell.y) * res.x + cell.x);
+  return majorants[index] * g.majorant_cell.w;
+}
+
+// Media coefficients at a tentative collision; rho[i] keeps each grid's
+// density_scale · density for the scattering-lobe choice.
+void coefficients_at(vec3 x, float t, vec2 span[MAX_MEDIA], out vec3 sigma_a, out vec3 sigma_s, out float rho[MAX_MEDIA],
+                     inout PathStats stats) {
+  sigma_a = vec3(0.0);
+  sigma_s = vec3(0.0);
+  for (uint i = 0u; i < frame.image.z; ++i) {
+    rho[i] = 0.0;
+    if (!(span[i].x <= t && t < span[i].y)) continue;
+    GpuMedium m = media[i];
+    float r = 1.0;
+    if (HAS_GRIDS && uint(m.sigma_a.w) == SHAPE_GRID) {
+      uint slot = uint(m.bounds0.x);
+      GpuGrid g = grids[slot];
+      r = g.density_dims.w * density_at(slot, density_texel(g, x) / g.density_dims.xyz);
+      stats.lookups += 1.0;
+    }
+    rho[i] = r;
+    sigma_a += r * m.sigma_a.rgb;
+    sigma_s += r * m.sigma_s.rgb;
+  }
+}
+
+// Emitted power per unit length, Σ sigma_a_i(x)·Le_i(x), over the media at t.
+vec3 emission_at(vec3 x, float t, vec2 span[MAX_MEDIA], float rho[MAX_MEDIA]) {
+  vec3 E = vec3(0.0);
+  for (uint i = 0u; i < frame.image.z; ++i) {
+    if (!(span[i].x <= t && t < span[i].y)) continue;
+    GpuMedium m = media[i];
+    if (HAS_GRIDS && uint(m.sigma_a.w) == SHAPE_GRID) {
+      if (rho[i] > 0.0) E += rho[i] * m.sigma_a.rgb * grid_le(m, uint(m.bounds0.x), x);
+    } else {
+      E += m.emission.rgb;
+    }
+  }
+  return E;
+}
+
+// Local majorant over [t, t_next): sum over the media present of their bound.
+float majorant_at(vec3 o, vec3 d, float t, vec2 span[MAX_MEDIA], out float t_next, out bool any_ahead) {
+  float sigma_bar = 0.0;
+  t_next = INF;
+  any_ahead = false;
+  for (uint i = 0u; i < frame.image.z; ++i) {
+    vec2 s = span[i];
+    if (s.y <= t) continue;
+    any_ahead = true;
+    if (s.x > t) {
+      t_next = min(t_next, s.x);
+      continue;
+    }
+    t_next = min(t_next, s.y);
+    GpuMedium m = media[i];
+    if (HAS_GRIDS && uint(m.sigma_a.w) == SHAPE_GRID) sigma_bar += grid_majorant(m, o, d, t, t_next);
+    else sigma_bar += max3(m.sigma_a.rgb + m.sigma_s.rgb);
+  }
+  return sigma_bar;
+}
+
+// Transmittance along a ray to infinity, per channel. Ratio tracking (Novák et
+// al. 2014): multiply by the null fraction sigma_n/sigma_bar at every tentative
+// collision, with Russian roulette once the estimate is small. Delta tracking
+// (spectral: Kutz et al. 2017) terminates at real collisions instead.
+vec3 transmittance(vec3 o, vec3 d, bool ratio, inout uint rng, inout PathStats stats) {
+  vec2 span[MAX_MEDIA];
+  bool any_hit;
+  media_spans(o, d, span, any_hit);
+  vec3 T = vec3(1.0);
+  float t = 0.0;
+  for (;;) {
+    float t_next;
+    bool any_ahead;
+    float sigma_bar = majorant_at(o, d, t, span, t_next, any_ahead);
+    if (!any_ahead || isinf(t_next)) return T;
+    if (sigma_bar <= 0.0) { t = t_next; continue; }
+    float dt = sample_free_flight(sigma_bar, rng_next(rng));
+    if (t + dt >= t_next) { t = t_next; continue; }
+    t += dt;
+    vec3 sigma_a, sigma_s;
+    float rho[MAX_MEDIA];
+    coefficients_at(o + t * d, t, span, sigma_a, sigma_s, rho, stats);
+    vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
+    if (ratio) {
+      T *= sigma_n / sigma_bar;
+      float q = max3(T);
+      if (q < 0.1) {  // Russian roulette: survive with probability q, reweight by 1/q
+        if (rng_next(rng) >= q) return vec3(0.0);
+        T /= q;
+      }
+    } else {
+      float p_null = avg3(sigma_n * T) / (sigma_bar * avg3(T));
+      if (rng_next(rng) >= p_null) return vec3(0.0);
+      T *= sigma_n / (sigma_bar * p_null);
+    }
+  }
+  return T;
+}
 
 // Radiance along one camera ray.
 //
-// Media are piecewise constant along a ray, so the ray is split at the bounds'
-// entry/exit distances and free flights restart at each boundary (memoryless).
-// RGB sigma is handled by spectral tracking (Kutz et al. 2017, "Spectral and
-// Decomposition Tracking", history-aware averaged probabilities): distances are
-// sampled with the grey majorant sigma_bar = max channel of sigma_t, and event x
-// (absorb / scatter / null) is chosen with P_x = avg(sigma_x ⊙ w) / (sigma_bar·avg(w));
-// the path weight w then picks up sigma_x / (sigma_bar·P_x) per channel. For grey
+// Delta tracking against a piecewise-constant majorant: the ray is split at
+// media boundaries and majorant-cell faces, and free flights restart at each
+// (memoryless). RGB sigma is handled by spectral tracking (Kutz et al. 2017,
+// "Spectral and Decomposition Tracking", history-aware averaged probabilities):
+// distances are sampled with the grey majorant sigma_bar, and event x (absorb /
+// scatter / null) is chosen with P_x = avg(sigma_x ⊙ w) / (sigma_bar·avg(w)); the
+// path weight w then picks up sigma_x / (sigma_bar·P_x) per channel. For grey
 // media every factor is 1 and this is plain delta tracking.
 vec3 trace(vec3 o, vec3 d, inout uint rng, inout PathStats stats) {
-  uint medium_count = frame.image.z;
-  uint max_depth = frame.image.w;
+  const uint max_depth = frame.image.w;
   vec3 w = vec3(1.0);
   vec3 L = vec3(0.0);
   uint depth = 0u;
   for (;;) {
-    // Intervals of every medium along the current ray.
     vec2 span[MAX_MEDIA];
-    bool any_ahead = false;
-    for (uint i = 0u; i < medium_count; ++i) {
-      GpuMedium m = media[i];
-      vec2 t;
-      bool hit = uint(m.sigma_a.w) == SHAPE_SPHERE
-                     ? intersect_sphere(o, d, m.bounds0.xyz, m.bounds0.w, t)
-                     : intersect_box(o, d, m.bounds0.xyz, m.bounds1.xyz, t);
-      span[i] = hit ? t : vec2(-1.0);
-      any_ahead = any_ahead || hit;
-    }
-    if (!any_ahead) {
-      L += w * frame.background.rgb;
-      return L;
-    }
+    bool any_hit;
+    media_spans(o, d, span, any_hit);
+    if (!any_hit) return L + w * frame.background.rgb;
 
     bool scattered = false;
     float t = 0.0;
     while (!scattered) {
-      // Active media at t and the next boundary beyond t.
-      vec3 sigma_a = vec3(0.0), sigma_s = vec3(0.0), emitted = vec3(0.0);
-      float t_next = 1.0 / 0.0;
-      for (uint i = 0u; i < medium_count; ++i) {
-        vec2 s = span[i];
-        if (s.y <= t) continue;
-        if (s.x > t) { t_next = min(t_next, s.x); continue; }
-        t_next = min(t_next, s.y);
-        GpuMedium m = media[i];
-        sigma_a += m.sigma_a.rgb;
-        sigma_s += m.sigma_s.rgb;
-        emitted += m.emission.rgb;
-      }
-      if (isinf(t_next)) {  // left every medium
-        L += w * frame.background.rgb;
-        return L;
-      }
-      vec3 sigma_t = sigma_a + sigma_s;
-      float sigma_bar = max3(sigma_t);
+      float t_next;
+      bool any_ahead;
+      float sigma_bar = majorant_at(o, d, t, span, t_next, any_ahead);
+      if (!any_ahead || isinf(t_next)) return L + w * frame.background.rgb;
       if (sigma_bar <= 0.0) { t = t_next; continue; }
       float dt = sample_free_flight(sigma_bar, rng_next(rng));
       if (t + dt >= t_next) { t = t_next; continue; }
       t += dt;
+      vec3 x = o + t * d;
 
-      vec3 sigma_n = vec3(sigma_bar) - sigma_t;
-      float w_avg = avg3(w);
-      float c = sigma_bar * w_avg;
+      vec3 sigma_a, sigma_s;
+      float rho[MAX_MEDIA];
+      coefficients_at(x, t, span, sigma_a, sigma_s, rho, stats);
+      if (HAS_EMISSION && COLLISION_ESTIMATOR) {
+        // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.
+        L += w * emission_at(x, t, span, rho) / sigma_bar;
+      }
+      vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
+      float c = sigma_bar * avg3(w);
       float p_a = avg3(sigma_a * w) / c;
-      float p_s = avg3(sigma_s * w) / c;
+      float p_s = HAS_SCATTERING ? avg3(sigma_s * w) / c : 0.0;
       float u = rng_next(rng);
       if (u < p_a) {
-        // Absorbed: collect sigma_a·Le / (sigma_bar·P_a) (Kutz et al. 2017, eq. 20).
+        // Absorbed: the absorption estimator collects sigma_a·Le / (sigma_bar·P_a).
         stats.events += 1.0;
-        L += w * emitted / (sigma_bar * p_a);
+        if (HAS_EMISSION && !COLLISION_ESTIMATOR) L += w * emission_at(x, t, span, rho) / (sigma_bar * p_a);
         return L;
-      } else if (u < p_a + p_s) {
+      } else if (HAS_SCATTERING && u < p_a + p_s) {
         stats.events += 1.0;
         if (depth >= max_depth) return L;
         ++depth;
@@ -106,14 +292,13 @@ vec3 trace(vec3 o, vec3 d, inout uint rng, inout PathStats stats) {
         // with q_i ∝ avg(share_i ⊙ w), sample its HG lobe, weight share_i / q_i.
         vec3 inv_sigma_s = 1.0 / max(sigma_s, vec3(1e-30));
         float total = 0.0;
-        for (uint i = 0u; i < medium_count; ++i)
-          if (span[i].x <= t && t < span[i].y) total += avg3(media[i].sigma_s.rgb * inv_sigma_s * w);
+        for (uint i = 0u; i < frame.image.z; ++i)
+          total += avg3(rho[i] * media[i].sigma_s.rgb * inv_sigma_s * w);
         float pick = rng_next(rng) * total;
         float acc = 0.0, g = 0.0;
         vec3 mix_w = vec3(0.0);
-        for (uint i = 0u; i < medium_count; ++i) {
-          if (!(span[i].x <= t && t < span[i].y)) continue;
-          vec3 share = media[i].sigma_s.rgb * inv_sigma_s;
+        for (uint i = 0u; i < frame.image.z; ++i) {
+          vec3 share = rho[i] * media[i].sigma_s.rgb * inv_sigma_s;
           float p_i = avg3(share * w);
           if (p_i <= 0.0) continue;
           acc += p_i;
@@ -122,7 +307,7 @@ vec3 trace(vec3 o, vec3 d, inout uint rng, inout PathStats stats) {
           if (pick < acc) break;
         }
         w *= mix_w;
-        o = o + t * d;
+        o = x;
         d = sample_hg(d, g, vec2(rng_next(rng), rng_next(rng)));
         scattered = true;
       } else {
@@ -152,7 +337,10 @@ void main() {
     float tan_half = frame.camera_position.w, aspect = frame.camera_forward.w;
     vec3 d = normalize(frame.camera_forward.xyz + ndc.x * tan_half * aspect * frame.camera_right.xyz +
                        ndc.y * tan_half * frame.camera_up.xyz);
-    vec3 L = trace(frame.camera_position.xyz, d, rng, stats);
+    vec3 L;
+    if (DEBUG_MODE == DEBUG_RATIO_TRACKING) L = transmittance(frame.camera_position.xyz, d, true, rng, stats);
+    else if (DEBUG_MODE == DEBUG_DELTA_TRACKING) L = transmittance(frame.camera_position.xyz, d, false, rng, stats);
+    else L = trace(frame.camera_position.xyz, d, rng, stats);
     if (any(isnan(L)) || any(isinf(L))) {
       nonfinite += 1.0;
       L = vec3(0.0);

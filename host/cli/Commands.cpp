@@ -54,10 +54,6 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
       throw input_error(args.stats, "", "stats folder does not exist");
   }
 
-  for (size_t i = 0; i < scene.media.size(); ++i)
-    if (scene.media[i].type == Medium::Type::Vdb)
-      throw input_error(scene.file.string(), "media[" + std::to_string(i) + "].type",
-                        "\"vdb\" media are not supported by this build yet");
   // Accepted by the v1 format but not rendered yet: say so rather than ignore silently.
   if (!scene.shapes.empty())
     std::cerr << "pyrolume: warning: " << scene.file.string() << ": shapes: surfaces are not rendered yet; ignored\n";
@@ -107,6 +103,7 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
     j["cancelled"] = result.cancelled;
     write_text_atomic(args.stats, j.dump(2) + "\n");
   }
+  for (const auto& w : result.warnings) std::cerr << "pyrolume: warning: " << w << "\n";
   if (result.nonfinite_samples > 0)
     std::cerr << "pyrolume: warning: " << result.nonfinite_samples << " non-finite samples were recorded as 0\n";
   if (result.cancelled) std::cerr << "pyrolume: interrupted after " << result.spp << " spp; the image so far is saved\n";

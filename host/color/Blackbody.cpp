@@ -68,6 +68,52 @@ glm::dvec3 blackbody_rgb(double temperature_k, BlackbodyMode mode, int observer,
   return rgb;
 }
 
+glm::dvec3 blackbody_rgb_5nm(double temperature_k, BlackbodyMode mode, int observer,
+                             std::optional<double> adapt_to_k) {
+  const CmfTable& cmf = cmf_table(observer);
+  glm::dvec3 xyz(0.0);
+  if (temperature_k > 0.0 && std::isfinite(temperature_k)) {
+    double norm = 1e-9;  // as blackbody_xyz: per metre -> per nanometre, or Wien-peak normalised
+    if (mode != BlackbodyMode::Physical) {
+      const double B_max = planck_radiance(wien_peak_wavelength_m(temperature_k), temperature_k);
+      norm = B_max > 0.0 ? 1.0 / B_max : 0.0;
+    }
+    if (norm > 0.0) {
+      // The table starts at 360 nm, a multiple of 5: rows 0, 5, 10, ... are the 5 nm table.
+      for (int i = 0; i < cmf.size(); i += 5) {
+        const double B = planck_radiance((cmf.lambda_min_nm + i) * 1e-9, temperature_k) * norm;
+        const CmfSample& s = cmf.samples[i];
+        xyz += B * glm::dvec3(s.xbar, s.ybar, s.zbar);
+      }
+      xyz *= 5.0;  // d_lambda = 5 nm
+      if (!std::isfinite(xyz.x) || !std::isfinite(xyz.y) || !std::isfinite(xyz.z)) xyz = glm::dvec3(0.0);
+    }
+  }
+  if (adapt_to_k) {
+    // The white costs a 1 nm sum; callers use one white for millions of calls.
+    thread_local double cached_k = -1.0;
+    thread_local int cached_observer = 0;
+    thread_local glm::dvec3 cached_white(0.0);
+    if (cached_k != *adapt_to_k || cached_observer != observer) {
+      cached_white = blackbody_xyz(*adapt_to_k, BlackbodyMode::Peak, observer);
+      if (!(cached_white.y > 0.0))
+        throw std::invalid_argument("adapt_to_k: a blackbody at " + std::to_string(*adapt_to_k) +
+                                    " K has no visible light to adapt to");
+      cached_k = *adapt_to_k;
+      cached_observer = observer;
+    }
+    xyz = von_kries_bradford(xyz, cached_white, d65_white_xyz());
+  }
+  // Same clamp and seed normalisation as blackbody_rgb.
+  glm::dvec3 rgb = glm::max(xyz_to_linear_srgb(xyz), glm::dvec3(0.0));
+  if (!std::isfinite(rgb.r) || !std::isfinite(rgb.g) || !std::isfinite(rgb.b)) return glm::dvec3(0.0);
+  if (mode == BlackbodyMode::Seed) {
+    const double m = std::max({rgb.r, rgb.g, rgb.b});
+    rgb = m > 0.0 ? rgb / m : glm::dvec3(0.0);
+  }
+  return rgb;
+}
+
 const char* to_string(BlackbodyMode mode) {
   switch (mode) {
     case BlackbodyMode::Seed: return "seed";

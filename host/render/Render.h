@@ -17,6 +17,9 @@ struct RenderSettings {
   uint32_t seed = 1;
   uint32_t frame = 0;        // animation frame; feeds the RNG key
   double time_limit = 0.0;   // seconds, 0 = none; stops after the pass that crosses it
+  // Test hook (no scene key): 1 = camera rays return the ratio-tracking
+  // transmittance through the media, 2 = the delta-tracking one (per channel).
+  uint32_t debug_mode = 0;
 };
 
 // Called after each progressive pass: samples per pixel done so far, target.
@@ -40,6 +43,7 @@ struct RenderResult {
   double events = 0.0;           // real collisions (absorption + scattering)
   uint64_t nonfinite_samples = 0;
   bool cancelled = false;
+  std::vector<std::string> warnings;  // one line each (e.g. NaN voxels), printed by the CLI
 };
 
 }  // namespace pyrolume

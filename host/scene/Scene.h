@@ -92,6 +92,7 @@ struct Medium {
   TemperatureMapping temperature;
   Transform transform;
   int downsample = 1;
+  std::string texture_format = "r16f";  // "r16f" | "r32f" (R32F is also used when values exceed R16F)
 };
 
 struct Shape {

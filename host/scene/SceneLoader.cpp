@@ -196,6 +196,7 @@ Medium read_medium(Reader r, const std::filesystem::path& base, int index) {
     m.density_scale = r.number("density_scale", 1.0);
     if (m.density_scale < 0) r.fail("density_scale", "must be >= 0");
     m.downsample = r.integer("downsample", 1, 1, 64);
+    m.texture_format = r.choice("texture_format", "r16f", {"r16f", "r32f"});
     if (r.has("temperature")) {
       Reader t = r.child("temperature");
       m.temperature.scale = t.number("scale", 1.0);

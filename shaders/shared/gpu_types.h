@@ -21,23 +21,64 @@ using uint = uint32_t;
 PYRO_CONST uint WORKGROUP_SIZE_X = 8;
 PYRO_CONST uint WORKGROUP_SIZE_Y = 8;
 PYRO_CONST uint MAX_MEDIA = 16;
+PYRO_CONST uint MAX_GRIDS = 4;  // grid (vdb) media; each has its own texture slots
 
 // Descriptor bindings of render.comp (set 0).
 PYRO_CONST uint BINDING_FRAME = 0;     // uniform FrameConstants
 PYRO_CONST uint BINDING_MEDIA = 1;     // readonly buffer GpuMedium[]
 PYRO_CONST uint BINDING_ACCUM = 2;     // buffer AccumTexel[] (one per pixel)
+PYRO_CONST uint BINDING_GRIDS = 3;     // readonly buffer GpuGrid[]
+PYRO_CONST uint BINDING_MAJORANTS = 4; // readonly buffer float[]: every grid's majorant cells
+PYRO_CONST uint BINDING_DENSITY = 5;   // sampler3D[MAX_GRIDS]
+PYRO_CONST uint BINDING_TEMPERATURE = 6;  // sampler3D[MAX_GRIDS]
+PYRO_CONST uint BINDING_BLACKBODY = 7; // sampler1D[MAX_GRIDS]: blackbody LUT per grid medium
+
+// Specialisation constants of render.comp: a scene pays only for what it uses.
+PYRO_CONST uint SPEC_HAS_GRIDS = 0;
+PYRO_CONST uint SPEC_HAS_SCATTERING = 1;
+PYRO_CONST uint SPEC_HAS_EMISSION = 2;
+PYRO_CONST uint SPEC_COLLISION_ESTIMATOR = 3;
+PYRO_CONST uint SPEC_DEBUG_MODE = 4;
+PYRO_CONST uint DEBUG_NONE = 0;
+PYRO_CONST uint DEBUG_RATIO_TRACKING = 1;  // camera rays return ratio-tracking transmittance
+PYRO_CONST uint DEBUG_DELTA_TRACKING = 2;  // camera rays return delta-tracking transmittance
 
 PYRO_CONST uint SHAPE_SPHERE = 0;
 PYRO_CONST uint SHAPE_BOX = 1;
+PYRO_CONST uint SHAPE_GRID = 2;  // bounded by its density texture; data in GpuGrid[slot]
 
-// One homogeneous medium (96 bytes).
+PYRO_CONST uint EMIT_NONE = 0;
+PYRO_CONST uint EMIT_CONSTANT = 1;     // grid: Le = emission.rgb (× density via sigma_a)
+PYRO_CONST uint EMIT_TEMPERATURE = 2;  // grid: Le = scale × blackbody LUT(T(x))
+
+// One medium (96 bytes). Grid media multiply sigma_a and sigma_s by
+// density_scale · density(x).
 struct GpuMedium {
   vec4 sigma_a;   // rgb: absorption coefficient, 1/unit; w: shape (SHAPE_*)
   vec4 sigma_s;   // rgb: scattering coefficient, 1/unit; w: Henyey–Greenstein g
-  vec4 emission;  // rgb: sigma_a * Le, emitted radiance per unit length; w: unused
-  vec4 bounds0;   // sphere: xyz centre, w radius; box: xyz min
+  vec4 emission;  // homogeneous: rgb sigma_a·Le (per unit length); grid: rgb Le or blackbody scale; w: EMIT_*
+  vec4 bounds0;   // sphere: xyz centre, w radius; box: xyz min; grid: x = slot
   vec4 bounds1;   // box: xyz max
   vec4 reserved;
+};
+
+// A grid medium's textures and majorant grid (192 bytes). "Texel coordinates"
+// u: texel i's centre is at u = i + 0.5, the sampler reads u / dims; the rows map
+// world points to u (index − origin + 0.5: OpenVDB values sit at integer index
+// points). The map is affine, so a ray keeps its parameter t in texel space.
+struct GpuGrid {
+  vec4 density_row0;      // u = (dot(row0, p1), dot(row1, p1), dot(row2, p1)), p1 = (p, 1)
+  vec4 density_row1;
+  vec4 density_row2;
+  vec4 density_dims;      // xyz: texels; w: density_scale
+  vec4 temperature_row0;  // the temperature texture's own world -> texel map
+  vec4 temperature_row1;
+  vec4 temperature_row2;
+  vec4 temperature_dims;  // xyz: texels; w: unused
+  vec4 temperature_map;   // T = (value - x) · y kelvin; z: cutoff_k; w: unused
+  vec4 blackbody_lut;     // s = ln(T)·x + y; z: t_min_k (no emission below); w: unused
+  uvec4 majorant_res;     // xyz: cells; w: offset of cell (0,0,0) in the majorant buffer
+  vec4 majorant_cell;     // xyz: cell size in texels; w: max channel of (sigma_a + sigma_s)·density_scale
 };
 
 // Per-render constants (uniform buffer).
@@ -70,6 +111,7 @@ struct AccumTexel {
 
 #ifdef __cplusplus
 static_assert(sizeof(GpuMedium) == 96);
+static_assert(sizeof(GpuGrid) == 192);
 static_assert(sizeof(FrameConstants) == 112);
 static_assert(offsetof(FrameConstants, image) == 80);
 static_assert(sizeof(PassConstants) == 16);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -10,7 +11,7 @@
 #include <vector>
 
 #include "color/Blackbody.h"
-#include "render/cpu/Intersect.h"
+#include "render/cpu/Media.h"
 #include "render/cpu/Rng.h"
 #include "render/cpu/Sampling.h"
 
@@ -20,44 +21,20 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// A homogeneous medium reduced to what the walk needs.
-struct MediumData {
-  Bounds bounds;
-  glm::dvec3 sigma_a{0.0}, sigma_s{0.0};
-  glm::dvec3 sigma_a_Le{0.0};  // emitted radiance per unit length: σa · Le
-  double g = 0.0;
-};
-
-// A medium's bounds along the current ray, clipped to t >= 0.
-struct Span {
-  double t0, t1;
-  int medium;
-};
-
 struct Scratch {
   std::vector<Span> spans;
   std::vector<double> cuts;
+  std::vector<int> present;
+  std::vector<double> rho;  // density looked up at the current collision, per present medium
+  LeCache Le_cache;
 };
 
-MediumData prepare_medium(const Medium& m) {
-  if (m.type != Medium::Type::Homogeneous)
-    throw std::runtime_error("cpu reference: vdb media not supported yet");
-  MediumData d;
-  d.bounds = m.bounds;
-  d.sigma_a = m.sigma_a;
-  d.sigma_s = m.sigma_s;
-  d.g = m.g;
-  glm::dvec3 Le(0.0);
-  if (m.emission.emits()) {
-    if (m.emission.rgb)
-      Le = m.emission.scale * *m.emission.rgb;
-    else if (m.emission.temperature_k)
-      Le = m.emission.scale * color::blackbody_rgb(*m.emission.temperature_k, m.emission.blackbody,
-                                                   m.emission.observer, m.emission.adapt_to_k);
-  }
-  d.sigma_a_Le = m.sigma_a * Le;
-  return d;
-}
+struct ThreadCounters {
+  uint64_t collisions = 0;       // real collisions (absorption + scattering)
+  uint64_t density_lookups = 0;  // trilinear density-texture samples
+  uint64_t majorant_violations = 0;
+  uint64_t nonfinite = 0;
+};
 
 // One analog random walk of a *grey* medium: colour channel c alone.
 //
@@ -68,78 +45,94 @@ MediumData prepare_medium(const Medium& m) {
 // bias a per-channel mean. (The GPU path instead tracks a max-channel majorant
 // with spectral weights; keeping this one different is the point.)
 //
-// Estimator ("absorption" estimator, issue 2 part 5): media are piecewise
-// constant along the ray, so walk the segments between sorted bounds crossings;
-// in each, sample a free flight from p(t) = σt exp(−σt t) and restart at the next
-// crossing if it overshoots (the exponential is memoryless). At a collision the
-// path is absorbed with probability σa/σt and returns the absorbing mixture's
-// Le = Σ σa_i Le_i / σa, or scatters with probability σs/σt by the σs-weighted
-// mixture of the media's HG lobes. Escaping all media returns the background.
-// The (max_depth+1)-th scattering returns 0.
-double walk_channel(const std::vector<MediumData>& media, int c, double background, int max_depth,
-                    glm::dvec3 o, glm::dvec3 d, Pcg32& rng, uint64_t& collisions, Scratch& s) {
+// Free flights: delta tracking (Woodcock et al. 1965). Between consecutive
+// bounds crossings the set of media is fixed and its majorant σ̄ is the sum of
+// their global majorants (Media.h); tentative collisions are sampled from
+// σ̄ exp(−σ̄ t), restarting at each crossing (the exponential is memoryless).
+// At a tentative collision x one uniform u picks: absorption with probability
+// σa(x)/σ̄, scattering with σs(x)/σ̄, a null collision with 1 − σt(x)/σ̄. Where
+// only homogeneous media are present σt = σ̄ and this is the analog walk.
+//
+// Emission estimators (integrator.emission_estimator):
+//  - "absorption": an absorbed path returns the absorbing mixture's
+//    Le = Σ σa_i Le_i / σa at x; escaping returns the background.
+//  - "collision" (pbrt-v4 §14.2, VolPathIntegrator: beta · σa · Le / σ_maj at
+//    every majorant sample): at EVERY tentative collision add Σ σa_i Le_i(x)/σ̄,
+//    then absorb (end), scatter or continue; escaping adds the background. In an
+//    analog grey walk the throughput stays 1: the event probabilities equal the
+//    coefficient ratios, so the weights cancel.
+// Scattering picks medium i's HG lobe with probability σs_i/σs (mixture phase
+// function). The (max_depth+1)-th scattering ends the path: the absorption
+// estimator returns 0, the collision estimator keeps what it collected before.
+double walk_channel(const MediaData& md, int c, double background, int max_depth, bool collision_estimator,
+                    glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt, Scratch& s) {
   int scatters = 0;
+  double L = 0.0;  // the collision estimator's running sum
   for (;;) {
-    s.spans.clear();
-    s.cuts.clear();
-    for (int i = 0; i < int(media.size()); ++i) {
-      RayInterval r = intersect_bounds(o, d, media[i].bounds);
-      if (!r.hit) continue;
-      double t0 = std::max(r.t0, 0.0), t1 = r.t1;
-      if (!(t1 > t0)) continue;  // behind the origin, tangent, or zero length
-      s.spans.push_back({t0, t1, i});
-      s.cuts.push_back(t0);
-      s.cuts.push_back(t1);
-    }
-    std::sort(s.cuts.begin(), s.cuts.end());
-    s.cuts.erase(std::unique(s.cuts.begin(), s.cuts.end()), s.cuts.end());
-
+    ray_spans(md, o, d, s.spans, s.cuts);
     bool scattered = false;
     for (size_t k = 0; k + 1 < s.cuts.size() && !scattered; ++k) {
-      double a = s.cuts[k], b = s.cuts[k + 1];
-      // The cuts are the spans' own endpoints, so containment is exact.
-      double sigma_a = 0.0, sigma_s = 0.0;
-      for (const Span& sp : s.spans)
-        if (sp.t0 <= a && sp.t1 >= b) {
-          sigma_a += media[sp.medium].sigma_a[c];
-          sigma_s += media[sp.medium].sigma_s[c];
+      const double a = s.cuts[k], b = s.cuts[k + 1];
+      const double sigma_maj = media_present(md, s.spans, a, b, c, s.present);
+      if (!(sigma_maj > 0.0)) continue;
+      for (double t = a;;) {
+        t += sample_free_flight(sigma_maj, rng.uniform());
+        if (!(t < b)) break;  // memoryless: restart the flight at b
+        const glm::dvec3 x = o + t * d;
+        // Look up the local coefficients of the media present.
+        double sigma_a = 0.0, sigma_s = 0.0;
+        s.rho.resize(s.present.size());
+        for (size_t j = 0; j < s.present.size(); ++j) {
+          const MediumData& m = md.media[s.present[j]];
+          double rho = 1.0;
+          if (m.is_vdb()) {
+            rho = grid_density(m, x);
+            ++cnt.density_lookups;
+          }
+          s.rho[j] = rho;
+          sigma_a += m.sigma_a[c] * rho;
+          sigma_s += m.sigma_s[c] * rho;
         }
-      double sigma_t = sigma_a + sigma_s;
-      if (!(sigma_t > 0.0)) continue;
-      double t = a + sample_free_flight(sigma_t, rng.uniform());
-      if (!(t < b)) continue;  // memoryless: restart the flight at b
+        if (exceeds_majorant(sigma_a + sigma_s, sigma_maj)) ++cnt.majorant_violations;
+        auto emitted = [&] {  // Σ σa_i Le_i at x
+          double e = 0.0;
+          for (size_t j = 0; j < s.present.size(); ++j) {
+            const MediumData& m = md.media[s.present[j]];
+            e += m.is_vdb() ? grid_sigma_a_Le(m, s.present[j], c, x, s.rho[j], s.Le_cache) : m.sigma_a_Le[c];
+          }
+          return e;
+        };
+        if (collision_estimator && sigma_a > 0.0) L += emitted() / sigma_maj;
 
-      ++collisions;
-      if (rng.uniform() * sigma_t < sigma_a) {
-        double emitted = 0.0;  // Σ σa_i Le_i of the media present here
-        for (const Span& sp : s.spans)
-          if (sp.t0 <= a && sp.t1 >= b) emitted += media[sp.medium].sigma_a_Le[c];
-        return emitted / sigma_a;
-      }
-      if (scatters == max_depth) return 0.0;
-      ++scatters;
-      // Pick the lobe of medium i with probability σs_i/σs (mixture phase function).
-      double pick = rng.uniform() * sigma_s;
-      double g = 0.0;
-      for (const Span& sp : s.spans)
-        if (sp.t0 <= a && sp.t1 >= b && media[sp.medium].sigma_s[c] > 0.0) {
-          g = media[sp.medium].g;
-          pick -= media[sp.medium].sigma_s[c];
+        const double u = rng.uniform() * sigma_maj;
+        if (u < sigma_a) {
+          ++cnt.collisions;
+          return collision_estimator ? L : emitted() / sigma_a;
+        }
+        if (!(u < sigma_a + sigma_s)) continue;  // null collision
+        ++cnt.collisions;
+        if (scatters == max_depth) return collision_estimator ? L : 0.0;
+        ++scatters;
+        // Given a scattering, u − σa is uniform on [0, σs): reuse it to pick the lobe.
+        double pick = u - sigma_a, g = 0.0;
+        for (size_t j = 0; j < s.present.size(); ++j) {
+          const MediumData& m = md.media[s.present[j]];
+          const double ss = m.sigma_s[c] * s.rho[j];
+          if (!(ss > 0.0)) continue;
+          g = m.g;
+          pick -= ss;
           if (pick < 0.0) break;
         }
-      glm::dvec2 u(rng.uniform(), rng.uniform());
-      o = o + t * d;
-      d = sample_hg(d, g, u).direction;
-      scattered = true;
+        glm::dvec2 uv(rng.uniform(), rng.uniform());
+        o = x;
+        d = sample_hg(d, g, uv).direction;
+        scattered = true;
+        break;
+      }
     }
-    if (!scattered) return background;
+    if (!scattered) return L + background;
   }
 }
-
-struct ThreadCounters {
-  uint64_t collisions = 0;
-  uint64_t nonfinite = 0;
-};
 
 }  // namespace
 
@@ -175,8 +168,12 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
     if (!(glm::length(glm::cross(f, scene.camera.up)) > 0.0))
       throw std::invalid_argument("cpu reference: camera up is parallel to the view direction");
   }
-  std::vector<MediumData> media;
-  for (const Medium& m : scene.media) media.push_back(prepare_medium(m));
+  const std::string& estimator = scene.integrator.emission_estimator;
+  if (estimator != "absorption" && estimator != "collision")
+    throw std::invalid_argument("cpu reference: unknown emission_estimator \"" + estimator + "\"");
+  const bool collision_estimator = estimator == "collision";
+  const MediaData media = prepare_media(scene);  // loads the vdb media's grids
+  for (const std::string& w : media.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 
   const int W = settings.width, H = settings.height;
   const int max_depth = std::max(0, scene.integrator.max_depth);
@@ -195,7 +192,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   auto render_start = Clock::now();
   res.load_seconds = std::chrono::duration<double>(render_start - load_start).count();
 
-  uint64_t total_collisions = 0, total_nonfinite = 0;
+  uint64_t total_collisions = 0, total_nonfinite = 0, total_lookups = 0, total_violations = 0;
   int spp_done = 0;
   while (spp_done < settings.spp) {
     const int s_begin = spp_done, s_end = std::min(settings.spp, spp_done + kPassSpp);
@@ -216,8 +213,8 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
               glm::dvec3 dir = camera_ray_direction(scene.camera, W, H, fx, fy);
               glm::dvec3 L;
               for (int c = 0; c < 3; ++c)
-                L[c] = walk_channel(media, c, scene.background[c], max_depth, scene.camera.position, dir, rng,
-                                    cnt.collisions, scratch);
+                L[c] = walk_channel(media, c, scene.background[c], max_depth, collision_estimator,
+                                    scene.camera.position, dir, rng, cnt, scratch);
               if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z)) {
                 ++cnt.nonfinite;
                 L = glm::dvec3(0.0);  // recorded as 0, counted in nonfinite_samples
@@ -237,6 +234,8 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
     for (const auto& cnt : counters) {
       total_collisions += cnt.collisions;
       total_nonfinite += cnt.nonfinite;
+      total_lookups += cnt.density_lookups;
+      total_violations += cnt.majorant_violations;
     }
 
     spp_done = s_end;
@@ -252,10 +251,20 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
       break;
   }
   res.seconds = std::chrono::duration<double>(Clock::now() - render_start).count();
-  // events: real collisions of all three channel walks divided by 3, i.e. summed
-  // over camera samples of the channel-average collision count.
+  // Both counters are summed over camera samples of the average over the three
+  // channel walks (each walk's count, all three added, divided by 3):
+  //  - events: real collisions (absorptions + scatterings, including the one
+  //    that max_depth ends);
+  //  - density_lookups: trilinear density-texture samples, one per vdb medium
+  //    present at each tentative collision (real or null); homogeneous media
+  //    read no texture. (Shadow rays, when MIS lands, add their ratio-tracking
+  //    lookups the same way.) Temperature lookups are not counted.
   res.events = double(total_collisions) / 3.0;
-  res.density_lookups = 0.0;  // homogeneous media read no density texture
+  res.density_lookups = double(total_lookups) / 3.0;
+  majorant_violations_ = total_violations;
+  if (total_violations)
+    std::fprintf(stderr, "warning: cpu reference: %llu tentative collisions had sigma_t above the majorant\n",
+                 (unsigned long long)total_violations);
   res.nonfinite_samples = total_nonfinite;
   return res;
 }

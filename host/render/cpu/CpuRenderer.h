@@ -1,8 +1,10 @@
 #pragma once
 // The CPU reference renderer: plain, double precision, written independently of
 // the GLSL path so that it can catch the GPU path's mistakes (issue 2, part 3).
-// Homogeneous media (sphere / box bounds, overlapping media add), constant
-// background, the "absorption" emission estimator, Henyey–Greenstein scattering.
+// Homogeneous media (sphere / box bounds) and grid (vdb) media, overlapping media
+// add; delta tracking with one global majorant per medium (Media.h); constant
+// background; the "absorption" and "collision" emission estimators;
+// Henyey–Greenstein scattering.
 #include <string>
 
 #include <glm/glm.hpp>
@@ -22,16 +24,21 @@ class CpuRenderer : public Backend {
   std::string device_name() const override;  // "CPU reference (N threads)"
   int threads() const { return threads_; }
 
-  // Throws std::runtime_error for what the reference cannot render yet (vdb
-  // media) and std::invalid_argument for bad settings. Surfaces and environment maps are not
+  // Throws InputError for unreadable grids (as the loader) and
+  // std::invalid_argument for bad settings. Surfaces and environment maps are not
   // rendered yet: they are ignored (the CLI warns), as on the Vulkan backend.
   RenderResult render(const Scene& scene, const RenderSettings& settings, const RenderControl& control) override;
 
   // Samples per pixel per progressive pass (progress/cancel/time-limit granularity).
   static constexpr int kPassSpp = 4;
 
+  // Tentative collisions of the last render() where σt(x) exceeded the majorant
+  // (a negative null-collision probability). Must be 0; tests check it.
+  uint64_t majorant_violations() const { return majorant_violations_; }
+
  private:
   int threads_;
+  uint64_t majorant_violations_ = 0;
 };
 
 namespace cpu {

@@ -4,40 +4,97 @@
 
 #include "color/Blackbody.h"
 #include "util/Error.h"
+#include "volume/MajorantGrid.h"
 
 namespace pyrolume {
 namespace {
 gpu::vec4 v4(glm::dvec3 v, double w) { return gpu::vec4(float(v.x), float(v.y), float(v.z), float(w)); }
+double max3(glm::dvec3 v) { return std::max(v.x, std::max(v.y, v.z)); }
 
-glm::dvec3 emitted_radiance(const Emission& e) {
+glm::dvec3 homogeneous_le(const Emission& e) {
   if (e.rgb) return *e.rgb * e.scale;
   if (e.temperature_k) return color::blackbody_rgb(*e.temperature_k, e.blackbody, e.observer, e.adapt_to_k) * e.scale;
   return glm::dvec3(0.0);
 }
+
+// Rows of the affine world -> texel map: u = index − origin + 0.5 (texel i's
+// centre, OpenVDB's integer index point, sits at u = i + 0.5).
+void texel_rows(const DenseGrid& g, gpu::vec4& r0, gpu::vec4& r1, gpu::vec4& r2) {
+  glm::dmat4 shift(1.0);
+  shift[3] = glm::dvec4(-glm::dvec3(g.origin) + 0.5, 1.0);
+  glm::dmat4 m = shift * g.world_to_index;  // column-major: m[col][row]
+  gpu::vec4* rows[3] = {&r0, &r1, &r2};
+  for (int r = 0; r < 3; ++r) *rows[r] = gpu::vec4(float(m[0][r]), float(m[1][r]), float(m[2][r]), float(m[3][r]));
+}
 }  // namespace
 
-std::vector<gpu::GpuMedium> build_gpu_media(const Scene& scene) {
-  std::vector<gpu::GpuMedium> out;
+GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes, bool with_luts) {
+  GpuScene out;
   for (size_t i = 0; i < scene.media.size(); ++i) {
     const Medium& m = scene.media[i];
-    if (m.type != Medium::Type::Homogeneous)
-      throw input_error(scene.file.string(), "media[" + std::to_string(i) + "].type",
-                        "\"vdb\" media are not supported by this build yet");
     gpu::GpuMedium g{};
-    bool sphere = m.bounds.kind == Bounds::Kind::Sphere;
-    g.sigma_a = v4(m.sigma_a, sphere ? gpu::SHAPE_SPHERE : gpu::SHAPE_BOX);
     g.sigma_s = v4(m.sigma_s, m.g);
-    // A medium emits sigma_a·Le per unit length (DESIGN.md).
-    g.emission = v4(m.sigma_a * emitted_radiance(m.emission), 0.0);
-    if (sphere) {
-      g.bounds0 = v4(m.bounds.center, m.bounds.radius);
+    if (m.type == Medium::Type::Homogeneous) {
+      bool sphere = m.bounds.kind == Bounds::Kind::Sphere;
+      g.sigma_a = v4(m.sigma_a, sphere ? gpu::SHAPE_SPHERE : gpu::SHAPE_BOX);
+      // A medium emits sigma_a·Le per unit length (DESIGN.md).
+      g.emission = v4(m.sigma_a * homogeneous_le(m.emission), 0.0);
+      if (sphere) {
+        g.bounds0 = v4(m.bounds.center, m.bounds.radius);
+      } else {
+        g.bounds0 = v4(m.bounds.min, 0.0);
+        g.bounds1 = v4(m.bounds.max, 0.0);
+      }
+      out.has_emission = out.has_emission || max3(glm::dvec3(g.emission)) > 0.0;
     } else {
-      g.bounds0 = v4(m.bounds.min, 0.0);
-      g.bounds1 = v4(m.bounds.max, 0.0);
+      const StoredVolume& v = *volumes.at(i);
+      if (v.density.grid.empty()) continue;  // an empty grid renders as no medium
+      if (out.grids.size() >= gpu::MAX_GRIDS)
+        throw input_error(scene.file.string(), "media[" + std::to_string(i) + "]",
+                          "at most " + std::to_string(gpu::MAX_GRIDS) + " vdb media per scene");
+      const uint32_t slot = uint32_t(out.grids.size());
+      g.sigma_a = v4(m.sigma_a, gpu::SHAPE_GRID);
+      g.bounds0 = gpu::vec4(float(slot), 0.f, 0.f, 0.f);
+
+      gpu::GpuGrid grid{};
+      GpuGridSource src;
+      src.density = &v.density;
+      texel_rows(v.density.grid, grid.density_row0, grid.density_row1, grid.density_row2);
+      grid.density_dims = v4(glm::dvec3(v.density.grid.dims), m.density_scale);
+      if (m.emission.rgb) {
+        g.emission = v4(*m.emission.rgb * m.emission.scale, gpu::EMIT_CONSTANT);
+      } else if (needs_temperature_grid(m) && v.temperature && !v.temperature->grid.empty()) {
+        g.emission = v4(glm::dvec3(m.emission.scale), gpu::EMIT_TEMPERATURE);
+        src.temperature = &*v.temperature;
+        texel_rows(v.temperature->grid, grid.temperature_row0, grid.temperature_row1, grid.temperature_row2);
+        grid.temperature_dims = v4(glm::dvec3(v.temperature->grid.dims), 0.0);
+        grid.temperature_map = gpu::vec4(float(m.temperature.offset), float(m.temperature.scale),
+                                         float(m.temperature.cutoff_k), 0.f);
+        if (with_luts) src.blackbody.emplace(m.emission.blackbody, m.emission.observer, m.emission.adapt_to_k);
+        color::BlackbodyLutParams p = src.blackbody ? src.blackbody->params() : color::BlackbodyLutParams{};
+        grid.blackbody_lut = gpu::vec4(p.log_scale, p.log_bias, p.t_min_k, 0.f);
+      } else {
+        g.emission = gpu::vec4(0.f, 0.f, 0.f, float(gpu::EMIT_NONE));
+      }
+      out.has_emission = out.has_emission || (g.emission.w != float(gpu::EMIT_NONE) && m.emission.scale > 0.0);
+
+      // Majorant cells over the stored (rounded) density.
+      glm::ivec3 res = scene.integrator.majorant == "global"
+                           ? glm::ivec3(1)
+                           : scene.integrator.majorant_grid.value_or(default_majorant_resolution(v.density.grid.dims));
+      MajorantGrid mg = build_majorant_grid(v.density.grid, res);
+      grid.majorant_res = gpu::uvec4(uint32_t(mg.res.x), uint32_t(mg.res.y), uint32_t(mg.res.z),
+                                     uint32_t(out.majorants.size()));
+      grid.majorant_cell = v4(mg.cell_size, max3(m.sigma_a + m.sigma_s) * m.density_scale);
+      out.majorants.insert(out.majorants.end(), mg.max_density.begin(), mg.max_density.end());
+      out.grids.push_back(grid);
+      out.grid_sources.push_back(std::move(src));
+      out.has_grids = true;
     }
-    out.push_back(g);
+    out.has_scattering = out.has_scattering || max3(m.sigma_s) > 0.0;
+    out.media.push_back(g);
   }
-  if (out.size() > gpu::MAX_MEDIA)
+  if (out.media.size() > gpu::MAX_MEDIA)
     throw input_error(scene.file.string(), "media", "at most " + std::to_string(gpu::MAX_MEDIA) + " media are supported");
   return out;
 }

@@ -1,14 +1,35 @@
 #pragma once
-// Scene -> the structs in shaders/shared/gpu_types.h.
+// Scene (+ its loaded grids) -> the structs in shaders/shared/gpu_types.h.
+#include <optional>
 #include <vector>
 
+#include "color/BlackbodyLut.h"
 #include "render/Render.h"
 #include "scene/Scene.h"
 #include "shared/gpu_types.h"
+#include "volume/StoredVolume.h"
 
 namespace pyrolume {
 
-std::vector<gpu::GpuMedium> build_gpu_media(const Scene& scene);
+struct GpuGridSource {
+  const StoredGrid* density = nullptr;
+  const StoredGrid* temperature = nullptr;  // null unless the medium emits from its temperature
+  std::optional<color::BlackbodyLut> blackbody;
+};
+
+struct GpuScene {
+  std::vector<gpu::GpuMedium> media;
+  std::vector<gpu::GpuGrid> grids;
+  std::vector<GpuGridSource> grid_sources;  // per slot, same order as grids
+  std::vector<float> majorants;             // every grid's cells, at GpuGrid::majorant_res.w
+  bool has_grids = false, has_scattering = false, has_emission = false;
+};
+
+// volumes[i] holds medium i's grids when it is a vdb medium. Empty grids are
+// left out (they render as no medium). `with_luts` = false skips the blackbody
+// LUT bake (for updates that keep the existing textures).
+GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes,
+                         bool with_luts = true);
 gpu::FrameConstants build_frame_constants(const Scene& scene, const RenderSettings& settings, uint32_t medium_count);
 
 }  // namespace pyrolume

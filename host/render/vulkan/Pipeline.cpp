@@ -16,7 +16,7 @@ ComputePipeline::ComputePipeline(Context& ctx, const std::vector<uint32_t>& spir
   if (spirv.empty()) throw VulkanError("ComputePipeline " + name_ + ": empty SPIR-V");
 
   std::vector<VkDescriptorSetLayoutBinding> lb;
-  for (const Binding& b : bindings) lb.push_back({b.binding, b.type, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+  for (const Binding& b : bindings) lb.push_back({b.binding, b.type, b.count, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
   VkDescriptorSetLayoutCreateInfo sli{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
   sli.bindingCount = uint32_t(lb.size());
   sli.pBindings = lb.data();
@@ -82,7 +82,7 @@ void ComputePipeline::push(VkCommandBuffer cmd, const void* data, uint32_t bytes
 DescriptorSet::DescriptorSet(Context& ctx, const ComputePipeline& pipeline, const char* debug_name)
     : device_(ctx.device()), bindings_(pipeline.bindings()) {
   std::map<VkDescriptorType, uint32_t> counts;
-  for (const auto& b : bindings_) counts[b.type]++;
+  for (const auto& b : bindings_) counts[b.type] += b.count;
   std::vector<VkDescriptorPoolSize> sizes;
   for (auto [type, n] : counts) sizes.push_back({type, n});
   VkDescriptorPoolCreateInfo pci{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
@@ -121,11 +121,13 @@ void DescriptorSet::write_buffer(uint32_t binding, const Buffer& buffer, VkDevic
   vkUpdateDescriptorSets(device_, 1, &w, 0, nullptr);
 }
 
-void DescriptorSet::write_image(uint32_t binding, VkImageView view, VkSampler sampler, VkImageLayout layout) {
+void DescriptorSet::write_image(uint32_t binding, VkImageView view, VkSampler sampler, VkImageLayout layout,
+                                uint32_t array_element) {
   VkDescriptorImageInfo info{sampler, view, layout};
   VkWriteDescriptorSet w{.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
   w.dstSet = set_;
   w.dstBinding = binding;
+  w.dstArrayElement = array_element;
   w.descriptorCount = 1;
   w.descriptorType = type_of(binding);
   w.pImageInfo = &info;

@@ -19,6 +19,7 @@ class ComputePipeline {
   struct Binding {
     uint32_t binding;
     VkDescriptorType type;
+    uint32_t count = 1;  // > 1: an array of descriptors (e.g. sampler3D tex[4])
   };
   // specialization: (constant_id, 32-bit value as a bit pattern). Every
   // constant is 4 bytes: use std::bit_cast for floats, 0/1 for bools.
@@ -62,9 +63,9 @@ class DescriptorSet {
   void write_buffer(uint32_t binding, const Buffer& buffer, VkDeviceSize offset = 0,
                     VkDeviceSize range = VK_WHOLE_SIZE);
   void write_image(uint32_t binding, VkImageView view, VkSampler sampler,
-                   VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-  void write_image(uint32_t binding, const SampledImage& image) {
-    write_image(binding, image.view(), image.sampler());
+                   VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, uint32_t array_element = 0);
+  void write_image(uint32_t binding, const SampledImage& image, uint32_t array_element = 0) {
+    write_image(binding, image.view(), image.sampler(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, array_element);
   }
 
  private:

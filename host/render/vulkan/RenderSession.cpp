@@ -1,48 +1,149 @@
 #include "render/vulkan/RenderSession.h"
 
-#include "render/vulkan/GpuScene.h"
+#include <algorithm>
+
 #include "render/vulkan/Spirv.h"
+#include "util/Error.h"
 
 namespace pyrolume {
 namespace {
-constexpr size_t kMediaCapacity = gpu::MAX_MEDIA;
+constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 
-vk::ComputePipeline make_pipeline(vk::Context& ctx) {
-  return vk::ComputePipeline(ctx, vk::load_spirv("render.comp"),
-                             {{gpu::BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
-                              {gpu::BINDING_MEDIA, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                              {gpu::BINDING_ACCUM, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
-                             sizeof(gpu::PassConstants), {}, "render");
-}
+std::string mib(double bytes) { return std::to_string(int(bytes / (1024.0 * 1024.0) + 0.5)) + " MiB"; }
 }  // namespace
 
 RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderSettings& settings)
-    : ctx_(ctx),
-      settings_(settings),
-      frame_buffer_(ctx, sizeof(gpu::FrameConstants), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::MemoryKind::HostVisible,
-                    "frame constants"),
-      media_buffer_(ctx, kMediaCapacity * sizeof(gpu::GpuMedium), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                    vk::MemoryKind::HostVisible, "media"),
-      accum_(ctx, size_t(settings.width) * size_t(settings.height) * sizeof(gpu::AccumTexel),
-             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-             vk::MemoryKind::DeviceLocal, "accumulation"),
-      pipeline_(make_pipeline(ctx)),
-      set_(ctx, pipeline_, "render set") {
-  set_.write_buffer(gpu::BINDING_FRAME, frame_buffer_);
-  set_.write_buffer(gpu::BINDING_MEDIA, media_buffer_);
-  set_.write_buffer(gpu::BINDING_ACCUM, accum_);
-  upload_scene(scene);
+    : ctx_(ctx), settings_(settings) {
+  // Load only what the scene uses: the grids of its vdb media.
+  volumes_.resize(scene.media.size());
+  for (size_t i = 0; i < scene.media.size(); ++i) {
+    if (scene.media[i].type != Medium::Type::Vdb) continue;
+    volumes_[i] = load_stored_volume(scene.media[i]);
+    for (const auto& w : volumes_[i]->warnings) warnings_.push_back(w);
+  }
+  gpu_scene_ = build_gpu_scene(scene, volumes_);
+
+  frame_buffer_ = vk::Buffer(ctx, sizeof(gpu::FrameConstants), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+                             vk::MemoryKind::HostVisible, "frame constants");
+  media_buffer_ = vk::Buffer(ctx, gpu::MAX_MEDIA * sizeof(gpu::GpuMedium), kStorage, vk::MemoryKind::HostVisible, "media");
+  grid_buffer_ = vk::Buffer(ctx, gpu::MAX_GRIDS * sizeof(gpu::GpuGrid), kStorage, vk::MemoryKind::HostVisible, "grids");
+  majorant_buffer_ = vk::Buffer(ctx, std::max<size_t>(1, gpu_scene_.majorants.size()) * sizeof(float), kStorage,
+                                vk::MemoryKind::DeviceLocal, "majorant cells");
+  if (!gpu_scene_.majorants.empty())
+    majorant_buffer_.upload(ctx, gpu_scene_.majorants.data(), gpu_scene_.majorants.size() * sizeof(float));
+  accum_ = vk::Buffer(ctx, size_t(settings.width) * size_t(settings.height) * sizeof(gpu::AccumTexel),
+                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                          VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                      vk::MemoryKind::DeviceLocal, "accumulation");
+  create_textures(scene);
+
+  // The shader variant: code for grids, scattering and emission only when used.
+  auto flag = [](bool b) { return uint32_t(b ? 1 : 0); };
+  std::vector<std::pair<uint32_t, uint32_t>> spec = {
+      {gpu::SPEC_HAS_GRIDS, flag(gpu_scene_.has_grids)},
+      {gpu::SPEC_HAS_SCATTERING, flag(gpu_scene_.has_scattering && scene.integrator.max_depth > 0)},
+      {gpu::SPEC_HAS_EMISSION, flag(gpu_scene_.has_emission)},
+      {gpu::SPEC_COLLISION_ESTIMATOR, flag(scene.integrator.emission_estimator == "collision")},
+      {gpu::SPEC_DEBUG_MODE, settings.debug_mode}};
+  pipeline_.emplace(ctx, vk::load_spirv("render.comp"),
+                    std::vector<vk::ComputePipeline::Binding>{
+                        {gpu::BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+                        {gpu::BINDING_MEDIA, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_ACCUM, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_GRIDS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_MAJORANTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_DENSITY, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS},
+                        {gpu::BINDING_TEMPERATURE, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS},
+                        {gpu::BINDING_BLACKBODY, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS}},
+                    uint32_t(sizeof(gpu::PassConstants)), spec, "render");
+  set_.emplace(ctx, *pipeline_, "render set");
+  set_->write_buffer(gpu::BINDING_FRAME, frame_buffer_);
+  set_->write_buffer(gpu::BINDING_MEDIA, media_buffer_);
+  set_->write_buffer(gpu::BINDING_ACCUM, accum_);
+  set_->write_buffer(gpu::BINDING_GRIDS, grid_buffer_);
+  set_->write_buffer(gpu::BINDING_MAJORANTS, majorant_buffer_);
+  // textures_3d_[0] / textures_1d_[0] are 1-texel placeholders for unused slots.
+  for (uint32_t slot = 0; slot < gpu::MAX_GRIDS; ++slot) {
+    const bool used = slot < gpu_scene_.grid_sources.size();
+    const size_t d = used ? 1 + 2 * slot : 0, t = used ? 2 + 2 * slot : 0, b = used ? 1 + slot : 0;
+    set_->write_image(gpu::BINDING_DENSITY, textures_3d_[d], slot);
+    set_->write_image(gpu::BINDING_TEMPERATURE, textures_3d_[t], slot);
+    set_->write_image(gpu::BINDING_BLACKBODY, textures_1d_[b], slot);
+  }
+  upload_constants(scene);
 }
 
-void RenderSession::upload_scene(const Scene& scene) {
-  std::vector<gpu::GpuMedium> media = build_gpu_media(scene);
-  gpu::FrameConstants frame = build_frame_constants(scene, settings_, uint32_t(media.size()));
+// One 3D texture per grid, each over its own active bounding box with its own
+// transform (no resampling), plus one blackbody LUT per emitting grid medium.
+void RenderSession::create_textures(const Scene& scene) {
+  const VkPhysicalDeviceLimits& limits = ctx_.properties().limits;
+  const uint16_t zero_half = 0;
+  const float zero_rgba[4] = {0, 0, 0, 0};
+  auto make_3d = [&](const StoredGrid* g, const std::string& what) {
+    if (!g) {
+      vk::Image3D img(ctx_, 1, 1, 1, VK_FORMAT_R16_SFLOAT, "unused grid slot");
+      img.upload(ctx_, &zero_half, sizeof zero_half);
+      return img;
+    }
+    const glm::ivec3 d = g->grid.dims;
+    const uint32_t max_dim = limits.maxImageDimension3D;
+    const uint32_t largest = uint32_t(std::max({d.x, d.y, d.z}));
+    const bool half = g->format == TextureFormat::R16F;
+    if (largest > max_dim)
+      throw input_error(scene.file.string(), what,
+                        std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z) +
+                            " texels exceed this device's 3D texture limit of " + std::to_string(max_dim) +
+                            " per axis; add \"downsample\": " + std::to_string((largest + max_dim - 1) / max_dim) +
+                            " to the medium");
+    double bytes = double(dense_bytes(g->grid, half));
+    if (bytes > double(ctx_.max_allocation_size()))
+      throw input_error(scene.file.string(), what,
+                        "the dense texture needs " + mib(bytes) + ", more than the device allows in one allocation (" +
+                            mib(double(ctx_.max_allocation_size())) + "); add \"downsample\": 2 to the medium");
+    vk::Image3D img(ctx_, uint32_t(d.x), uint32_t(d.y), uint32_t(d.z), half ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT,
+                    what.c_str());
+    if (half) img.upload(ctx_, g->half_bits.data(), g->half_bits.size() * sizeof(uint16_t));
+    else img.upload(ctx_, g->grid.values.data(), g->grid.values.size() * sizeof(float));
+    return img;
+  };
+  auto make_lut = [&](const color::BlackbodyLut* lut) {
+    if (!lut) {
+      vk::Image1D img(ctx_, 1, VK_FORMAT_R32G32B32A32_SFLOAT, "unused blackbody LUT");
+      img.upload(ctx_, zero_rgba, sizeof zero_rgba);
+      return img;
+    }
+    if (lut->size() > limits.maxImageDimension1D)
+      throw vk::VulkanError("blackbody LUT of " + std::to_string(lut->size()) +
+                            " texels exceeds this device's maxImageDimension1D (" +
+                            std::to_string(limits.maxImageDimension1D) + ")");
+    vk::Image1D img(ctx_, lut->size(), VK_FORMAT_R32G32B32A32_SFLOAT, "blackbody LUT");
+    img.upload(ctx_, lut->rgba().data(), lut->rgba().size() * sizeof(float));
+    return img;
+  };
+  // Slot layout: 3D [0] placeholder, then density 1 + 2·slot, temperature 2 + 2·slot;
+  // 1D [0] placeholder, then the LUT of slot at 1 + slot.
+  textures_3d_.push_back(make_3d(nullptr, ""));
+  textures_1d_.push_back(make_lut(nullptr));
+  for (const GpuGridSource& s : gpu_scene_.grid_sources) {
+    textures_3d_.push_back(make_3d(s.density, "grid \"" + s.density->grid.name + "\""));
+    textures_3d_.push_back(make_3d(s.temperature, s.temperature ? "grid \"" + s.temperature->grid.name + "\"" : ""));
+    textures_1d_.push_back(make_lut(s.blackbody ? &*s.blackbody : nullptr));
+  }
+}
+
+void RenderSession::upload_constants(const Scene& scene) {
+  GpuScene now = build_gpu_scene(scene, volumes_, /*with_luts=*/false);
+  // Keep the LUT parameters of the baked textures (the mode is not editable live).
+  for (size_t i = 0; i < now.grids.size() && i < gpu_scene_.grids.size(); ++i)
+    now.grids[i].blackbody_lut = gpu_scene_.grids[i].blackbody_lut;
+  gpu::FrameConstants frame = build_frame_constants(scene, settings_, uint32_t(now.media.size()));
   frame_buffer_.upload(ctx_, &frame, sizeof frame);
-  if (!media.empty()) media_buffer_.upload(ctx_, media.data(), media.size() * sizeof(gpu::GpuMedium));
+  if (!now.media.empty()) media_buffer_.upload(ctx_, now.media.data(), now.media.size() * sizeof(gpu::GpuMedium));
+  if (!now.grids.empty()) grid_buffer_.upload(ctx_, now.grids.data(), now.grids.size() * sizeof(gpu::GpuGrid));
   reset();
 }
 
-void RenderSession::update(const Scene& scene) { upload_scene(scene); }
+void RenderSession::update(const Scene& scene) { upload_constants(scene); }
 
 void RenderSession::reset() {
   spp_done_ = 0;
@@ -57,8 +158,8 @@ void RenderSession::record_pass(VkCommandBuffer cmd, int spp) {
     needs_clear_ = false;
   }
   gpu::PassConstants pass{uint32_t(spp_done_), uint32_t(spp), 0u, 0u};
-  pipeline_.bind(cmd, set_.set());
-  pipeline_.push(cmd, pass);
+  pipeline_->bind(cmd, set_->set());
+  pipeline_->push(cmd, pass);
   const uint32_t groups_x = (uint32_t(settings_.width) + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X;
   const uint32_t groups_y = (uint32_t(settings_.height) + gpu::WORKGROUP_SIZE_Y - 1) / gpu::WORKGROUP_SIZE_Y;
   vkCmdDispatch(cmd, groups_x, groups_y, 1);

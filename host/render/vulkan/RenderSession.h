@@ -1,15 +1,19 @@
 #pragma once
-// One scene on one device, ready to accumulate samples: the uploaded constants
-// and media, the pipeline and the per-pixel accumulation buffer. `render` and the
-// preview window both drive it, pass by pass.
+// One scene on one device, ready to accumulate samples: the uploaded constants,
+// media, grid textures, majorant cells and blackbody LUTs, the pipeline
+// specialised to the scene, and the per-pixel accumulation buffer. `render` and
+// the preview window both drive it, pass by pass.
+#include <optional>
 #include <vector>
 
 #include "render/Render.h"
 #include "render/vulkan/Context.h"
+#include "render/vulkan/GpuScene.h"
 #include "render/vulkan/Memory.h"
 #include "render/vulkan/Pipeline.h"
 #include "scene/Scene.h"
 #include "shared/gpu_types.h"
+#include "volume/StoredVolume.h"
 
 namespace pyrolume {
 
@@ -17,8 +21,9 @@ class RenderSession {
  public:
   RenderSession(vk::Context& ctx, const Scene& scene, const RenderSettings& settings);
 
-  // Re-upload what the scene changes (camera, media parameters) and restart
-  // the accumulation. The image size stays as constructed.
+  // Re-upload what the scene changes (camera, media parameters, temperature
+  // mapping, density scale) and restart the accumulation. Image size, grids,
+  // textures and the shader variant stay as constructed.
   void update(const Scene& scene);
   // Zero the accumulation; the next pass starts at sample 0 again.
   void reset();
@@ -35,15 +40,23 @@ class RenderSession {
   const vk::Buffer& accumulation() const { return accum_; }
   // Read the sums and counters back into result (sum, sum_sq, spp, counters).
   void read(RenderResult& result);
+  // Warnings from loading the grids (one line each).
+  const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
-  void upload_scene(const Scene& scene);
+  void upload_constants(const Scene& scene);
+  void create_textures(const Scene& scene);
 
   vk::Context& ctx_;
   RenderSettings settings_;
-  vk::Buffer frame_buffer_, media_buffer_, accum_;
-  vk::ComputePipeline pipeline_;
-  vk::DescriptorSet set_;
+  std::vector<std::optional<StoredVolume>> volumes_;
+  std::vector<std::string> warnings_;
+  GpuScene gpu_scene_;
+  vk::Buffer frame_buffer_, media_buffer_, grid_buffer_, majorant_buffer_, accum_;
+  std::vector<vk::Image3D> textures_3d_;
+  std::vector<vk::Image1D> textures_1d_;
+  std::optional<vk::ComputePipeline> pipeline_;
+  std::optional<vk::DescriptorSet> set_;
   int spp_done_ = 0;
   bool needs_clear_ = true;
 };

@@ -44,6 +44,7 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
   RenderResult result;
   result.backend = name();
   result.device = device_name();
+  result.warnings = session.warnings();
   result.load_seconds = since(load_start) + context_seconds_;
   context_seconds_ = 0.0;
 

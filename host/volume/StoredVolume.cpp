@@ -1,0 +1,51 @@
+#include "volume/StoredVolume.h"
+
+#include <cmath>
+
+#include <glm/gtc/packing.hpp>
+
+#include "volume/VdbLoader.h"
+
+namespace pyrolume {
+
+bool needs_temperature_grid(const Medium& m) {
+  return m.type == Medium::Type::Vdb && m.emission.is_grid && m.emission.scale > 0.0;
+}
+
+void round_to_format(StoredGrid& g) {
+  g.half_bits.clear();
+  if (g.format != TextureFormat::R16F) return;
+  g.half_bits.resize(g.grid.values.size());
+  for (size_t i = 0; i < g.grid.values.size(); ++i) {
+    g.half_bits[i] = glm::packHalf1x16(g.grid.values[i]);
+    g.grid.values[i] = glm::unpackHalf1x16(g.half_bits[i]);
+  }
+  if (!g.grid.values.empty()) {
+    g.grid.min_value = glm::unpackHalf1x16(glm::packHalf1x16(g.grid.min_value));
+    g.grid.max_value = glm::unpackHalf1x16(glm::packHalf1x16(g.grid.max_value));
+  }
+}
+
+namespace {
+StoredGrid store(DenseGrid grid, TextureFormat wanted) {
+  StoredGrid g;
+  // R16F's largest finite value is 65504; keep a margin for rounding.
+  bool fits_half = std::max(std::abs(grid.min_value), std::abs(grid.max_value)) <= 6.0e4f;
+  g.format = (wanted == TextureFormat::R16F && fits_half) ? TextureFormat::R16F : TextureFormat::R32F;
+  g.grid = std::move(grid);
+  round_to_format(g);
+  return g;
+}
+}  // namespace
+
+StoredVolume load_stored_volume(const Medium& m) {
+  VolumeGrids grids = load_volume(m, needs_temperature_grid(m));
+  TextureFormat wanted = m.texture_format == "r32f" ? TextureFormat::R32F : TextureFormat::R16F;
+  StoredVolume v;
+  v.density = store(std::move(grids.density), wanted);
+  if (grids.temperature) v.temperature = store(std::move(*grids.temperature), wanted);
+  v.warnings = std::move(grids.warnings);
+  return v;
+}
+
+}  // namespace pyrolume

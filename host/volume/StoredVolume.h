@@ -1,0 +1,41 @@
+#pragma once
+// A vdb medium's grids as the renderers store them: the dense values rounded to
+// the texture format the GPU samples (R16F by default), so the CPU reference, the
+// majorant grid and the GPU all see exactly the same numbers. Computing majorants
+// from unrounded floats lets the texture exceed its bound (pbrt-v4 issue 33).
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scene/Scene.h"
+#include "volume/DenseGrid.h"
+
+namespace pyrolume {
+
+enum class TextureFormat { R16F, R32F };
+
+struct StoredGrid {
+  DenseGrid grid;                // values as stored (already rounded when R16F)
+  TextureFormat format = TextureFormat::R16F;
+  std::vector<uint16_t> half_bits;  // the R16F texels to upload (empty for R32F)
+};
+
+struct StoredVolume {
+  StoredGrid density;
+  std::optional<StoredGrid> temperature;  // only when the medium emits from its temperature
+  std::vector<std::string> warnings;
+};
+
+// Whether a medium's emission needs its temperature grid.
+bool needs_temperature_grid(const Medium& m);
+
+// Loads the medium's grids (VdbLoader) and rounds them to their texture format:
+// the medium's `texture_format` ("r16f" default, "r32f"), promoted to R32F when a
+// stored value exceeds what R16F holds (|v| > 6e4).
+StoredVolume load_stored_volume(const Medium& m);
+
+// Rounds every value to the nearest half and fills half_bits.
+void round_to_format(StoredGrid& g);
+
+}  // namespace pyrolume

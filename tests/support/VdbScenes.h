@@ -1,0 +1,318 @@
+#pragma once
+// Small VDB files for tests, written with the OpenVDB API, scenes around them,
+// and closed forms for the constant-box grid (header-only; shared by the CPU
+// reference tests and the GPU tests).
+//
+// Conventions (docs/volumes.md, host/volume/VdbLoader.cpp): a `Lattice` maps
+// voxel index ijk to world  offset + voxel · ijk  (OpenVDB's linear transform:
+// voxel ijk's value sits at that point, the voxel's CENTRE). The renderers copy
+// the active bounding box into a dense texture with one texel of zero padding
+// on every side and interpolate trilinearly between texel centres. So a grid
+// that is c on the active voxels lo..hi is exactly c only between the first and
+// the last active voxel centres (`centre_box`), falls linearly to 0 over one
+// voxel beyond them, and is 0 from the padding centres on (`support_box`, the
+// extent the renderers clip rays to). ConstantBoxField reproduces that field
+// exactly (independently of DenseGrid) and integrates it along rays exactly.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+
+#include "scene/Scene.h"
+#include "support/AnalyticScenes.h"
+
+namespace pyrolume::test {
+
+// ------------------------------------------------------------ lattices ----
+
+// Voxel ijk's centre is at world  offset + voxel · ijk.
+struct Lattice {
+  double voxel = 0.1;
+  glm::dvec3 offset{0.0};
+  glm::dvec3 world(const glm::dvec3& ijk) const { return offset + voxel * ijk; }
+  glm::dvec3 index(const glm::dvec3& p) const { return (p - offset) / voxel; }
+};
+
+// Active voxels lo..hi inclusive.
+struct VoxelBox {
+  glm::ivec3 lo{0}, hi{0};
+};
+
+// World box between the first and last active voxel centres: where the
+// trilinear lookup of a constant box equals the constant.
+inline Bounds centre_box(const Lattice& l, const VoxelBox& b) {
+  Bounds r;
+  r.kind = Bounds::Kind::Box;
+  r.min = l.world(glm::dvec3(b.lo));
+  r.max = l.world(glm::dvec3(b.hi));
+  return r;
+}
+
+// World box between the padding texel centres (lo − 1 .. hi + 1): the support
+// of the trilinear field, the extent rays are clipped to.
+inline Bounds support_box(const Lattice& l, const VoxelBox& b) {
+  Bounds r;
+  r.kind = Bounds::Kind::Box;
+  r.min = l.world(glm::dvec3(b.lo) - 1.0);
+  r.max = l.world(glm::dvec3(b.hi) + 1.0);
+  return r;
+}
+
+// ------------------------------------------------------------- writing ----
+
+inline void ensure_openvdb() {
+  static const bool once = [] {
+    openvdb::initialize();
+    return true;
+  }();
+  (void)once;
+}
+
+using VoxelFn = std::function<float(int i, int j, int k)>;
+
+// A float grid with every voxel of `box` active and set to value(i, j, k)
+// (zeros included, so the active bbox is exactly `box`). NaN/Inf are written
+// as they are (the loader must turn them into 0).
+inline openvdb::FloatGrid::Ptr make_float_grid(const std::string& name, const Lattice& l, const VoxelBox& box,
+                                               const VoxelFn& value) {
+  ensure_openvdb();
+  auto g = openvdb::FloatGrid::create(0.0f);
+  g->setName(name);
+  auto xf = openvdb::math::Transform::createLinearTransform(l.voxel);
+  xf->postTranslate(openvdb::Vec3d(l.offset.x, l.offset.y, l.offset.z));
+  g->setTransform(xf);
+  g->setGridClass(openvdb::GRID_FOG_VOLUME);
+  auto acc = g->getAccessor();
+  for (int k = box.lo.z; k <= box.hi.z; ++k)
+    for (int j = box.lo.y; j <= box.hi.y; ++j)
+      for (int i = box.lo.x; i <= box.hi.x; ++i) acc.setValueOn(openvdb::Coord(i, j, k), value(i, j, k));
+  return g;
+}
+
+// A grid with no active voxels at all.
+inline openvdb::FloatGrid::Ptr make_empty_grid(const std::string& name, const Lattice& l = {}) {
+  return make_float_grid(name, l, VoxelBox{{0, 0, 0}, {-1, -1, -1}}, [](int, int, int) { return 0.0f; });
+}
+
+inline std::filesystem::path write_vdb(const std::filesystem::path& file, const openvdb::GridPtrVec& grids) {
+  ensure_openvdb();
+  openvdb::io::File f(file.string());
+  f.write(grids);
+  f.close();
+  return file;
+}
+
+// A second grid for emission, on its own lattice (voxel size and offset may
+// differ from the density's).
+struct TemperatureBox {
+  Lattice lattice;
+  VoxelBox box;
+  float value = 1.0f;
+  std::string name = "temperature";
+};
+
+// "density" = c on the box (and optionally a constant temperature box).
+inline std::filesystem::path write_constant_box_vdb(const std::filesystem::path& file, const Lattice& l,
+                                                    const VoxelBox& box, float c,
+                                                    const std::optional<TemperatureBox>& temperature = {}) {
+  openvdb::GridPtrVec grids{make_float_grid("density", l, box, [c](int, int, int) { return c; })};
+  if (temperature)
+    grids.push_back(make_float_grid(temperature->name, temperature->lattice, temperature->box,
+                                    [v = temperature->value](int, int, int) { return v; }));
+  return write_vdb(file, grids);
+}
+
+// "density" = a + b · i (linear in x). Trilinear interpolation reproduces a
+// linear field exactly, so inside the centre box ρ(p) = a + b · index(p).x.
+inline std::filesystem::path write_ramp_x_vdb(const std::filesystem::path& file, const Lattice& l,
+                                              const VoxelBox& box, float a, float b) {
+  return write_vdb(file, {make_float_grid("density", l, box, [a, b](int i, int, int) { return a + b * float(i); })});
+}
+
+inline int floor_div(int a, int k) { return a >= 0 ? a / k : -((-a + k - 1) / k); }
+
+// "density": a 3D checkerboard of `cell`³-voxel cells, `lo` and `hi` alternating.
+inline std::filesystem::path write_checkerboard_vdb(const std::filesystem::path& file, const Lattice& l,
+                                                    const VoxelBox& box, float lo, float hi, int cell = 1) {
+  return write_vdb(file, {make_float_grid("density", l, box, [=](int i, int j, int k) {
+                     return ((floor_div(i, cell) + floor_div(j, cell) + floor_div(k, cell)) & 1) ? hi : lo;
+                   })});
+}
+
+// "density" with no active voxels.
+inline std::filesystem::path write_empty_vdb(const std::filesystem::path& file) {
+  return write_vdb(file, {make_empty_grid("density")});
+}
+
+// A sparse "explosion": a spherical shell of smoke (density peaks at mid-shell,
+// 0 inside and outside; only shell voxels are active, so the tree is sparse
+// while the dense box is mostly empty) with a hot inner rim ("temperature" in
+// kelvin, from t_outer_k at the outer surface to t_inner_k at the inner one),
+// centred on the lattice origin. Radii in voxels.
+inline std::filesystem::path write_explosion_shell_vdb(const std::filesystem::path& file, const Lattice& l,
+                                                       double r_inner = 9.0, double r_outer = 14.0,
+                                                       float peak_density = 1.0f, float t_inner_k = 3000.0f,
+                                                       float t_outer_k = 600.0f) {
+  ensure_openvdb();
+  auto make = [&](const std::string& name, bool temperature) {
+    auto g = openvdb::FloatGrid::create(0.0f);
+    g->setName(name);
+    auto xf = openvdb::math::Transform::createLinearTransform(l.voxel);
+    xf->postTranslate(openvdb::Vec3d(l.offset.x, l.offset.y, l.offset.z));
+    g->setTransform(xf);
+    auto acc = g->getAccessor();
+    const int R = int(std::ceil(r_outer));
+    for (int k = -R; k <= R; ++k)
+      for (int j = -R; j <= R; ++j)
+        for (int i = -R; i <= R; ++i) {
+          const double r = std::sqrt(double(i * i + j * j + k * k));
+          if (r < r_inner || r > r_outer) continue;
+          const double s = (r - r_inner) / (r_outer - r_inner);  // 0 inner .. 1 outer
+          const float v = temperature ? float(t_inner_k + (t_outer_k - t_inner_k) * s)
+                                      : float(peak_density * std::sin(3.14159265358979 * s));
+          acc.setValueOn(openvdb::Coord(i, j, k), v);
+        }
+    return g;
+  };
+  return write_vdb(file, {make("density", false), make("temperature", true)});
+}
+
+// -------------------------------------------------------------- scenes ----
+
+// Camera at (0, 0, −5) looking at the origin (AnalyticScenes' base), background 0.
+inline Scene vdb_base_scene(int width, int height, int spp) { return analytic_base_scene(width, height, spp); }
+
+// A `type: vdb` medium reading `file` ("density"; "temperature" when it emits
+// from a grid). Le_rgb set: constant emission scale · rgb × density; unset and
+// temperature_emission: blackbody of the grid temperature; else no emission.
+inline Medium vdb_medium(const std::string& name, const std::filesystem::path& file, glm::dvec3 sigma_a,
+                         glm::dvec3 sigma_s, double g = 0.0, std::optional<glm::dvec3> Le_rgb = std::nullopt,
+                         double emission_scale = 1.0, bool temperature_emission = false) {
+  Medium m;
+  m.name = name;
+  m.type = Medium::Type::Vdb;
+  m.file = file;
+  m.density_grid = "density";
+  m.sigma_a = sigma_a;
+  m.sigma_s = sigma_s;
+  m.g = g;
+  m.emission.scale = emission_scale;
+  m.emission.rgb = Le_rgb;
+  m.emission.is_grid = !Le_rgb && temperature_emission;
+  if (m.emission.is_grid) m.temperature_grid = "temperature";
+  if (!Le_rgb && !temperature_emission) m.emission.scale = 0.0;  // emits nothing
+  return m;
+}
+
+// -------------------------------------------------------- closed forms ----
+
+// The trilinear field of a constant box grid as the renderers sample it:
+//   ρ(p) = c · h(u.x; lo.x, hi.x) · h(u.y; ...) · h(u.z; ...),  u = lattice index of p,
+//   h(u; lo, hi) = clamp(min(u − (lo − 1), (hi + 1) − u), 0, 1),
+// (trilinear weights are separable, and the 1D interpolant of "c on lo..hi, 0
+// on the padding" is that trapezoid). `c` must be the value AS STORED (round to
+// half first for R16F textures; exact for 0.5, 0.75, 2 ...). No medium transform.
+struct ConstantBoxField {
+  Lattice lattice;
+  VoxelBox box;
+  double c = 1.0;
+
+  static double hat(double u, int lo, int hi) {
+    return std::clamp(std::min(u - (lo - 1.0), (hi + 1.0) - u), 0.0, 1.0);
+  }
+  double density(const glm::dvec3& p) const {
+    const glm::dvec3 u = lattice.index(p);
+    return c * hat(u.x, box.lo.x, box.hi.x) * hat(u.y, box.lo.y, box.hi.y) * hat(u.z, box.lo.z, box.hi.z);
+  }
+
+  // ∫_{t0}^{t1} ρ(o + t d) dt, exact: along a ray each hat is piecewise linear in
+  // t with kinks where u crosses lo − 1, lo, hi, hi + 1, so between kinks ρ is a
+  // polynomial of degree <= 3, which 3-point Gauss–Legendre integrates exactly.
+  double optical_depth(const glm::dvec3& o, const glm::dvec3& d, double t0, double t1) const {
+    if (!(t1 > t0)) return 0.0;
+    std::vector<double> ts{t0, t1};
+    const glm::dvec3 uo = lattice.index(o), ud = d / lattice.voxel;
+    for (int a = 0; a < 3; ++a) {
+      if (ud[a] == 0.0) continue;
+      for (double k : {box.lo[a] - 1.0, double(box.lo[a]), double(box.hi[a]), box.hi[a] + 1.0}) {
+        const double t = (k - uo[a]) / ud[a];
+        if (t > t0 && t < t1) ts.push_back(t);
+      }
+    }
+    std::sort(ts.begin(), ts.end());
+    static const double x[3] = {-std::sqrt(0.6), 0.0, std::sqrt(0.6)}, w[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
+    double sum = 0.0;
+    for (size_t i = 0; i + 1 < ts.size(); ++i) {
+      const double a = ts[i], b = ts[i + 1];
+      if (!(b > a)) continue;
+      if (!std::isfinite(b)) break;  // ρ = 0 beyond the last kink
+      const double m = 0.5 * (a + b), h = 0.5 * (b - a);
+      for (int q = 0; q < 3; ++q) sum += w[q] * h * density(o + (m + h * x[q]) * d);
+    }
+    return sum;
+  }
+
+  // τ over the whole ray t >= 0.
+  double optical_depth(const glm::dvec3& o, const glm::dvec3& d) const {
+    const Bounds s = support_box(lattice, box);
+    Chord ch = chord(s, o, d);
+    if (ch.length <= 0.0) return 0.0;
+    return optical_depth(o, d, 0.0, 1e300);  // kinks bound every piece; beyond them ρ = 0
+  }
+
+  // Signature for pixel_average's refinement: changes wherever τ is not smooth.
+  int signature(const glm::dvec3& o, const glm::dvec3& d) const {
+    return chord(support_box(lattice, box), o, d).signature * 1000 + chord(centre_box(lattice, box), o, d).signature;
+  }
+};
+
+// Radiance along a ray through one vdb medium whose density is `field`, with
+// constant emission Le = scale · rgb, when no path scatters (σs = 0 or
+// max_depth = 0): the absorbed fraction σa/σt of the extinction emits, since
+// σa(x)/σt(x) is the same at every x:
+//   L = (σa/σt) · Le · (1 − e^{−σt τ}) + background · e^{−σt τ},  σ = sigma · density_scale
+inline glm::dvec3 constant_box_radiance(const Scene& s, const ConstantBoxField& field, const glm::dvec3& o,
+                                        const glm::dvec3& d, int* sig = nullptr) {
+  const Medium& m = s.media.at(0);
+  const glm::dvec3 Le = m.emission.emits() && m.emission.rgb ? m.emission.scale * *m.emission.rgb : glm::dvec3(0.0);
+  const double tau = field.optical_depth(o, d);
+  if (sig) *sig = field.signature(o, d);
+  glm::dvec3 L;
+  for (int c = 0; c < 3; ++c) {
+    const double sa = m.sigma_a[c] * m.density_scale, st = (m.sigma_a[c] + m.sigma_s[c]) * m.density_scale;
+    const double T = std::exp(-st * tau);
+    L[c] = (st > 0.0 ? sa / st * Le[c] * (1.0 - T) : 0.0) + s.background[c] * T;
+  }
+  return L;
+}
+
+// Pixel means of any per-ray closed form (jittered box filter), for ztest_against_exact.
+inline std::function<glm::dvec3(int, int)> exact_image(
+    const Scene& s, const std::function<glm::dvec3(const glm::dvec3& o, const glm::dvec3& d, int* sig)>& L,
+    int base = 8, int max_level = 6, double steep_rel = 0.05) {
+  const int W = s.film.width, H = s.film.height;
+  auto img = std::make_shared<std::vector<glm::dvec3>>(size_t(W) * H);
+  auto Lf = [&](double fx, double fy, int* sig) {
+    return L(s.camera.position, film_ray(s.camera, W, H, fx, fy), sig);
+  };
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) (*img)[size_t(y) * W + x] = pixel_average(Lf, x, y, base, max_level, steep_rel);
+  return [img, W](int x, int y) { return (*img)[size_t(y) * W + x]; };
+}
+
+inline std::function<glm::dvec3(int, int)> constant_box_exact(const Scene& s, const ConstantBoxField& field) {
+  return exact_image(s, [&s, field](const glm::dvec3& o, const glm::dvec3& d, int* sig) {
+    return constant_box_radiance(s, field, o, d, sig);
+  });
+}
+
+}  // namespace pyrolume::test
