@@ -19,11 +19,16 @@ layout(constant_id = SPEC_HAS_SCATTERING) const bool HAS_SCATTERING = true;
 layout(constant_id = SPEC_HAS_EMISSION) const bool HAS_EMISSION = true;
 layout(constant_id = SPEC_COLLISION_ESTIMATOR) const bool COLLISION_ESTIMATOR = false;
 layout(constant_id = SPEC_DEBUG_MODE) const uint DEBUG_MODE = DEBUG_NONE;
+// A constant trip count lets the compiler unroll the per-medium loops and keep
+// span[] and rho[] in registers instead of per-lane scratch memory (lavapipe).
+layout(constant_id = SPEC_MEDIUM_COUNT) const uint MEDIUM_COUNT = 1;
 
 layout(std140, set = 0, binding = BINDING_FRAME) uniform FrameBlock { FrameConstants frame; };
-layout(std430, set = 0, binding = BINDING_MEDIA) readonly buffer MediaBlock { GpuMedium media[]; };
+// Media and grids are uniform blocks: every lane reads the same entries, which
+// uniform loads serve without per-lane gathers.
+layout(std140, set = 0, binding = BINDING_MEDIA) uniform MediaBlock { GpuMedium media[MAX_MEDIA]; };
 layout(std430, set = 0, binding = BINDING_ACCUM) buffer AccumBlock { AccumTexel accum[]; };
-layout(std430, set = 0, binding = BINDING_GRIDS) readonly buffer GridBlock { GpuGrid grids[]; };
+layout(std140, set = 0, binding = BINDING_GRIDS) uniform GridBlock { GpuGrid grids[MAX_GRIDS]; };
 layout(std430, set = 0, binding = BINDING_MAJORANTS) readonly buffer MajorantBlock { float majorants[]; };
 layout(set = 0, binding = BINDING_DENSITY) uniform sampler3D density_tex[MAX_GRIDS];
 layout(set = 0, binding = BINDING_TEMPERATURE) uniform sampler3D temperature_tex[MAX_GRIDS];
@@ -95,7 +100,7 @@ vec3 grid_le(GpuMedium m, uint slot, vec3 x) {
 // The media's extent along a ray: [t_enter, t_exit], (-1,-1) when missed.
 void media_spans(vec3 o, vec3 d, out vec2 span[MAX_MEDIA], out bool any_hit) {
   any_hit = false;
-  for (uint i = 0u; i < frame.image.z; ++i) {
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     GpuMedium m = media[i];
     uint shape = uint(m.sigma_a.w);
     vec2 t;
@@ -140,7 +145,7 @@ void coefficients_at(vec3 x, float t, vec2 span[MAX_MEDIA], out vec3 sigma_a, ou
                      inout PathStats stats) {
   sigma_a = vec3(0.0);
   sigma_s = vec3(0.0);
-  for (uint i = 0u; i < frame.image.z; ++i) {
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     rho[i] = 0.0;
     if (!(span[i].x <= t && t < span[i].y)) continue;
     GpuMedium m = media[i];
@@ -160,7 +165,7 @@ void coefficients_at(vec3 x, float t, vec2 span[MAX_MEDIA], out vec3 sigma_a, ou
 // Emitted power per unit length, Σ sigma_a_i(x)·Le_i(x), over the media at t.
 vec3 emission_at(vec3 x, float t, vec2 span[MAX_MEDIA], float rho[MAX_MEDIA]) {
   vec3 E = vec3(0.0);
-  for (uint i = 0u; i < frame.image.z; ++i) {
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     if (!(span[i].x <= t && t < span[i].y)) continue;
     GpuMedium m = media[i];
     if (HAS_GRIDS && uint(m.sigma_a.w) == SHAPE_GRID) {
@@ -177,7 +182,7 @@ float majorant_at(vec3 o, vec3 d, float t, vec2 span[MAX_MEDIA], out float t_nex
   float sigma_bar = 0.0;
   t_next = INF;
   any_ahead = false;
-  for (uint i = 0u; i < frame.image.z; ++i) {
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     vec2 s = span[i];
     if (s.y <= t) continue;
     any_ahead = true;
@@ -292,12 +297,12 @@ vec3 trace(vec3 o, vec3 d, inout uint rng, inout PathStats stats) {
         // with q_i ∝ avg(share_i ⊙ w), sample its HG lobe, weight share_i / q_i.
         vec3 inv_sigma_s = 1.0 / max(sigma_s, vec3(1e-30));
         float total = 0.0;
-        for (uint i = 0u; i < frame.image.z; ++i)
+        for (uint i = 0u; i < MEDIUM_COUNT; ++i)
           total += avg3(rho[i] * media[i].sigma_s.rgb * inv_sigma_s * w);
         float pick = rng_next(rng) * total;
         float acc = 0.0, g = 0.0;
         vec3 mix_w = vec3(0.0);
-        for (uint i = 0u; i < frame.image.z; ++i) {
+        for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
           vec3 share = rho[i] * media[i].sigma_s.rgb * inv_sigma_s;
           float p_i = avg3(share * w);
           if (p_i <= 0.0) continue;

@@ -472,7 +472,6 @@ void PreviewWindow::draw_frame() {
   }
   const double period = last_frame_end_ ? std::chrono::duration<double>(done - *last_frame_end_).count() : fence_seconds;
   last_frame_end_ = done;
-  if (std::getenv("PV_DEBUG")) std::fprintf(stderr, "frame %d: %d spp pass %.2f ms period %.2f ms\n", frames_shown_, pass_spp, pass_seconds*1e3, period*1e3);
   pace(pass_spp, pass_seconds, period);
 }
 

@@ -25,9 +25,9 @@ PYRO_CONST uint MAX_GRIDS = 4;  // grid (vdb) media; each has its own texture sl
 
 // Descriptor bindings of render.comp (set 0).
 PYRO_CONST uint BINDING_FRAME = 0;     // uniform FrameConstants
-PYRO_CONST uint BINDING_MEDIA = 1;     // readonly buffer GpuMedium[]
+PYRO_CONST uint BINDING_MEDIA = 1;     // uniform GpuMedium[MAX_MEDIA]
 PYRO_CONST uint BINDING_ACCUM = 2;     // buffer AccumTexel[] (one per pixel)
-PYRO_CONST uint BINDING_GRIDS = 3;     // readonly buffer GpuGrid[]
+PYRO_CONST uint BINDING_GRIDS = 3;     // uniform GpuGrid[MAX_GRIDS]
 PYRO_CONST uint BINDING_MAJORANTS = 4; // readonly buffer float[]: every grid's majorant cells
 PYRO_CONST uint BINDING_DENSITY = 5;   // sampler3D[MAX_GRIDS]
 PYRO_CONST uint BINDING_TEMPERATURE = 6;  // sampler3D[MAX_GRIDS]
@@ -39,6 +39,7 @@ PYRO_CONST uint SPEC_HAS_SCATTERING = 1;
 PYRO_CONST uint SPEC_HAS_EMISSION = 2;
 PYRO_CONST uint SPEC_COLLISION_ESTIMATOR = 3;
 PYRO_CONST uint SPEC_DEBUG_MODE = 4;
+PYRO_CONST uint SPEC_MEDIUM_COUNT = 5;  // loops over media get a constant trip count
 PYRO_CONST uint DEBUG_NONE = 0;
 PYRO_CONST uint DEBUG_RATIO_TRACKING = 1;  // camera rays return ratio-tracking transmittance
 PYRO_CONST uint DEBUG_DELTA_TRACKING = 2;  // camera rays return delta-tracking transmittance

@@ -7,6 +7,7 @@
 
 namespace pyrolume {
 namespace {
+constexpr VkBufferUsageFlags kUniform = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 
 std::string mib(double bytes) { return std::to_string(int(bytes / (1024.0 * 1024.0) + 0.5)) + " MiB"; }
@@ -25,8 +26,8 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
 
   frame_buffer_ = vk::Buffer(ctx, sizeof(gpu::FrameConstants), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                              vk::MemoryKind::HostVisible, "frame constants");
-  media_buffer_ = vk::Buffer(ctx, gpu::MAX_MEDIA * sizeof(gpu::GpuMedium), kStorage, vk::MemoryKind::HostVisible, "media");
-  grid_buffer_ = vk::Buffer(ctx, gpu::MAX_GRIDS * sizeof(gpu::GpuGrid), kStorage, vk::MemoryKind::HostVisible, "grids");
+  media_buffer_ = vk::Buffer(ctx, gpu::MAX_MEDIA * sizeof(gpu::GpuMedium), kUniform, vk::MemoryKind::HostVisible, "media");
+  grid_buffer_ = vk::Buffer(ctx, gpu::MAX_GRIDS * sizeof(gpu::GpuGrid), kUniform, vk::MemoryKind::HostVisible, "grids");
   majorant_buffer_ = vk::Buffer(ctx, std::max<size_t>(1, gpu_scene_.majorants.size()) * sizeof(float), kStorage,
                                 vk::MemoryKind::DeviceLocal, "majorant cells");
   if (!gpu_scene_.majorants.empty())
@@ -44,13 +45,14 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
       {gpu::SPEC_HAS_SCATTERING, flag(gpu_scene_.has_scattering && scene.integrator.max_depth > 0)},
       {gpu::SPEC_HAS_EMISSION, flag(gpu_scene_.has_emission)},
       {gpu::SPEC_COLLISION_ESTIMATOR, flag(scene.integrator.emission_estimator == "collision")},
-      {gpu::SPEC_DEBUG_MODE, settings.debug_mode}};
+      {gpu::SPEC_DEBUG_MODE, settings.debug_mode},
+      {gpu::SPEC_MEDIUM_COUNT, uint32_t(gpu_scene_.media.size())}};
   pipeline_.emplace(ctx, vk::load_spirv("render.comp"),
                     std::vector<vk::ComputePipeline::Binding>{
                         {gpu::BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
-                        {gpu::BINDING_MEDIA, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_MEDIA, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
                         {gpu::BINDING_ACCUM, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                        {gpu::BINDING_GRIDS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_GRIDS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
                         {gpu::BINDING_MAJORANTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_DENSITY, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS},
                         {gpu::BINDING_TEMPERATURE, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS},
