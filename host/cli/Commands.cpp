@@ -18,6 +18,7 @@
 #include "util/Error.h"
 #include "util/Progress.h"
 #include "util/ResourceUsage.h"
+#include "volume/VdbInfo.h"
 
 namespace pyrolume {
 namespace {
@@ -123,6 +124,8 @@ int run_devices(int device) {
   std::cout << vk::format_device_list(list, chosen);
   return 0;
 }
+
+int run_info(const std::string& file, bool values) { return run_info_command(file, values, std::cout); }
 
 int run_blackbody(const BlackbodyArgs& a) {
   BlackbodyMode mode = a.mode == "peak" ? BlackbodyMode::Peak : a.mode == "physical" ? BlackbodyMode::Physical : BlackbodyMode::Seed;

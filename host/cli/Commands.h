@@ -17,6 +17,7 @@ struct RenderArgs {
 int run_render(const RenderArgs& args, const std::atomic<bool>& cancel);
 
 int run_devices(int device);
+int run_info(const std::string& file, bool values);
 
 struct BlackbodyArgs {
   double from_k = 0, to_k = 0, step_k = 0;

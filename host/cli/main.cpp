@@ -52,6 +52,12 @@ int main(int argc, char** argv) {
   preview->add_option("--width", pv.width, "Window width (overrides film.width)")->check(CLI::Range(16, 16384));
   preview->add_option("--height", pv.height, "Window height (overrides film.height)")->check(CLI::Range(16, 16384));
 
+  std::string info_file;
+  bool info_values = false;
+  auto* info = app.add_subcommand("info", "Print a VDB/NanoVDB file's grids: types, transforms, bboxes, counts, ranges");
+  info->add_option("file", info_file, "A .vdb or .nvdb file")->required();
+  info->add_flag("--values", info_values, "Read every voxel for exact counts and ranges (slower)");
+
   int devices_device = -1;
   auto* devices = app.add_subcommand("devices", "List the Vulkan devices and which one is chosen");
   devices->add_option("--device", devices_device, "Device index to mark as chosen")->check(CLI::NonNegativeNumber);
@@ -96,6 +102,7 @@ int main(int argc, char** argv) {
       return status;
     }
     if (*preview) return run_preview_command(pv);
+    if (*info) return run_info(info_file, info_values);
     if (*devices) return run_devices(devices_device);
     if (*blackbody) return run_blackbody(bb);
     if (*compare) return run_compare(cmp);

