@@ -22,6 +22,10 @@ layout(constant_id = SPEC_DEBUG_MODE) const uint DEBUG_MODE = DEBUG_NONE;
 // A constant trip count lets the compiler unroll the per-medium loops and keep
 // span[] and rho[] in registers instead of per-lane scratch memory (lavapipe).
 layout(constant_id = SPEC_MEDIUM_COUNT) const uint MEDIUM_COUNT = 1;
+const uint MEDIA_N = MEDIUM_COUNT > 0u ? MEDIUM_COUNT : 1u;  // array size (never 0)
+// With a single grid medium the texture switches below fold to slot 0 (15 %
+// faster on lavapipe than a switch the compiler cannot resolve).
+layout(constant_id = SPEC_GRID_COUNT) const uint GRID_COUNT = 1;
 
 layout(std140, set = 0, binding = BINDING_FRAME) uniform FrameBlock { FrameConstants frame; };
 // Media and grids are uniform blocks: every lane reads the same entries, which
@@ -49,6 +53,7 @@ struct PathStats {
 // Texture arrays are indexed with constants only (no dependence on
 // dynamically-uniform indexing, which lavapipe and older GPUs handle poorly).
 float density_at(uint slot, vec3 tc) {
+  if (GRID_COUNT <= 1u) slot = 0u;
   switch (slot) {
     case 0u: return textureLod(density_tex[0], tc, 0.0).r;
     case 1u: return textureLod(density_tex[1], tc, 0.0).r;
@@ -57,6 +62,7 @@ float density_at(uint slot, vec3 tc) {
   }
 }
 float temperature_at(uint slot, vec3 tc) {
+  if (GRID_COUNT <= 1u) slot = 0u;
   switch (slot) {
     case 0u: return textureLod(temperature_tex[0], tc, 0.0).r;
     case 1u: return textureLod(temperature_tex[1], tc, 0.0).r;
@@ -65,6 +71,7 @@ float temperature_at(uint slot, vec3 tc) {
   }
 }
 vec3 blackbody_at(uint slot, float s) {
+  if (GRID_COUNT <= 1u) slot = 0u;
   switch (slot) {
     case 0u: return textureLod(blackbody_tex[0], s, 0.0).rgb;
     case 1u: return textureLod(blackbody_tex[1], s, 0.0).rgb;
@@ -73,13 +80,15 @@ vec3 blackbody_at(uint slot, float s) {
   }
 }
 
-vec3 density_texel(GpuGrid g, vec3 p) {
+// Grid fields are read straight from the uniform block (no GpuGrid copies:
+// copying the 192-byte struct per call is measurably slower on lavapipe).
+vec3 density_texel(uint slot, vec3 p) {
   vec4 p1 = vec4(p, 1.0);
-  return vec3(dot(g.density_row0, p1), dot(g.density_row1, p1), dot(g.density_row2, p1));
+  return vec3(dot(grids[slot].density_row0, p1), dot(grids[slot].density_row1, p1), dot(grids[slot].density_row2, p1));
 }
-vec3 density_texel_dir(GpuGrid g, vec3 d) {
+vec3 density_texel_dir(uint slot, vec3 d) {
   vec4 d0 = vec4(d, 0.0);
-  return vec3(dot(g.density_row0, d0), dot(g.density_row1, d0), dot(g.density_row2, d0));
+  return vec3(dot(grids[slot].density_row0, d0), dot(grids[slot].density_row1, d0), dot(grids[slot].density_row2, d0));
 }
 
 // Emitted radiance Le of grid medium m at world point x (DESIGN.md: T = (v − offset)·scale,
@@ -88,17 +97,18 @@ vec3 grid_le(GpuMedium m, uint slot, vec3 x) {
   uint mode = uint(m.emission.w);
   if (mode == EMIT_CONSTANT) return m.emission.rgb;
   if (mode != EMIT_TEMPERATURE) return vec3(0.0);
-  GpuGrid g = grids[slot];
   vec4 p1 = vec4(x, 1.0);
-  vec3 u = vec3(dot(g.temperature_row0, p1), dot(g.temperature_row1, p1), dot(g.temperature_row2, p1));
-  float value = temperature_at(slot, u / g.temperature_dims.xyz);
-  float T = (value - g.temperature_map.x) * g.temperature_map.y;
-  if (!(T > g.temperature_map.z) || !(T >= g.blackbody_lut.z)) return vec3(0.0);
-  return m.emission.rgb * blackbody_at(slot, log(T) * g.blackbody_lut.x + g.blackbody_lut.y);
+  vec3 u = vec3(dot(grids[slot].temperature_row0, p1), dot(grids[slot].temperature_row1, p1),
+                dot(grids[slot].temperature_row2, p1));
+  float value = temperature_at(slot, u / grids[slot].temperature_dims.xyz);
+  vec4 map = grids[slot].temperature_map, lut = grids[slot].blackbody_lut;
+  float T = (value - map.x) * map.y;
+  if (!(T > map.z) || !(T >= lut.z)) return vec3(0.0);
+  return m.emission.rgb * blackbody_at(slot, log(T) * lut.x + lut.y);
 }
 
 // The media's extent along a ray: [t_enter, t_exit], (-1,-1) when missed.
-void media_spans(vec3 o, vec3 d, out vec2 span[MAX_MEDIA], out bool any_hit) {
+void media_spans(vec3 o, vec3 d, out vec2 span[MEDIA_N], out bool any_hit) {
   any_hit = false;
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     GpuMedium m = media[i];
@@ -111,8 +121,8 @@ void media_spans(vec3 o, vec3 d, out vec2 span[MAX_MEDIA], out bool any_hit) {
       hit = intersect_box(o, d, m.bounds0.xyz, m.bounds1.xyz, t);
     } else {
       // The texel box [0, dims] in texel space; t is the same there (affine map).
-      GpuGrid g = grids[uint(m.bounds0.x)];
-      hit = intersect_box(density_texel(g, o), density_texel_dir(g, d), vec3(0.0), g.density_dims.xyz, t);
+      uint slot = uint(m.bounds0.x);
+      hit = intersect_box(density_texel(slot, o), density_texel_dir(slot, d), vec3(0.0), grids[slot].density_dims.xyz, t);
     }
     span[i] = hit ? t : vec2(-1.0);
     any_hit = any_hit || hit;
@@ -123,25 +133,27 @@ void media_spans(vec3 o, vec3 d, out vec2 span[MAX_MEDIA], out bool any_hit) {
 // which the ray leaves that cell. Stateless: the cell is found at t + a small
 // nudge along the ray, so a point on a face belongs to the cell being entered.
 float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, inout float t_next) {
-  GpuGrid g = grids[uint(m.bounds0.x)];
-  vec3 u = density_texel(g, o + t * d);
-  vec3 du = density_texel_dir(g, d);
-  vec3 cs = g.majorant_cell.xyz;
+  uint slot = uint(m.bounds0.x);
+  vec3 u = density_texel(slot, o + t * d);
+  vec3 du = density_texel_dir(slot, d);
+  vec4 cell_info = grids[slot].majorant_cell;
+  uvec4 res4 = grids[slot].majorant_res;
+  vec3 cs = cell_info.xyz;
   vec3 inv_du = 1.0 / du;
   float nudge = 1e-4 * min3(cs) / max(max3(abs(du)), 1e-30);
-  ivec3 res = ivec3(g.majorant_res.xyz);
+  ivec3 res = ivec3(res4.xyz);
   ivec3 cell = clamp(ivec3(floor((u + du * nudge) / cs)), ivec3(0), res - 1);
   vec3 bound = (vec3(cell) + step(vec3(0.0), du)) * cs;
   vec3 tx = (bound - u) * inv_du;  // ±inf on axes the ray runs parallel to
   float t_exit = t + max(min3(mix(tx, vec3(INF), isnan(tx))), nudge);
   t_next = min(t_next, t_exit);
-  uint index = g.majorant_res.w + uint((cell.z * res.y + cell.y) * res.x + cell.x);
-  return majorants[index] * g.majorant_cell.w;
+  uint index = res4.w + uint((cell.z * res.y + cell.y) * res.x + cell.x);
+  return majorants[index] * cell_info.w;
 }
 
 // Media coefficients at a tentative collision; rho[i] keeps each grid's
 // density_scale · density for the scattering-lobe choice.
-void coefficients_at(vec3 x, float t, vec2 span[MAX_MEDIA], out vec3 sigma_a, out vec3 sigma_s, out float rho[MAX_MEDIA],
+void coefficients_at(vec3 x, float t, vec2 span[MEDIA_N], out vec3 sigma_a, out vec3 sigma_s, out float rho[MEDIA_N],
                      inout PathStats stats) {
   sigma_a = vec3(0.0);
   sigma_s = vec3(0.0);
@@ -152,8 +164,8 @@ void coefficients_at(vec3 x, float t, vec2 span[MAX_MEDIA], out vec3 sigma_a, ou
     float r = 1.0;
     if (HAS_GRIDS && uint(m.sigma_a.w) == SHAPE_GRID) {
       uint slot = uint(m.bounds0.x);
-      GpuGrid g = grids[slot];
-      r = g.density_dims.w * density_at(slot, density_texel(g, x) / g.density_dims.xyz);
+      vec4 dims = grids[slot].density_dims;
+      r = dims.w * density_at(slot, density_texel(slot, x) / dims.xyz);
       stats.lookups += 1.0;
     }
     rho[i] = r;
@@ -163,7 +175,7 @@ void coefficients_at(vec3 x, float t, vec2 span[MAX_MEDIA], out vec3 sigma_a, ou
 }
 
 // Emitted power per unit length, Σ sigma_a_i(x)·Le_i(x), over the media at t.
-vec3 emission_at(vec3 x, float t, vec2 span[MAX_MEDIA], float rho[MAX_MEDIA]) {
+vec3 emission_at(vec3 x, float t, vec2 span[MEDIA_N], float rho[MEDIA_N]) {
   vec3 E = vec3(0.0);
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     if (!(span[i].x <= t && t < span[i].y)) continue;
@@ -178,7 +190,7 @@ vec3 emission_at(vec3 x, float t, vec2 span[MAX_MEDIA], float rho[MAX_MEDIA]) {
 }
 
 // Local majorant over [t, t_next): sum over the media present of their bound.
-float majorant_at(vec3 o, vec3 d, float t, vec2 span[MAX_MEDIA], out float t_next, out bool any_ahead) {
+float majorant_at(vec3 o, vec3 d, float t, vec2 span[MEDIA_N], out float t_next, out bool any_ahead) {
   float sigma_bar = 0.0;
   t_next = INF;
   any_ahead = false;
@@ -203,7 +215,7 @@ float majorant_at(vec3 o, vec3 d, float t, vec2 span[MAX_MEDIA], out float t_nex
 // collision, with Russian roulette once the estimate is small. Delta tracking
 // (spectral: Kutz et al. 2017) terminates at real collisions instead.
 vec3 transmittance(vec3 o, vec3 d, bool ratio, inout uint rng, inout PathStats stats) {
-  vec2 span[MAX_MEDIA];
+  vec2 span[MEDIA_N];
   bool any_hit;
   media_spans(o, d, span, any_hit);
   vec3 T = vec3(1.0);
@@ -218,7 +230,7 @@ vec3 transmittance(vec3 o, vec3 d, bool ratio, inout uint rng, inout PathStats s
     if (t + dt >= t_next) { t = t_next; continue; }
     t += dt;
     vec3 sigma_a, sigma_s;
-    float rho[MAX_MEDIA];
+    float rho[MEDIA_N];
     coefficients_at(o + t * d, t, span, sigma_a, sigma_s, rho, stats);
     vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
     if (ratio) {
@@ -253,7 +265,7 @@ vec3 trace(vec3 o, vec3 d, inout uint rng, inout PathStats stats) {
   vec3 L = vec3(0.0);
   uint depth = 0u;
   for (;;) {
-    vec2 span[MAX_MEDIA];
+    vec2 span[MEDIA_N];
     bool any_hit;
     media_spans(o, d, span, any_hit);
     if (!any_hit) return L + w * frame.background.rgb;
@@ -272,7 +284,7 @@ vec3 trace(vec3 o, vec3 d, inout uint rng, inout PathStats stats) {
       vec3 x = o + t * d;
 
       vec3 sigma_a, sigma_s;
-      float rho[MAX_MEDIA];
+      float rho[MEDIA_N];
       coefficients_at(x, t, span, sigma_a, sigma_s, rho, stats);
       if (HAS_EMISSION && COLLISION_ESTIMATOR) {
         // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.

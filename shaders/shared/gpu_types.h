@@ -40,6 +40,7 @@ PYRO_CONST uint SPEC_HAS_EMISSION = 2;
 PYRO_CONST uint SPEC_COLLISION_ESTIMATOR = 3;
 PYRO_CONST uint SPEC_DEBUG_MODE = 4;
 PYRO_CONST uint SPEC_MEDIUM_COUNT = 5;  // loops over media get a constant trip count
+PYRO_CONST uint SPEC_GRID_COUNT = 6;
 PYRO_CONST uint DEBUG_NONE = 0;
 PYRO_CONST uint DEBUG_RATIO_TRACKING = 1;  // camera rays return ratio-tracking transmittance
 PYRO_CONST uint DEBUG_DELTA_TRACKING = 2;  // camera rays return delta-tracking transmittance

@@ -309,7 +309,7 @@ TEST_F(CpuVdb, LongRays) {
 // σs = 0 every tentative collision in the hot constant region is real.)
 TEST_F(CpuVdb, TemperatureGridOnAnotherLatticeEmitsWhereItIsHot) {
   const test::TemperatureBox tb{{0.13, {0.065, -0.03, 0.02}}, {{-3, -2, -3}, {2, 3, 3}}, 1.0f};
-  Scene s = test::vdb_base_scene(24, 24, 1024);
+  Scene s = test::vdb_base_scene(24, 24, 2048);
   s.camera.position = {1.5, 1.0, -4.0};
   s.camera.look_at = {0.0, 0.0, 0.0};
   s.camera.fov_deg = 22.0;

@@ -46,7 +46,8 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
       {gpu::SPEC_HAS_EMISSION, flag(gpu_scene_.has_emission)},
       {gpu::SPEC_COLLISION_ESTIMATOR, flag(scene.integrator.emission_estimator == "collision")},
       {gpu::SPEC_DEBUG_MODE, settings.debug_mode},
-      {gpu::SPEC_MEDIUM_COUNT, uint32_t(gpu_scene_.media.size())}};
+      {gpu::SPEC_MEDIUM_COUNT, uint32_t(gpu_scene_.media.size())},
+      {gpu::SPEC_GRID_COUNT, uint32_t(gpu_scene_.grids.size())}};
   pipeline_.emplace(ctx, vk::load_spirv("render.comp"),
                     std::vector<vk::ComputePipeline::Binding>{
                         {gpu::BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
