@@ -249,7 +249,19 @@ vec3 transmittance(vec3 o, vec3 d, bool ratio, inout uint rng, inout PathStats s
   return T;
 }
 
-// Radiance along one camera ray.
+// One path's state between tracking steps (see main: paths are regenerated
+// within a lane, so the state must live outside any per-path loop).
+struct PathState {
+  vec3 o, d;   // current ray
+  vec3 w;      // path weight (per channel)
+  vec3 L;      // radiance gathered so far
+  float t;     // distance along the current ray
+  uint depth;  // scattering events so far
+  bool fresh;  // the ray changed: recompute the media spans
+};
+
+// One step of delta tracking along one path; returns true when the path has
+// ended (p.L is then final).
 //
 // Delta tracking against a piecewise-constant majorant: the ray is split at
 // media boundaries and majorant-cell faces, and free flights restart at each
@@ -259,81 +271,97 @@ vec3 transmittance(vec3 o, vec3 d, bool ratio, inout uint rng, inout PathStats s
 // scatter / null) is chosen with P_x = avg(sigma_x ⊙ w) / (sigma_bar·avg(w)); the
 // path weight w then picks up sigma_x / (sigma_bar·P_x) per channel. For grey
 // media every factor is 1 and this is plain delta tracking.
-vec3 trace(vec3 o, vec3 d, inout uint rng, inout PathStats stats) {
-  const uint max_depth = frame.image.w;
-  vec3 w = vec3(1.0);
-  vec3 L = vec3(0.0);
-  uint depth = 0u;
-  for (;;) {
-    vec2 span[MEDIA_N];
+bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inout PathStats stats) {
+  if (p.fresh) {
     bool any_hit;
-    media_spans(o, d, span, any_hit);
-    if (!any_hit) return L + w * frame.background.rgb;
-
-    bool scattered = false;
-    float t = 0.0;
-    while (!scattered) {
-      float t_next;
-      bool any_ahead;
-      float sigma_bar = majorant_at(o, d, t, span, t_next, any_ahead);
-      if (!any_ahead || isinf(t_next)) return L + w * frame.background.rgb;
-      if (sigma_bar <= 0.0) { t = t_next; continue; }
-      float dt = sample_free_flight(sigma_bar, rng_next(rng));
-      if (t + dt >= t_next) { t = t_next; continue; }
-      t += dt;
-      vec3 x = o + t * d;
-
-      vec3 sigma_a, sigma_s;
-      float rho[MEDIA_N];
-      coefficients_at(x, t, span, sigma_a, sigma_s, rho, stats);
-      if (HAS_EMISSION && COLLISION_ESTIMATOR) {
-        // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.
-        L += w * emission_at(x, t, span, rho) / sigma_bar;
-      }
-      vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
-      float c = sigma_bar * avg3(w);
-      float p_a = avg3(sigma_a * w) / c;
-      float p_s = HAS_SCATTERING ? avg3(sigma_s * w) / c : 0.0;
-      float u = rng_next(rng);
-      if (u < p_a) {
-        // Absorbed: the absorption estimator collects sigma_a·Le / (sigma_bar·P_a).
-        stats.events += 1.0;
-        if (HAS_EMISSION && !COLLISION_ESTIMATOR) L += w * emission_at(x, t, span, rho) / (sigma_bar * p_a);
-        return L;
-      } else if (HAS_SCATTERING && u < p_a + p_s) {
-        stats.events += 1.0;
-        if (depth >= max_depth) return L;
-        ++depth;
-        w *= sigma_s / (sigma_bar * p_s);
-        // Phase function of the mixture sum_i (sigma_s_i / sigma_s) p_i: pick medium i
-        // with q_i ∝ avg(share_i ⊙ w), sample its HG lobe, weight share_i / q_i.
-        vec3 inv_sigma_s = 1.0 / max(sigma_s, vec3(1e-30));
-        float total = 0.0;
-        for (uint i = 0u; i < MEDIUM_COUNT; ++i)
-          total += avg3(rho[i] * media[i].sigma_s.rgb * inv_sigma_s * w);
-        float pick = rng_next(rng) * total;
-        float acc = 0.0, g = 0.0;
-        vec3 mix_w = vec3(0.0);
-        for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-          vec3 share = rho[i] * media[i].sigma_s.rgb * inv_sigma_s;
-          float p_i = avg3(share * w);
-          if (p_i <= 0.0) continue;
-          acc += p_i;
-          g = media[i].sigma_s.w;
-          mix_w = share * (total / p_i);
-          if (pick < acc) break;
-        }
-        w *= mix_w;
-        o = x;
-        d = sample_hg(d, g, vec2(rng_next(rng), rng_next(rng)));
-        scattered = true;
-      } else {
-        w *= sigma_n / (sigma_bar * (1.0 - p_a - p_s));
-      }
-      if (max3(w) <= 0.0) return L;
+    media_spans(p.o, p.d, span, any_hit);
+    p.fresh = false;
+    p.t = 0.0;
+    if (!any_hit) {
+      p.L += p.w * frame.background.rgb;
+      return true;
     }
   }
-  return L;
+  float t_next;
+  bool any_ahead;
+  float sigma_bar = majorant_at(p.o, p.d, p.t, span, t_next, any_ahead);
+  if (!any_ahead || isinf(t_next)) {
+    p.L += p.w * frame.background.rgb;
+    return true;
+  }
+  if (sigma_bar <= 0.0) {
+    p.t = t_next;
+    return false;
+  }
+  float dt = sample_free_flight(sigma_bar, rng_next(rng));
+  if (p.t + dt >= t_next) {
+    p.t = t_next;
+    return false;
+  }
+  p.t += dt;
+  vec3 x = p.o + p.t * p.d;
+
+  vec3 sigma_a, sigma_s;
+  float rho[MEDIA_N];
+  coefficients_at(x, p.t, span, sigma_a, sigma_s, rho, stats);
+  if (HAS_EMISSION && COLLISION_ESTIMATOR) {
+    // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.
+    p.L += p.w * emission_at(x, p.t, span, rho) / sigma_bar;
+  }
+  vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
+  float c = sigma_bar * avg3(p.w);
+  float p_a = avg3(sigma_a * p.w) / c;
+  float p_s = HAS_SCATTERING ? avg3(sigma_s * p.w) / c : 0.0;
+  float u = rng_next(rng);
+  if (u < p_a) {
+    // Absorbed: the absorption estimator collects sigma_a·Le / (sigma_bar·P_a).
+    stats.events += 1.0;
+    if (HAS_EMISSION && !COLLISION_ESTIMATOR) p.L += p.w * emission_at(x, p.t, span, rho) / (sigma_bar * p_a);
+    return true;
+  } else if (HAS_SCATTERING && u < p_a + p_s) {
+    stats.events += 1.0;
+    if (p.depth >= frame.image.w) return true;  // max_depth reached
+    ++p.depth;
+    p.w *= sigma_s / (sigma_bar * p_s);
+    // Phase function of the mixture sum_i (sigma_s_i / sigma_s) p_i: pick medium i
+    // with q_i ∝ avg(share_i ⊙ w), sample its HG lobe, weight share_i / q_i.
+    vec3 inv_sigma_s = 1.0 / max(sigma_s, vec3(1e-30));
+    float total = 0.0;
+    for (uint i = 0u; i < MEDIUM_COUNT; ++i) total += avg3(rho[i] * media[i].sigma_s.rgb * inv_sigma_s * p.w);
+    float pick = rng_next(rng) * total;
+    float acc = 0.0, g = 0.0;
+    vec3 mix_w = vec3(0.0);
+    for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+      vec3 share = rho[i] * media[i].sigma_s.rgb * inv_sigma_s;
+      float p_i = avg3(share * p.w);
+      if (p_i <= 0.0) continue;
+      acc += p_i;
+      g = media[i].sigma_s.w;
+      mix_w = share * (total / p_i);
+      if (pick < acc) break;
+    }
+    p.w *= mix_w;
+    p.o = x;
+    p.d = sample_hg(p.d, g, vec2(rng_next(rng), rng_next(rng)));
+    p.fresh = true;
+  } else {
+    p.w *= sigma_n / (sigma_bar * (1.0 - p_a - p_s));
+  }
+  return max3(p.w) <= 0.0;
+}
+
+// A camera ray through pixel `pixel` for sample `k`, with that sample's random stream.
+PathState camera_path(uvec2 pixel, uint k, out uint rng) {
+  uint width = frame.image.x, height = frame.image.y;
+  rng = rng_init(frame.sampling.x, frame.sampling.y, pixel.y * width + pixel.x, k);
+  // Box filter: jitter uniformly inside the pixel; pixel (0,0) is top-left.
+  vec2 jitter = vec2(rng_next(rng), rng_next(rng));
+  vec2 ndc = vec2(2.0 * (float(pixel.x) + jitter.x) / float(width) - 1.0,
+                  1.0 - 2.0 * (float(pixel.y) + jitter.y) / float(height));
+  float tan_half = frame.camera_position.w, aspect = frame.camera_forward.w;
+  vec3 d = normalize(frame.camera_forward.xyz + ndc.x * tan_half * aspect * frame.camera_right.xyz +
+                     ndc.y * tan_half * frame.camera_up.xyz);
+  return PathState(frame.camera_position.xyz, d, vec3(1.0), vec3(0.0), 0.0, 0u, true);
 }
 
 void main() {
@@ -345,25 +373,35 @@ void main() {
   vec3 pass_sum = vec3(0.0), pass_sq = vec3(0.0);
   PathStats stats = PathStats(0.0, 0.0);
   float nonfinite = 0.0;
-  for (uint k = 0u; k < pass_constants.spp; ++k) {
-    uint rng = rng_init(frame.sampling.x, frame.sampling.y, pixel_index, pass_constants.sample_offset + k);
-    // Box filter: jitter uniformly inside the pixel; pixel (0,0) is top-left.
-    vec2 jitter = vec2(rng_next(rng), rng_next(rng));
-    vec2 ndc = vec2(2.0 * (float(pixel.x) + jitter.x) / float(width) - 1.0,
-                    1.0 - 2.0 * (float(pixel.y) + jitter.y) / float(height));
-    float tan_half = frame.camera_position.w, aspect = frame.camera_forward.w;
-    vec3 d = normalize(frame.camera_forward.xyz + ndc.x * tan_half * aspect * frame.camera_right.xyz +
-                       ndc.y * tan_half * frame.camera_up.xyz);
-    vec3 L;
-    if (DEBUG_MODE == DEBUG_RATIO_TRACKING) L = transmittance(frame.camera_position.xyz, d, true, rng, stats);
-    else if (DEBUG_MODE == DEBUG_DELTA_TRACKING) L = transmittance(frame.camera_position.xyz, d, false, rng, stats);
-    else L = trace(frame.camera_position.xyz, d, rng, stats);
-    if (any(isnan(L)) || any(isinf(L))) {
-      nonfinite += 1.0;
-      L = vec3(0.0);
+  const uint first = pass_constants.sample_offset, last = first + pass_constants.spp;
+  if (DEBUG_MODE != DEBUG_NONE) {
+    for (uint k = first; k < last; ++k) {
+      uint rng;
+      PathState p = camera_path(pixel, k, rng);
+      vec3 T = transmittance(p.o, p.d, DEBUG_MODE == DEBUG_RATIO_TRACKING, rng, stats);
+      pass_sum += T;
+      pass_sq += T * T;
     }
-    pass_sum += L;
-    pass_sq += L * L;
+  } else {
+    // Paths are regenerated within the lane: one loop iteration is one tracking
+    // step, and a lane whose path ends starts its next sample at once instead of
+    // idling until the longest path of its SIMD group ends (LAVAPIPE.md:
+    // divergence halves throughput). Each sample keeps its own random stream, so
+    // the result does not depend on the schedule.
+    uint k = first, rng;
+    PathState p = camera_path(pixel, k, rng);
+    vec2 span[MEDIA_N];
+    while (k < last) {
+      if (!path_step(p, span, rng, stats)) continue;
+      vec3 L = p.L;
+      if (any(isnan(L)) || any(isinf(L))) {
+        nonfinite += 1.0;
+        L = vec3(0.0);
+      }
+      pass_sum += L;
+      pass_sq += L * L;
+      if (++k < last) p = camera_path(pixel, k, rng);
+    }
   }
 
   // Kahan-compensated accumulation across passes.
