@@ -238,17 +238,6 @@ TEST(CpuRenderer, GrazingAndBoundaryRaysStayFinite) {
   EXPECT_TRUE(all_finite(r));
 }
 
-TEST(CpuRenderer, RejectsVdbMedia) {
-  Scene s = test::absorbing_sphere_scene(8, 8, 1);
-  s.media[0].type = Medium::Type::Vdb;
-  try {
-    render(s);
-    FAIL() << "expected an exception";
-  } catch (const std::runtime_error& e) {
-    EXPECT_STREQ(e.what(), "cpu reference: vdb media not supported yet");
-  }
-}
-
 TEST(CpuRenderer, ProgressCancelAndTimeLimit) {
   Scene s = test::absorbing_sphere_scene(16, 16, 64);
   CpuRenderer cpu(2);
