@@ -53,7 +53,14 @@ INSTANTIATE_TEST_SUITE_P(
         CliCase{"spp_zero", R"({"film": {"spp": 0}})", "", "film.spp"},
         CliCase{"wrong_type", R"({"film": {"height": [3]}})", "", "film.height: expected an integer"},
         CliCase{"not_json", "this is not json", "", "invalid JSON"},
-        CliCase{"flag_spp_zero", kSphere, "--spp 0", "--spp"}),
+        CliCase{"flag_spp_zero", kSphere, "--spp 0", "--spp"},
+        CliCase{"vdb_missing_file", R"({"media": [{"type": "vdb", "file": "nothere.vdb"}]})", "",
+                "nothere.vdb: file not found"},
+        CliCase{"vdb_missing_grid",
+                R"({"media": [{"type": "vdb", "file": ")" PYROLUME_SOURCE_DIR R"(/assets/volumes/fire.vdb", "density_grid": "smoke"}]})",
+                "", "density grid \"smoke\": no such grid; the file has: \"density\""},
+        CliCase{"vdb_not_a_vdb", R"({"media": [{"type": "vdb", "file": ")" PYROLUME_SOURCE_DIR R"(/README.md"}]})", "",
+                "not an OpenVDB (.vdb) or NanoVDB (.nvdb) file"}),
     [](const ::testing::TestParamInfo<CliCase>& info) { return std::string(info.param.label); });
 
 TEST(Cli, MissingSceneFile) {
