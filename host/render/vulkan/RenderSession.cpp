@@ -74,6 +74,15 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
     set_->write_image(gpu::BINDING_BLACKBODY, textures_1d_[b], slot);
   }
   upload_constants(scene);
+  // lavapipe compiles a pipeline inside its first dispatch (~0.1–0.5 s,
+  // LAVAPIPE.md): dispatch one empty workgroup now so that cost counts as
+  // loading, not rendering (DESIGN.md: `seconds` starts at the first real pass).
+  ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    gpu::PassConstants nothing{0u, 0u, 0u, 0u};
+    pipeline_->bind(cmd, set_->set());
+    pipeline_->push(cmd, nothing);
+    vkCmdDispatch(cmd, 1, 1, 1);
+  });
 }
 
 // One 3D texture per grid, each over its own active bounding box with its own
