@@ -1,0 +1,139 @@
+#include "geometry/Mesh.h"
+
+#include <cmath>
+#include <fstream>
+#include <string>
+
+// The only translation unit that compiles tinyobjloader (header-only use).
+#define TINYOBJLOADER_IMPLEMENTATION
+#include <tiny_obj_loader.h>
+
+#include "util/Error.h"
+
+namespace pyrolume::geometry {
+namespace {
+
+// tinyobjloader's messages end in newlines and may hold several lines: keep
+// the first, so the error stays one line.
+std::string first_line(const std::string& text) {
+  size_t start = text.find_first_not_of(" \t\r\n");
+  if (start == std::string::npos) return "parse error";
+  size_t end = text.find_first_of("\r\n", start);
+  return text.substr(start, end == std::string::npos ? std::string::npos : end - start);
+}
+
+bool finite(float x) { return std::isfinite(x); }
+
+}  // namespace
+
+Mesh load_obj(const std::filesystem::path& file) {
+  const std::string name = file.string();
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) throw input_error(name, "", "no such file");
+  if (std::filesystem::is_directory(file, ec)) throw input_error(name, "", "is a directory, not an OBJ file");
+  {
+    std::ifstream probe(file, std::ios::binary);
+    if (!probe) throw input_error(name, "", "cannot open for reading");
+  }
+
+  tinyobj::ObjReaderConfig config;
+  config.triangulate = true;
+  config.vertex_color = false;
+  config.mtl_search_path = file.parent_path().string();
+  tinyobj::ObjReader reader;
+  if (!reader.ParseFromFile(name, config))
+    throw input_error(name, "", "not a valid OBJ file: " + first_line(reader.Error()));
+  // A mesh whose first line already failed to parse often "succeeds" with
+  // errors recorded; treat any error text as fatal.
+  if (!reader.Error().empty()) throw input_error(name, "", "not a valid OBJ file: " + first_line(reader.Error()));
+
+  // tinyobjloader skips a polygon with an out-of-range index with only a
+  // warning: a mesh with holes must not render silently.
+  if (reader.Warning().find("invalid vertex index") != std::string::npos)
+    throw input_error(name, "", "a face uses a vertex index out of range");
+
+  const tinyobj::attrib_t& attrib = reader.GetAttrib();
+  Mesh mesh;
+  const size_t np = attrib.vertices.size() / 3, nn = attrib.normals.size() / 3, nt = attrib.texcoords.size() / 2;
+  mesh.positions.resize(np);
+  for (size_t i = 0; i < np; ++i) {
+    glm::vec3 p(attrib.vertices[3 * i], attrib.vertices[3 * i + 1], attrib.vertices[3 * i + 2]);
+    if (!finite(p.x) || !finite(p.y) || !finite(p.z))
+      throw input_error(name, "", "vertex " + std::to_string(i + 1) + " has a non-finite coordinate");
+    mesh.positions[i] = p;
+  }
+  mesh.normals.resize(nn);
+  for (size_t i = 0; i < nn; ++i) {
+    glm::vec3 n(attrib.normals[3 * i], attrib.normals[3 * i + 1], attrib.normals[3 * i + 2]);
+    float len = glm::length(n);
+    // A zero or broken normal is unusable for shading; fall back to the
+    // geometric normal for faces that use it (their normal index is dropped).
+    mesh.normals[i] = (std::isfinite(len) && len > 0.0f) ? n / len : glm::vec3(0.0f);
+  }
+  mesh.uvs.resize(nt);
+  for (size_t i = 0; i < nt; ++i) {
+    glm::vec2 uv(attrib.texcoords[2 * i], attrib.texcoords[2 * i + 1]);
+    if (!finite(uv.x) || !finite(uv.y))
+      throw input_error(name, "", "texture coordinate " + std::to_string(i + 1) + " is not finite");
+    mesh.uvs[i] = uv;
+  }
+
+  for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+    const auto& idx = shape.mesh.indices;
+    size_t offset = 0;
+    for (size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f) {
+      const size_t fv = shape.mesh.num_face_vertices[f];
+      if (fv != 3) {
+        // triangulate = true only leaves degenerate faces (1-2 corners): skip them.
+        offset += fv;
+        continue;
+      }
+      std::array<Mesh::Corner, 3> tri;
+      bool all_normals = true, all_uvs = true;
+      for (size_t k = 0; k < 3; ++k) {
+        const tinyobj::index_t& ix = idx[offset + k];
+        if (ix.vertex_index < 0 || size_t(ix.vertex_index) >= np)
+          throw input_error(name, "",
+                            "face " + std::to_string(f + 1) + " of '" + shape.name + "' uses vertex " +
+                                std::to_string(ix.vertex_index + 1) + " of " + std::to_string(np));
+        tri[k].position = uint32_t(ix.vertex_index);
+        if (ix.normal_index >= 0 && size_t(ix.normal_index) < nn &&
+            mesh.normals[size_t(ix.normal_index)] != glm::vec3(0.0f))
+          tri[k].normal = uint32_t(ix.normal_index);
+        else
+          all_normals = false;
+        if (ix.normal_index >= 0 && size_t(ix.normal_index) >= nn)
+          throw input_error(name, "",
+                            "face " + std::to_string(f + 1) + " uses normal " + std::to_string(ix.normal_index + 1) +
+                                " of " + std::to_string(nn));
+        if (ix.texcoord_index >= 0 && size_t(ix.texcoord_index) < nt)
+          tri[k].uv = uint32_t(ix.texcoord_index);
+        else
+          all_uvs = false;
+        if (ix.texcoord_index >= 0 && size_t(ix.texcoord_index) >= nt)
+          throw input_error(name, "",
+                            "face " + std::to_string(f + 1) + " uses texture coordinate " +
+                                std::to_string(ix.texcoord_index + 1) + " of " + std::to_string(nt));
+      }
+      for (auto& c : tri) {
+        if (!all_normals) c.normal = kNoIndex;
+        if (!all_uvs) c.uv = kNoIndex;
+      }
+      mesh.triangles.push_back(tri);
+      offset += fv;
+    }
+  }
+  if (mesh.triangles.empty()) throw input_error(name, "", "no triangles (not an OBJ mesh, or only points and lines)");
+  return mesh;
+}
+
+void transform_mesh(Mesh& mesh, const glm::dmat4& object_to_world) {
+  const glm::dmat3 normal_map = glm::transpose(glm::inverse(glm::dmat3(object_to_world)));
+  for (glm::vec3& p : mesh.positions) p = glm::vec3(object_to_world * glm::dvec4(glm::dvec3(p), 1.0));
+  for (glm::vec3& n : mesh.normals) {
+    if (n == glm::vec3(0.0f)) continue;
+    n = glm::vec3(glm::normalize(normal_map * glm::dvec3(n)));
+  }
+}
+
+}  // namespace pyrolume::geometry

@@ -1,0 +1,106 @@
+#include "geometry/Surfaces.h"
+
+namespace pyrolume::geometry {
+
+bool intersect(const Surfaces& s, const Ray& ray, double t_max, SurfaceHit& hit) {
+  bool found = intersect(s.bvh, ray, t_max, hit);
+  double t_closest = found ? hit.t : t_max;
+  for (uint32_t i = 0; i < s.shapes.size(); ++i) {
+    SurfaceHit h;
+    if (intersect_shape(s.shapes[i], ray, t_closest, h)) {
+      h.primitive = i;
+      hit = h;
+      t_closest = h.t;
+      found = true;
+    }
+  }
+  return found;
+}
+
+bool occluded(const Surfaces& s, const Ray& ray, double t_max) {
+  for (const SurfaceShape& shape : s.shapes) {
+    SurfaceHit h;
+    if (intersect_shape(shape, ray, t_max, h)) return true;
+  }
+  return occluded(s.bvh, ray, t_max);
+}
+
+glm::dvec3 albedo_at(const Surfaces& s, const SurfaceHit& hit) {
+  if (hit.material >= s.materials.size()) return glm::dvec3(0.5);
+  const Material& m = s.materials[hit.material];
+  if (m.texture < 0 || size_t(m.texture) >= s.textures.size()) return m.albedo;
+  return m.albedo * s.textures[size_t(m.texture)].lookup(hit.uv);
+}
+
+std::vector<gpu::GpuBvhNode> pack_gpu_nodes(const Bvh& bvh) {
+  std::vector<gpu::GpuBvhNode> out(bvh.nodes.size());
+  for (size_t i = 0; i < bvh.nodes.size(); ++i) {
+    const BvhNode& n = bvh.nodes[i];
+    out[i].bounds_min = glm::vec4(n.bounds_min, 0.0f);
+    out[i].bounds_max = glm::vec4(n.bounds_max, 0.0f);
+    out[i].info = glm::uvec4(n.offset, n.count, n.axis, 0u);
+  }
+  return out;
+}
+
+gpu::GpuSurfaceShape pack_gpu_shape(const SurfaceShape& s) {
+  gpu::GpuSurfaceShape g{};
+  if (s.type == SurfaceShape::Type::Sphere) {
+    g.p0 = glm::vec4(glm::vec3(s.center), float(s.radius));
+    g.info = glm::uvec4(gpu::SURFACE_SPHERE, s.material, 0u, 0u);
+  } else {
+    g.p0 = glm::vec4(glm::vec3(s.center), float(s.half_u));
+    g.p1 = glm::vec4(glm::vec3(s.normal), float(s.half_v));
+    g.p2 = glm::vec4(glm::vec3(s.u_axis), 0.0f);
+    g.info = glm::uvec4(gpu::SURFACE_PLANE, s.material, 0u, 0u);
+  }
+  return g;
+}
+
+GpuSurfaces pack_gpu_surfaces(const Surfaces& s) {
+  GpuSurfaces g;
+  g.nodes = pack_gpu_nodes(s.bvh);
+  if (g.nodes.empty()) {  // a Bvh never built: the empty BVH's single leaf
+    g.nodes.push_back({});
+    g.nodes[0].info = glm::uvec4(0u, 0u, gpu::BVH_LEAF, 0u);
+  }
+  g.triangle_count = uint32_t(s.bvh.triangles.size());
+  for (const Triangle& t : s.bvh.triangles) {
+    gpu::GpuTriangle gt{};
+    gt.v0 = glm::vec4(t.p[0], 0.0f);
+    gt.v1 = glm::vec4(t.p[1], 0.0f);
+    gt.v2 = glm::vec4(t.p[2], 0.0f);
+    g.triangles.push_back(gt);
+    gpu::GpuTriangleAttributes a{};
+    if (t.has_normals) {
+      a.n0 = glm::vec4(t.n[0], 0.0f);
+      a.n1 = glm::vec4(t.n[1], 0.0f);
+      a.n2 = glm::vec4(t.n[2], 0.0f);
+    }
+    if (t.has_uvs) {
+      a.uv01 = glm::vec4(t.uv[0], t.uv[1]);
+      a.uv2 = glm::vec4(t.uv[2], 0.0f, 0.0f);
+    }
+    a.info = glm::uvec4(t.material, t.source, t.mesh,
+                        (t.has_normals ? gpu::TRIANGLE_HAS_NORMALS : 0u) | (t.has_uvs ? gpu::TRIANGLE_HAS_UVS : 0u));
+    g.attributes.push_back(a);
+  }
+  if (g.triangles.empty()) {
+    g.triangles.push_back({});
+    g.attributes.push_back({});
+  }
+  g.shape_count = uint32_t(s.shapes.size());
+  for (const SurfaceShape& shape : s.shapes) g.shapes.push_back(pack_gpu_shape(shape));
+  if (g.shapes.empty()) g.shapes.push_back({});
+  for (const Material& m : s.materials) {
+    gpu::GpuMaterial gm{};
+    gm.albedo = glm::vec4(glm::vec3(m.albedo), 0.0f);
+    gm.info = glm::uvec4(m.texture < 0 ? gpu::NO_TEXTURE : uint32_t(m.texture), 0u, 0u, 0u);
+    g.materials.push_back(gm);
+  }
+  if (g.materials.empty())
+    g.materials.push_back({glm::vec4(0.5f, 0.5f, 0.5f, 0.0f), glm::uvec4(gpu::NO_TEXTURE, 0, 0, 0)});
+  return g;
+}
+
+}  // namespace pyrolume::geometry
