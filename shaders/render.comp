@@ -10,6 +10,7 @@
 #include "rng.glsl"
 #include "sampling.glsl"
 #include "geometry.glsl"
+#include "shared/geometry_types.h"
 
 layout(local_size_x = WORKGROUP_SIZE_X, local_size_y = WORKGROUP_SIZE_Y) in;
 
@@ -26,6 +27,9 @@ const uint MEDIA_N = MEDIUM_COUNT > 0u ? MEDIUM_COUNT : 1u;  // array size (neve
 // With a single grid medium the texture switches below fold to slot 0 (15 %
 // faster on lavapipe than a switch the compiler cannot resolve).
 layout(constant_id = SPEC_GRID_COUNT) const uint GRID_COUNT = 1;
+layout(constant_id = SPEC_HAS_SURFACES) const bool HAS_SURFACES = false;
+layout(constant_id = SPEC_SURFACE_SHAPE_COUNT) const uint SURFACE_SHAPE_COUNT = 0;
+layout(constant_id = SPEC_SURFACE_HAS_TRIANGLES) const bool SURFACE_HAS_TRIANGLES = false;
 
 layout(std140, set = 0, binding = BINDING_FRAME) uniform FrameBlock { FrameConstants frame; };
 // Media and grids are uniform blocks: every lane reads the same entries, which
@@ -38,6 +42,18 @@ layout(set = 0, binding = BINDING_DENSITY) uniform sampler3D density_tex[MAX_GRI
 layout(set = 0, binding = BINDING_TEMPERATURE) uniform sampler3D temperature_tex[MAX_GRIDS];
 layout(set = 0, binding = BINDING_BLACKBODY) uniform sampler1D blackbody_tex[MAX_GRIDS];
 layout(push_constant) uniform PassBlock { PassConstants pass_constants; };
+// Surfaces (shaders/bvh.glsl's contract).
+layout(std430, set = 0, binding = BINDING_BVH_NODES) readonly buffer BvhNodes { GpuBvhNode bvh_nodes[]; };
+layout(std430, set = 0, binding = BINDING_BVH_TRIANGLES) readonly buffer BvhTriangles { GpuTriangle bvh_triangles[]; };
+layout(std430, set = 0, binding = BINDING_BVH_ATTRIBUTES) readonly buffer BvhAttributes {
+  GpuTriangleAttributes bvh_attributes[];
+};
+layout(std430, set = 0, binding = BINDING_SURFACE_SHAPES) readonly buffer SurfaceShapes {
+  GpuSurfaceShape surface_shapes[];
+};
+layout(std430, set = 0, binding = BINDING_MATERIALS) readonly buffer Materials { GpuMaterial surface_materials[]; };
+layout(set = 0, binding = BINDING_TEXTURES) uniform sampler2D albedo_tex[MAX_TEXTURES];
+#include "bvh.glsl"
 
 const float INF = 1.0 / 0.0;
 
@@ -82,6 +98,19 @@ vec3 blackbody_at(uint slot, float s) {
 
 // Grid fields are read straight from the uniform block (no GpuGrid copies:
 // copying the 192-byte struct per call is measurably slower on lavapipe).
+vec3 albedo_texture_at(uint slot, vec2 uv) {
+  switch (slot) {
+    case 0u: return textureLod(albedo_tex[0], uv, 0.0).rgb;
+    case 1u: return textureLod(albedo_tex[1], uv, 0.0).rgb;
+    case 2u: return textureLod(albedo_tex[2], uv, 0.0).rgb;
+    case 3u: return textureLod(albedo_tex[3], uv, 0.0).rgb;
+    case 4u: return textureLod(albedo_tex[4], uv, 0.0).rgb;
+    case 5u: return textureLod(albedo_tex[5], uv, 0.0).rgb;
+    case 6u: return textureLod(albedo_tex[6], uv, 0.0).rgb;
+    default: return textureLod(albedo_tex[7], uv, 0.0).rgb;
+  }
+}
+
 vec3 density_texel(uint slot, vec3 p) {
   vec4 p1 = vec4(p, 1.0);
   return vec3(dot(grids[slot].density_row0, p1), dot(grids[slot].density_row1, p1), dot(grids[slot].density_row2, p1));
@@ -122,7 +151,11 @@ void media_spans(vec3 o, vec3 d, out vec2 span[MEDIA_N], out bool any_hit) {
     } else {
       // The texel box [0, dims] in texel space; t is the same there (affine map).
       uint slot = uint(m.bounds0.x);
-      hit = intersect_box(density_texel(slot, o), density_texel_dir(slot, d), vec3(0.0), grids[slot].density_dims.xyz, t);
+      // Clip to the trilinear support, between the zero padding texels' centres
+      // (u = 0.5 .. dims − 0.5): outside it every lookup is 0, and a dense grid's
+      // majorant there would only buy null collisions.
+      hit = intersect_box(density_texel(slot, o), density_texel_dir(slot, d), vec3(0.5),
+                          grids[slot].density_dims.xyz - 0.5, t);
     }
     span[i] = hit ? t : vec2(-1.0);
     any_hit = any_hit || hit;
@@ -145,7 +178,9 @@ float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, inout float t_next) {
   ivec3 cell = clamp(ivec3(floor((u + du * nudge) / cs)), ivec3(0), res - 1);
   vec3 bound = (vec3(cell) + step(vec3(0.0), du)) * cs;
   vec3 tx = (bound - u) * inv_du;  // ±inf on axes the ray runs parallel to
-  float t_exit = t + max(min3(mix(tx, vec3(INF), isnan(tx))), nudge);
+  // At least a few float ulps of t, so t always moves on (a far camera loses
+  // precision in u; see also the origin shift in path_step).
+  float t_exit = t + max(min3(mix(tx, vec3(INF), isnan(tx))), max(nudge, abs(t) * 1e-6));
   t_next = min(t_next, t_exit);
   uint index = res4.w + uint((cell.z * res.y + cell.y) * res.x + cell.x);
   return majorants[index] * cell_info.w;
@@ -256,9 +291,33 @@ struct PathState {
   vec3 w;      // path weight (per channel)
   vec3 L;      // radiance gathered so far
   float t;     // distance along the current ray
-  uint depth;  // scattering events so far
-  bool fresh;  // the ray changed: recompute the media spans
+  uint depth;  // scattering events (medium and surface) so far
+  bool fresh;  // the ray changed: recompute the media spans and the surface hit
+  bool has_hit;     // a surface lies ahead on the current ray
+  SurfaceHit hit;   // the closest one (t = its distance)
 };
+
+// Radiance of a ray that leaves the scene.
+vec3 escaped_radiance(vec3 d) { return frame.background.rgb; }
+
+// A Lambertian bounce at the surface ahead: weight × albedo (cosine sampling's
+// pdf cancels the cosine and 1/π), new direction on the side the ray came
+// from (surfaces are two-sided). Returns true when the path ends.
+bool surface_bounce(inout PathState p, inout uint rng, inout PathStats stats) {
+  SurfaceInteraction si = surface_interaction(p.o, p.d, p.hit);
+  stats.events += 1.0;
+  if (p.depth >= frame.image.w) return true;  // max_depth reached
+  ++p.depth;
+  GpuMaterial m = surface_materials[si.material];
+  vec3 albedo = m.albedo.rgb;
+  if (m.info.x != NO_TEXTURE) albedo *= albedo_texture_at(m.info.x, vec2(si.uv.x, 1.0 - si.uv.y));  // OBJ v=0 at the bottom
+  p.w *= albedo;
+  vec3 n = dot(si.normal, p.d) < 0.0 ? si.normal : -si.normal;
+  p.o = offset_ray_origin(si.position, n);
+  p.d = sample_cosine_hemisphere(n, vec2(rng_next(rng), rng_next(rng)));
+  p.fresh = true;
+  return max3(p.w) <= 0.0;
+}
 
 // One step of delta tracking along one path; returns true when the path has
 // ended (p.L is then final).
@@ -275,26 +334,41 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   if (p.fresh) {
     bool any_hit;
     media_spans(p.o, p.d, span, any_hit);
+    p.has_hit = HAS_SURFACES && intersect_surfaces(p.o, p.d, 1e30, p.hit);
     p.fresh = false;
     p.t = 0.0;
-    if (!any_hit) {
-      p.L += p.w * frame.background.rgb;
+    if (!any_hit && !p.has_hit) {
+      p.L += p.w * escaped_radiance(p.d);
       return true;
+    }
+    // Move the origin to the first thing the ray reaches, so every later
+    // position o + t·d is computed with a small t: from a camera 1e4 units
+    // away, o + t·d would carry ~1e-3 units of float error into every lookup
+    // and DDA step.
+    float t0 = p.has_hit ? p.hit.t : INF;
+    for (uint i = 0u; i < MEDIUM_COUNT; ++i)
+      if (span[i].y > 0.0) t0 = min(t0, span[i].x);
+    if (t0 > 0.0 && !isinf(t0)) {
+      p.o += t0 * p.d;
+      for (uint i = 0u; i < MEDIUM_COUNT; ++i)
+        if (span[i].y > 0.0) span[i] -= t0;
+      if (p.has_hit) p.hit.t -= t0;
     }
   }
   float t_next;
   bool any_ahead;
   float sigma_bar = majorant_at(p.o, p.d, p.t, span, t_next, any_ahead);
-  if (!any_ahead || isinf(t_next)) {
-    p.L += p.w * frame.background.rgb;
+  if (!any_ahead) t_next = INF;
+  // Media beyond the closest surface do not matter: free flights end there.
+  const float t_surface = p.has_hit ? p.hit.t : INF;
+  if (isinf(t_next) && !p.has_hit) {
+    p.L += p.w * escaped_radiance(p.d);
     return true;
   }
-  if (sigma_bar <= 0.0) {
-    p.t = t_next;
-    return false;
-  }
-  float dt = sample_free_flight(sigma_bar, rng_next(rng));
-  if (p.t + dt >= t_next) {
+  const float t_end = min(t_next, t_surface);
+  float dt = sigma_bar > 0.0 ? sample_free_flight(sigma_bar, rng_next(rng)) : INF;
+  if (p.t + dt >= t_end) {
+    if (p.has_hit && t_surface <= t_next) return surface_bounce(p, rng, stats);
     p.t = t_next;
     return false;
   }
@@ -361,7 +435,16 @@ PathState camera_path(uvec2 pixel, uint k, out uint rng) {
   float tan_half = frame.camera_position.w, aspect = frame.camera_forward.w;
   vec3 d = normalize(frame.camera_forward.xyz + ndc.x * tan_half * aspect * frame.camera_right.xyz +
                      ndc.y * tan_half * frame.camera_up.xyz);
-  return PathState(frame.camera_position.xyz, d, vec3(1.0), vec3(0.0), 0.0, 0u, true);
+  PathState p;
+  p.o = frame.camera_position.xyz;
+  p.d = d;
+  p.w = vec3(1.0);
+  p.L = vec3(0.0);
+  p.t = 0.0;
+  p.depth = 0u;
+  p.fresh = true;
+  p.has_hit = false;
+  return p;
 }
 
 void main() {
@@ -388,19 +471,25 @@ void main() {
     // idling until the longest path of its SIMD group ends (LAVAPIPE.md:
     // divergence halves throughput). Each sample keeps its own random stream, so
     // the result does not depend on the schedule.
+    //
+    // Two nested loops, because llvmpipe ends any single loop after 65535
+    // iterations (per SIMD group): a dense pass would otherwise drop samples
+    // silently. The inner loop restarts its count at every entry.
     uint k = first, rng;
     PathState p = camera_path(pixel, k, rng);
     vec2 span[MEDIA_N];
     while (k < last) {
-      if (!path_step(p, span, rng, stats)) continue;
-      vec3 L = p.L;
-      if (any(isnan(L)) || any(isinf(L))) {
-        nonfinite += 1.0;
-        L = vec3(0.0);
+      for (uint n = 0u; n < 16384u && k < last; ++n) {
+        if (!path_step(p, span, rng, stats)) continue;
+        vec3 L = p.L;
+        if (any(isnan(L)) || any(isinf(L))) {
+          nonfinite += 1.0;
+          L = vec3(0.0);
+        }
+        pass_sum += L;
+        pass_sq += L * L;
+        if (++k < last) p = camera_path(pixel, k, rng);
       }
-      pass_sum += L;
-      pass_sq += L * L;
-      if (++k < last) p = camera_path(pixel, k, rng);
     }
   }
 

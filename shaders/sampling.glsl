@@ -38,4 +38,12 @@ vec3 sample_hg(vec3 dir, float g, vec2 u) {
   vec3 b = cross(dir, t);
   return normalize(cos_theta * dir + sin_theta * (cos(phi) * t + sin(phi) * b));
 }
+// Cosine-weighted direction on the hemisphere around unit n (Malley's method):
+// pdf = cos θ / π.
+vec3 sample_cosine_hemisphere(vec3 n, vec2 u) {
+  float r = sqrt(u.x), phi = 2.0 * PI * u.y;
+  vec3 t = any_perpendicular(n);
+  vec3 b = cross(n, t);
+  return normalize(r * cos(phi) * t + r * sin(phi) * b + sqrt(max(0.0, 1.0 - u.x)) * n);
+}
 #endif

@@ -32,6 +32,13 @@ PYRO_CONST uint BINDING_MAJORANTS = 4; // readonly buffer float[]: every grid's 
 PYRO_CONST uint BINDING_DENSITY = 5;   // sampler3D[MAX_GRIDS]
 PYRO_CONST uint BINDING_TEMPERATURE = 6;  // sampler3D[MAX_GRIDS]
 PYRO_CONST uint BINDING_BLACKBODY = 7; // sampler1D[MAX_GRIDS]: blackbody LUT per grid medium
+PYRO_CONST uint BINDING_BVH_NODES = 8;       // readonly buffer GpuBvhNode[] (shared/geometry_types.h)
+PYRO_CONST uint BINDING_BVH_TRIANGLES = 9;   // readonly buffer GpuTriangle[]
+PYRO_CONST uint BINDING_BVH_ATTRIBUTES = 10; // readonly buffer GpuTriangleAttributes[]
+PYRO_CONST uint BINDING_SURFACE_SHAPES = 11; // readonly buffer GpuSurfaceShape[]
+PYRO_CONST uint BINDING_MATERIALS = 12;      // readonly buffer GpuMaterial[]
+PYRO_CONST uint BINDING_TEXTURES = 13;       // sampler2D[MAX_TEXTURES]: albedo textures
+PYRO_CONST uint MAX_TEXTURES = 8;
 
 // Specialisation constants of render.comp: a scene pays only for what it uses.
 PYRO_CONST uint SPEC_HAS_GRIDS = 0;
@@ -41,6 +48,9 @@ PYRO_CONST uint SPEC_COLLISION_ESTIMATOR = 3;
 PYRO_CONST uint SPEC_DEBUG_MODE = 4;
 PYRO_CONST uint SPEC_MEDIUM_COUNT = 5;  // loops over media get a constant trip count
 PYRO_CONST uint SPEC_GRID_COUNT = 6;
+PYRO_CONST uint SPEC_HAS_SURFACES = 7;
+PYRO_CONST uint SPEC_SURFACE_SHAPE_COUNT = 8;
+PYRO_CONST uint SPEC_SURFACE_HAS_TRIANGLES = 9;
 PYRO_CONST uint DEBUG_NONE = 0;
 PYRO_CONST uint DEBUG_RATIO_TRACKING = 1;  // camera rays return ratio-tracking transmittance
 PYRO_CONST uint DEBUG_DELTA_TRACKING = 2;  // camera rays return delta-tracking transmittance

@@ -317,4 +317,127 @@ inline std::function<glm::dvec3(int, int)> constant_box_exact(const Scene& s, co
   });
 }
 
+
+// ------------------------------------------- general trilinear fields ----
+
+// The trilinear field of ANY grid whose active voxels fill `box` with
+// value(i, j, k) (the values AS STORED: round to half first for R16F), zero
+// padding around, sampled as the renderers do (voxel ijk's value at its centre,
+// linear in between; 0 beyond one voxel outside the box). Written
+// independently of DenseGrid. No medium transform. Values are cached at
+// construction (plus the one-texel padding), so lookups are cheap.
+struct TrilinearVoxelField {
+  Lattice lattice;
+  VoxelBox box;
+  glm::ivec3 dims{0};       // box size plus one padding texel on each side
+  std::vector<double> v;    // x fastest
+
+  TrilinearVoxelField() = default;
+  TrilinearVoxelField(const Lattice& l, const VoxelBox& b, const VoxelFn& value) : lattice(l), box(b) {
+    dims = b.hi - b.lo + 3;
+    v.assign(size_t(dims.x) * dims.y * dims.z, 0.0);
+    for (int k = b.lo.z; k <= b.hi.z; ++k)
+      for (int j = b.lo.y; j <= b.hi.y; ++j)
+        for (int i = b.lo.x; i <= b.hi.x; ++i) {
+          const double x = value(i, j, k);
+          at(i, j, k) = std::isfinite(x) && x > 0.0 ? x : 0.0;  // the loader's NaN/negative rule
+        }
+  }
+  double& at(int i, int j, int k) {
+    return v[(size_t(k - box.lo.z + 1) * dims.y + size_t(j - box.lo.y + 1)) * dims.x + size_t(i - box.lo.x + 1)];
+  }
+  double get(int i, int j, int k) const {
+    if (i < box.lo.x || j < box.lo.y || k < box.lo.z || i > box.hi.x || j > box.hi.y || k > box.hi.z) return 0.0;
+    return v[(size_t(k - box.lo.z + 1) * dims.y + size_t(j - box.lo.y + 1)) * dims.x + size_t(i - box.lo.x + 1)];
+  }
+  double density(const glm::dvec3& p) const {
+    const glm::dvec3 u = lattice.index(p);
+    const glm::dvec3 f = glm::floor(u);
+    const glm::ivec3 i0(f);
+    const glm::dvec3 w = u - f;
+    double r = 0.0;
+    for (int c = 0; c < 8; ++c) {
+      const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
+      const double wt = (dx ? w.x : 1.0 - w.x) * (dy ? w.y : 1.0 - w.y) * (dz ? w.z : 1.0 - w.z);
+      if (wt != 0.0) r += wt * get(i0.x + dx, i0.y + dy, i0.z + dz);
+    }
+    return r;
+  }
+  // ∫_{t0}^{t1} ρ(o + t d) dt, exact: between crossings of the lattice planes
+  // (voxel centres) trilinear interpolation is a product of three linear
+  // functions of t, a cubic, which 3-point Gauss–Legendre integrates exactly.
+  // Only the support (padding centres lo − 1 .. hi + 1) is integrated.
+  double optical_depth(const glm::dvec3& o, const glm::dvec3& d, double t0, double t1) const {
+    const glm::dvec3 uo = lattice.index(o), ud = d / lattice.voxel;
+    double a = t0, b = t1;
+    for (int ax = 0; ax < 3; ++ax) {
+      const double lo = box.lo[ax] - 1.0, hi = box.hi[ax] + 1.0;
+      if (ud[ax] == 0.0) {
+        if (uo[ax] <= lo || uo[ax] >= hi) return 0.0;
+        continue;
+      }
+      double ta = (lo - uo[ax]) / ud[ax], tb = (hi - uo[ax]) / ud[ax];
+      if (ta > tb) std::swap(ta, tb);
+      a = std::max(a, ta);
+      b = std::min(b, tb);
+    }
+    if (!(b > a)) return 0.0;
+    std::vector<double> ts{a, b};
+    for (int ax = 0; ax < 3; ++ax) {
+      if (ud[ax] == 0.0) continue;
+      for (int k = box.lo[ax] - 1; k <= box.hi[ax] + 1; ++k) {
+        const double t = (k - uo[ax]) / ud[ax];
+        if (t > a && t < b) ts.push_back(t);
+      }
+    }
+    std::sort(ts.begin(), ts.end());
+    static const double x[3] = {-std::sqrt(0.6), 0.0, std::sqrt(0.6)}, w[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
+    double sum = 0.0;
+    for (size_t i = 0; i + 1 < ts.size(); ++i) {
+      const double m = 0.5 * (ts[i] + ts[i + 1]), h = 0.5 * (ts[i + 1] - ts[i]);
+      if (!(h > 0.0)) continue;
+      for (int q = 0; q < 3; ++q) sum += w[q] * h * density(o + (m + h * x[q]) * d);
+    }
+    return sum;
+  }
+  double optical_depth(const glm::dvec3& o, const glm::dvec3& d) const { return optical_depth(o, d, 0.0, 1e300); }
+  int signature(const glm::dvec3& o, const glm::dvec3& d) const {
+    return chord(support_box(lattice, box), o, d).signature * 1000 + chord(centre_box(lattice, box), o, d).signature;
+  }
+};
+
+// Radiance of a single-medium grid scene with constant emission and σa/σt the
+// same everywhere, when no path scatters (σs = 0 or max_depth 0), from the
+// optical depth τ = ∫ρ along the ray (constant_box_radiance for any field):
+//   L = (σa/σt)·Le·(1 − e^{−σt τ}) + bg·e^{−σt τ},  σ = sigma · density_scale.
+inline glm::dvec3 uniform_albedo_radiance(const Scene& s, double tau) {
+  const Medium& m = s.media.at(0);
+  const glm::dvec3 Le = m.emission.emits() && m.emission.rgb ? m.emission.scale * *m.emission.rgb : glm::dvec3(0.0);
+  glm::dvec3 L;
+  for (int c = 0; c < 3; ++c) {
+    const double sa = m.sigma_a[c] * m.density_scale, st = (m.sigma_a[c] + m.sigma_s[c]) * m.density_scale;
+    const double T = std::exp(-st * tau);
+    L[c] = (st > 0.0 ? sa / st * Le[c] * (1.0 - T) : 0.0) + s.background[c] * T;
+  }
+  return L;
+}
+
+// Per-channel transmittance exp(−σt_c·density_scale·τ) along each camera ray
+// to infinity, pixel-averaged (what RenderSettings::debug_mode 1/2 estimates)
+// for a single grid medium whose density is `field`.
+template <class Field>
+std::function<glm::dvec3(int, int)> transmittance_exact(const Scene& s, const Field& field, int base = 4,
+                                                        int max_level = 4, double steep_rel = 0.05) {
+  const Medium& m = s.media.at(0);
+  const glm::dvec3 sigma_t = (m.sigma_a + m.sigma_s) * m.density_scale;
+  return exact_image(
+      s,
+      [sigma_t, &field](const glm::dvec3& o, const glm::dvec3& d, int* sig) {
+        const double tau = field.optical_depth(o, d);
+        if (sig) *sig = field.signature(o, d);
+        return glm::exp(-sigma_t * tau);
+      },
+      base, max_level, steep_rel);
+}
+
 }  // namespace pyrolume::test

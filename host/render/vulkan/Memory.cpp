@@ -246,7 +246,8 @@ uint32_t texel_bytes(VkFormat format) {
     case VK_FORMAT_R16_UNORM: return 2;
     case VK_FORMAT_R32_SFLOAT:
     case VK_FORMAT_R16G16_SFLOAT:
-    case VK_FORMAT_R8G8B8A8_UNORM: return 4;
+    case VK_FORMAT_R8G8B8A8_UNORM:
+    case VK_FORMAT_R8G8B8A8_SRGB: return 4;
     case VK_FORMAT_R32G32_SFLOAT:
     case VK_FORMAT_R16G16B16A16_SFLOAT: return 8;
     case VK_FORMAT_R32G32B32A32_SFLOAT: return 16;
@@ -366,6 +367,19 @@ VkSamplerCreateInfo linear_sampler(VkSamplerAddressMode mode) {
 Image3D::Image3D(Context& ctx, uint32_t width, uint32_t height, uint32_t depth, VkFormat format, const char* name)
     : SampledImage(ctx, VK_IMAGE_TYPE_3D, {width, height, depth}, format,
                    linear_sampler(VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER), name) {}
+
+namespace {
+VkSamplerCreateInfo sampler_2d(VkSamplerAddressMode u_mode, VkSamplerAddressMode v_mode) {
+  VkSamplerCreateInfo s = linear_sampler(u_mode);
+  s.addressModeV = v_mode;
+  s.addressModeW = v_mode;
+  return s;
+}
+}  // namespace
+
+Image2D::Image2D(Context& ctx, uint32_t width, uint32_t height, VkFormat format, VkSamplerAddressMode u_mode,
+                 VkSamplerAddressMode v_mode, const char* name)
+    : SampledImage(ctx, VK_IMAGE_TYPE_2D, {width, height, 1}, format, sampler_2d(u_mode, v_mode), name) {}
 
 Image1D::Image1D(Context& ctx, uint32_t width, VkFormat format, const char* name)
     : SampledImage(ctx, VK_IMAGE_TYPE_1D, {width, 1, 1}, format,

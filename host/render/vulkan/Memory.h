@@ -119,6 +119,16 @@ class Image3D : public SampledImage {
   Image3D(Context& ctx, uint32_t width, uint32_t height, uint32_t depth, VkFormat format, const char* name = nullptr);
 };
 
+// A 2D texture (albedo textures, environment maps): linear filtering; `u_mode`
+// and `v_mode` are the address modes (REPEAT for tiling textures and the
+// lat-long map's longitude, CLAMP_TO_EDGE for its latitude).
+class Image2D : public SampledImage {
+ public:
+  Image2D() = default;
+  Image2D(Context& ctx, uint32_t width, uint32_t height, VkFormat format, VkSamplerAddressMode u_mode,
+          VkSamplerAddressMode v_mode, const char* name = nullptr);
+};
+
 // A 1D table (blackbody LUT): linear filtering, clamp-to-edge.
 class Image1D : public SampledImage {
  public:
