@@ -56,8 +56,9 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   }
 
   // Accepted by the v1 format but not rendered yet: say so rather than ignore silently.
-  if (!scene.shapes.empty())
-    std::cerr << "pyrolume: warning: " << scene.file.string() << ": shapes: surfaces are not rendered yet; ignored\n";
+  if (!scene.shapes.empty() && scene.integrator.mis)
+    std::cerr << "pyrolume: warning: " << scene.file.string()
+              << ": integrator.mis: light sampling is not implemented yet; surfaces are lit by BSDF sampling only\n";
   if (scene.environment)
     std::cerr << "pyrolume: warning: " << scene.file.string()
               << ": environment: environment maps are not rendered yet; background.rgb is used\n";

@@ -95,10 +95,20 @@ struct Medium {
   std::string texture_format = "r16f";  // "r16f" | "r32f" (R32F is also used when values exceed R16F)
 };
 
+// A surface: a triangle mesh (OBJ), an analytic sphere, or a plane (a
+// rectangle, or unbounded along an axis whose size is 0), with a Lambertian
+// material whose albedo is a constant or a texture.
 struct Shape {
-  std::filesystem::path mesh;
+  enum class Type { Mesh, Sphere, Plane };
+  Type type = Type::Mesh;
+  std::filesystem::path mesh;  // mesh
+  Transform transform;         // mesh: scale, rotate (X, Y, Z), translate
+  glm::dvec3 center{0.0};      // sphere, plane
+  double radius = 1.0;         // sphere
+  glm::dvec3 normal{0, 1, 0};  // plane
+  glm::dvec2 size{0.0};        // plane: extent along its u and v axes; 0 = unbounded
   glm::dvec3 albedo{0.5};
-  std::filesystem::path texture;
+  std::filesystem::path texture;  // empty: constant albedo
 };
 
 struct Scene {

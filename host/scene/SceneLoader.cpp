@@ -175,6 +175,8 @@ Emission read_emission(Reader r, bool grid) {
   return e;
 }
 
+Transform read_transform(Reader t);
+
 Medium read_medium(Reader r, const std::filesystem::path& base, int index) {
   Medium m;
   m.name = r.string("name", "medium" + std::to_string(index));
@@ -205,15 +207,7 @@ Medium read_medium(Reader r, const std::filesystem::path& base, int index) {
       if (m.temperature.cutoff_k < 0) t.fail("cutoff_k", "must be >= 0 kelvin");
       t.finish();
     }
-    if (r.has("transform")) {
-      Reader t = r.child("transform");
-      m.transform.translate = t.vec3("translate", m.transform.translate);
-      m.transform.rotate_deg = t.vec3("rotate_deg", m.transform.rotate_deg);
-      m.transform.scale = t.vec3("scale", m.transform.scale);
-      if (m.transform.scale.x == 0 || m.transform.scale.y == 0 || m.transform.scale.z == 0)
-        t.fail("scale", "must be non-zero on every axis");
-      t.finish();
-    }
+    if (r.has("transform")) m.transform = read_transform(r.child("transform"));
   }
   if (r.has("emission")) m.emission = read_emission(r.child("emission"), m.type == Medium::Type::Vdb);
   else m.emission.is_grid = false;
@@ -221,10 +215,46 @@ Medium read_medium(Reader r, const std::filesystem::path& base, int index) {
   return m;
 }
 
+Transform read_transform(Reader t) {
+  Transform x;
+  x.translate = t.vec3("translate", x.translate);
+  x.rotate_deg = t.vec3("rotate_deg", x.rotate_deg);
+  x.scale = t.vec3("scale", x.scale);
+  if (x.scale.x == 0 || x.scale.y == 0 || x.scale.z == 0) t.fail("scale", "must be non-zero on every axis");
+  t.finish();
+  return x;
+}
+
 Shape read_shape(Reader r, const std::filesystem::path& base) {
   Shape s;
-  if (!r.has("mesh")) r.fail("mesh", "missing required key");
-  s.mesh = resolve(base, r.string("mesh", ""));
+  int kinds = int(r.has("mesh")) + int(r.has("sphere")) + int(r.has("plane"));
+  if (kinds != 1) r.fail("", "expected exactly one of \"mesh\", \"sphere\" or \"plane\"");
+  if (r.has("mesh")) {
+    s.type = Shape::Type::Mesh;
+    s.mesh = resolve(base, r.string("mesh", ""));
+    if (r.has("transform")) s.transform = read_transform(r.child("transform"));
+  } else if (r.has("sphere")) {
+    s.type = Shape::Type::Sphere;
+    Reader sp = r.child("sphere");
+    s.center = sp.vec3_required("center");
+    s.radius = sp.number_required("radius");
+    if (!(s.radius > 0)) sp.fail("radius", "must be > 0");
+    sp.finish();
+  } else {
+    s.type = Shape::Type::Plane;
+    Reader pl = r.child("plane");
+    s.center = pl.vec3("center", s.center);
+    s.normal = pl.vec3("normal", s.normal);
+    if (glm::length(s.normal) == 0) pl.fail("normal", "must not be zero");
+    if (pl.has("size")) {
+      const auto& v = pl.raw("size");
+      if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number() || v[0].get<double>() < 0 ||
+          v[1].get<double>() < 0)
+        pl.fail("size", "expected [width, height] >= 0 (0 = unbounded)");
+      s.size = glm::dvec2(v[0].get<double>(), v[1].get<double>());
+    }
+    pl.finish();
+  }
   if (r.has("material")) {
     Reader m = r.child("material");
     if (m.has("diffuse")) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "geometry/SceneSurfaces.h"
 #include "render/vulkan/Spirv.h"
 #include "util/Error.h"
 
@@ -37,6 +38,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                           VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                       vk::MemoryKind::DeviceLocal, "accumulation");
   create_textures(scene);
+  create_surfaces(scene);
 
   // The shader variant: code for grids, scattering and emission only when used.
   auto flag = [](bool b) { return uint32_t(b ? 1 : 0); };
@@ -47,7 +49,10 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
       {gpu::SPEC_COLLISION_ESTIMATOR, flag(scene.integrator.emission_estimator == "collision")},
       {gpu::SPEC_DEBUG_MODE, settings.debug_mode},
       {gpu::SPEC_MEDIUM_COUNT, uint32_t(gpu_scene_.media.size())},
-      {gpu::SPEC_GRID_COUNT, uint32_t(gpu_scene_.grids.size())}};
+      {gpu::SPEC_GRID_COUNT, uint32_t(gpu_scene_.grids.size())},
+      {gpu::SPEC_HAS_SURFACES, flag(!scene.shapes.empty())},
+      {gpu::SPEC_SURFACE_SHAPE_COUNT, gpu_surfaces_.shape_count},
+      {gpu::SPEC_SURFACE_HAS_TRIANGLES, flag(gpu_surfaces_.triangle_count > 0)}};
   pipeline_.emplace(ctx, vk::load_spirv("render.comp"),
                     std::vector<vk::ComputePipeline::Binding>{
                         {gpu::BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
@@ -57,7 +62,13 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                         {gpu::BINDING_MAJORANTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_DENSITY, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS},
                         {gpu::BINDING_TEMPERATURE, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS},
-                        {gpu::BINDING_BLACKBODY, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS}},
+                        {gpu::BINDING_BLACKBODY, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS},
+                        {gpu::BINDING_BVH_NODES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_BVH_TRIANGLES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_BVH_ATTRIBUTES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_SURFACE_SHAPES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_MATERIALS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_TEXTURES, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_TEXTURES}},
                     uint32_t(sizeof(gpu::PassConstants)), spec, "render");
   set_.emplace(ctx, *pipeline_, "render set");
   set_->write_buffer(gpu::BINDING_FRAME, frame_buffer_);
@@ -73,6 +84,13 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
     set_->write_image(gpu::BINDING_TEMPERATURE, textures_3d_[t], slot);
     set_->write_image(gpu::BINDING_BLACKBODY, textures_1d_[b], slot);
   }
+  set_->write_buffer(gpu::BINDING_BVH_NODES, bvh_nodes_);
+  set_->write_buffer(gpu::BINDING_BVH_TRIANGLES, bvh_triangles_);
+  set_->write_buffer(gpu::BINDING_BVH_ATTRIBUTES, bvh_attributes_);
+  set_->write_buffer(gpu::BINDING_SURFACE_SHAPES, surface_shapes_);
+  set_->write_buffer(gpu::BINDING_MATERIALS, materials_);
+  for (uint32_t slot = 0; slot < gpu::MAX_TEXTURES; ++slot)
+    set_->write_image(gpu::BINDING_TEXTURES, textures_2d_[slot + 1 < textures_2d_.size() ? slot + 1 : 0], slot);
   upload_constants(scene);
   // lavapipe compiles a pipeline inside its first dispatch (~0.1–0.5 s,
   // LAVAPIPE.md): dispatch one empty workgroup now so that cost counts as
@@ -140,6 +158,48 @@ void RenderSession::create_textures(const Scene& scene) {
     textures_3d_.push_back(make_3d(s.density, "grid \"" + s.density->grid.name + "\""));
     textures_3d_.push_back(make_3d(s.temperature, s.temperature ? "grid \"" + s.temperature->grid.name + "\"" : ""));
     textures_1d_.push_back(make_lut(s.blackbody ? &*s.blackbody : nullptr));
+  }
+}
+
+// The BVH over every mesh triangle, the analytic shapes, one material per
+// shape and the albedo textures (8-bit sources as SRGB8 so the sampler decodes
+// before filtering, float sources as RGBA32F). Empty scenes get 1-element
+// placeholders (Vulkan has no empty buffers); the spec constants keep the shader
+// from reading them.
+void RenderSession::create_surfaces(const Scene& scene) {
+  geometry::Surfaces surfaces;
+  if (!scene.shapes.empty()) surfaces = geometry::build_surfaces(scene);
+  if (surfaces.textures.size() > gpu::MAX_TEXTURES)
+    throw input_error(scene.file.string(), "shapes",
+                      "at most " + std::to_string(gpu::MAX_TEXTURES) + " different albedo textures per scene");
+  gpu_surfaces_ = geometry::pack_gpu_surfaces(surfaces);
+  auto storage = [&](vk::Buffer& b, const void* data, size_t bytes, const char* name) {
+    b = vk::Buffer(ctx_, bytes, kStorage, vk::MemoryKind::DeviceLocal, name);
+    b.upload(ctx_, data, bytes);
+  };
+  const auto& g = gpu_surfaces_;
+  storage(bvh_nodes_, g.nodes.data(), g.nodes.size() * sizeof(g.nodes[0]), "bvh nodes");
+  storage(bvh_triangles_, g.triangles.data(), g.triangles.size() * sizeof(g.triangles[0]), "bvh triangles");
+  storage(bvh_attributes_, g.attributes.data(), g.attributes.size() * sizeof(g.attributes[0]), "bvh attributes");
+  storage(surface_shapes_, g.shapes.data(), g.shapes.size() * sizeof(g.shapes[0]), "surface shapes");
+  storage(materials_, g.materials.data(), g.materials.size() * sizeof(g.materials[0]), "materials");
+
+  const uint8_t white[4] = {255, 255, 255, 255};
+  textures_2d_.emplace_back(ctx_, 1, 1, VK_FORMAT_R8G8B8A8_SRGB, VK_SAMPLER_ADDRESS_MODE_REPEAT,
+                            VK_SAMPLER_ADDRESS_MODE_REPEAT, "unused texture slot");
+  textures_2d_.back().upload(ctx_, white, sizeof white);
+  for (const geometry::Texture& t : surfaces.textures) {
+    if (t.srgb_source()) {
+      std::vector<uint8_t> texels = t.rgba8_srgb();
+      textures_2d_.emplace_back(ctx_, uint32_t(t.width()), uint32_t(t.height()), VK_FORMAT_R8G8B8A8_SRGB,
+                                VK_SAMPLER_ADDRESS_MODE_REPEAT, VK_SAMPLER_ADDRESS_MODE_REPEAT, "albedo texture");
+      textures_2d_.back().upload(ctx_, texels.data(), texels.size());
+    } else {
+      std::vector<float> texels = t.rgba32f();
+      textures_2d_.emplace_back(ctx_, uint32_t(t.width()), uint32_t(t.height()), VK_FORMAT_R32G32B32A32_SFLOAT,
+                                VK_SAMPLER_ADDRESS_MODE_REPEAT, VK_SAMPLER_ADDRESS_MODE_REPEAT, "albedo texture");
+      textures_2d_.back().upload(ctx_, texels.data(), texels.size() * sizeof(float));
+    }
   }
 }
 

@@ -13,6 +13,7 @@
 #include "render/vulkan/Pipeline.h"
 #include "scene/Scene.h"
 #include "shared/gpu_types.h"
+#include "geometry/Surfaces.h"
 #include "volume/StoredVolume.h"
 
 namespace pyrolume {
@@ -46,6 +47,7 @@ class RenderSession {
  private:
   void upload_constants(const Scene& scene);
   void create_textures(const Scene& scene);
+  void create_surfaces(const Scene& scene);
 
   vk::Context& ctx_;
   RenderSettings settings_;
@@ -55,6 +57,10 @@ class RenderSession {
   vk::Buffer frame_buffer_, media_buffer_, grid_buffer_, majorant_buffer_, accum_;
   std::vector<vk::Image3D> textures_3d_;
   std::vector<vk::Image1D> textures_1d_;
+  // Surfaces: BVH nodes, triangles, triangle attributes, shapes, materials.
+  geometry::GpuSurfaces gpu_surfaces_;
+  vk::Buffer bvh_nodes_, bvh_triangles_, bvh_attributes_, surface_shapes_, materials_;
+  std::vector<vk::Image2D> textures_2d_;  // [0] placeholder, then one per albedo texture
   std::optional<vk::ComputePipeline> pipeline_;
   std::optional<vk::DescriptorSet> set_;
   int spp_done_ = 0;
