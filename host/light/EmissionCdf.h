@@ -1,0 +1,122 @@
+#pragma once
+// An emissive grid medium as a light: a discrete distribution over the cells of
+// its density texture, proportional to (a conservative estimate of) the emitted
+// luminance in each cell, and a uniform point inside the chosen cell
+// (docs/lights.md).
+//
+// Cells. The density texture's texel centres sit at integer cell coordinates
+// c = index − origin (texel i at c = i); cell (i, j, k) is the parallelepiped
+// c ∈ [i, i+1) × [j, j+1) × [k, k+1) in world space, and its 8 corners are
+// exactly the 8 texels every trilinear lookup inside it blends. There are
+// (dims − 1) cells per axis; together they are the texture's support (the
+// density is 0 outside).
+//
+// Weight of a cell (one number, emitted luminance per unit volume):
+//   w = ρ_max · E_max,
+//   ρ_max = the largest of its 8 corner density texels (values as stored),
+//   E_max = the largest E(T) over the temperature texels whose trilinear
+//           footprint reaches into the cell (and E(T(0)) when the footprint
+//           leaves the temperature texture, whose outside reads 0),
+//   E(T)  = Y(σa ⊙ Le(T)): sRGB luminance, σa = sigma_a · density_scale,
+//           Le = emission.scale · blackbody_rgb_5nm(T) with the CPU reference's
+//           rules (0 at or below cutoff_k and below 100 K, T clamped to 1e6 K);
+//           T = (value − offset) · scale. Constant-rgb emission: E = Y(σa ⊙ Le_rgb).
+// The emission at x, σa·ρ(x)·Le(T(x)), is > 0 only if ρ(x) > 0 and
+// T(x) > cutoff; trilinear values are convex combinations of the corners, so
+// then ρ_max > 0 and some footprint texel has T > cutoff: every point that
+// emits has pdf > 0, and the light sampler is unbiased (the integrand is not
+// piecewise constant, so the distribution only approximates it).
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene/Scene.h"
+#include "shared/light_types.h"
+#include "volume/DenseGrid.h"
+#include "volume/StoredVolume.h"
+
+namespace pyrolume {
+
+// A point sampled inside an emissive medium.
+struct EmissionSample {
+  glm::dvec3 p{0.0};  // world space
+  double pdf = 0.0;   // VOLUME measure (1/unit³); 0: no sample. Solid angle from a
+                      // point x: pdf · |p − x|² (no cosine: a medium has no surface)
+  int64_t cell = -1;  // linear cell index x + X·(y + Y·z)
+};
+
+// What the weight needs from a medium.
+struct EmissionParams {
+  glm::dvec3 sigma_a{1.0};  // per unit stored density: sigma_a · density_scale
+  bool emits_rgb = false;   // Le = Le_rgb everywhere
+  glm::dvec3 Le_rgb{0.0};   // emission.scale · emission.rgb
+  bool emits_temperature = false;  // Le from the temperature grid
+  TemperatureMapping temperature;
+  Emission emission;  // blackbody mode, observer, adapt_to_k, scale
+
+  // The medium's parameters, as host/render/cpu/Media.cpp reads them.
+  static EmissionParams from_medium(const Medium& m);
+};
+
+class EmissionCdf {
+ public:
+  EmissionCdf() = default;
+
+  // For a vdb medium whose grids are loaded (load_stored_volume).
+  static EmissionCdf build(const Medium& m, const StoredVolume& vol);
+  // From grids directly. temperature may be null (then emits_temperature emits
+  // nothing, as in the renderers).
+  static EmissionCdf build(const DenseGrid& density, const DenseGrid* temperature, const EmissionParams& p);
+
+  // No emission anywhere (zero density, all temperatures at or below the cutoff,
+  // σa = 0, no grid): no distribution. sample() returns pdf 0, pdf() is 0.
+  bool empty() const { return cdf_.empty(); }
+  glm::ivec3 cells() const { return cells_; }
+  size_t cell_count() const { return size_t(cells_.x) * size_t(cells_.y) * size_t(cells_.z); }
+  size_t entry_count() const { return cdf_.size(); }  // cells of weight > 0
+  double cell_volume() const { return cell_volume_; }
+  // ∫ w dV = Σ w · cell volume: an upper estimate of ∫ Y(σa ρ Le) dV, for
+  // choosing between lights by power.
+  double power() const { return power_; }
+  double seconds_to_build() const { return build_seconds_; }
+
+  // The unnormalised weight w of a cell and its probability (as stored, float).
+  double cell_weight(const glm::ivec3& c) const;
+  double cell_pmf(int64_t cell) const { return pmf_.empty() ? 0.0 : double(pmf_[size_t(cell)]); }
+  int64_t linear_cell(const glm::ivec3& c) const {
+    return (int64_t(c.z) * cells_.y + c.y) * cells_.x + c.x;
+  }
+
+  glm::dvec3 world_to_cell(const glm::dvec3& p) const { return glm::dvec3(world_to_cell_ * glm::dvec4(p, 1.0)); }
+  glm::dvec3 cell_to_world(const glm::dvec3& c) const { return glm::dvec3(cell_to_world_ * glm::dvec4(c, 1.0)); }
+
+  // u picks the cell (searching the float CDF like the GPU); u3 ∈ [0,1)³ the
+  // point inside it: p = cell_to_world(cell + u3), pdf = pmf / cell volume.
+  EmissionSample sample(double u, const glm::dvec3& u3) const;
+  // The volume pdf of the cell containing world point p (0 outside every cell).
+  double pdf(const glm::dvec3& p) const;
+
+  // ---- what the GPU reads (shaders/shared/light_types.h, shaders/lights.glsl) ----
+  const std::vector<float>& gpu_cdf() const { return cdf_; }          // inclusive, last = 1
+  const std::vector<uint32_t>& gpu_cells() const { return entries_; }  // ascending linear cell indices
+  const std::vector<float>& gpu_pmf() const { return pmf_; }          // one per cell
+  // entry_offset / pmf_offset: where this medium's arrays start when several
+  // media share the buffers.
+  gpu::GpuEmissionCdf gpu_header(uint32_t entry_offset = 0, uint32_t pmf_offset = 0) const;
+
+ private:
+  glm::ivec3 cells_{0};
+  glm::dmat4 cell_to_world_{1.0}, world_to_cell_{1.0};
+  double cell_volume_ = 0.0;
+  double power_ = 0.0;
+  double build_seconds_ = 0.0;
+  std::vector<float> weight_;     // w per cell (float; for inspection and tests)
+  std::vector<float> pmf_;        // per cell
+  std::vector<float> cdf_;        // per entry
+  std::vector<uint32_t> entries_; // per entry
+};
+
+}  // namespace pyrolume

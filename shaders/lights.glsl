@@ -1,0 +1,160 @@
+// Light sampling: the environment map and the emission CDF of an emissive grid
+// medium. The GLSL twin of host/light/EnvironmentMap and host/light/EmissionCdf:
+// same names, same argument order, the same searches over the same float CDFs,
+// so the same uniforms give the same samples (docs/lights.md).
+//
+// Contract with the includer. Include shared/light_types.h, then define what
+// you use, then include this file:
+//
+//   #define LIGHTS_ENVIRONMENT   // env_radiance / env_sample / env_pdf, needs:
+//     layout(std430, binding = …) readonly buffer EnvTexelBlock { vec4 env_texels[]; };
+//     layout(std430, binding = …) readonly buffer EnvCdfBlock { float env_cdf[]; };
+//   #define LIGHTS_EMISSION      // emission_sample / emission_pdf, needs:
+//     layout(std430, binding = …) readonly buffer EmissionCdfBlock { float emission_cdf[]; };
+//     layout(std430, binding = …) readonly buffer EmissionCellBlock { uint emission_cells[]; };
+//     layout(std430, binding = …) readonly buffer EmissionPmfBlock { float emission_pmf[]; };
+//
+// The GpuEnvironment / GpuEmissionCdf headers are passed by value (keep them in
+// a uniform block). Block names are free; the array names are the contract.
+#ifndef PYROLUME_LIGHTS_GLSL
+#define PYROLUME_LIGHTS_GLSL
+
+const float LIGHTS_PI = 3.14159265358979;
+
+#ifdef LIGHTS_ENVIRONMENT
+
+struct EnvSample {
+  vec3 dir;       // unit, world space, away from the scene
+  float pdf;      // solid angle (1/sr); 0: no sample
+  vec3 radiance;  // scale included
+};
+
+// Map (u, v) of a world direction: Rz(−rotation)·d, then u = 0.5 − φ/2π, v = θ/π.
+vec2 env_direction_to_uv(GpuEnvironment env, vec3 d) {
+  float c = env.transform.x, s = env.transform.y;
+  float x = c * d.x + s * d.y;
+  float y = -s * d.x + c * d.y;
+  float cos_theta = clamp(d.z / length(d), -1.0, 1.0);
+  float u = 0.5 - atan(y, x) * (0.5 / LIGHTS_PI);
+  u = u >= 1.0 ? u - 1.0 : (u < 0.0 ? u + 1.0 : u);
+  return vec2(u, acos(cos_theta) * (1.0 / LIGHTS_PI));
+}
+
+// θ = π·v, φ = π − 2π·u, then Rz(rotation).
+vec3 env_uv_to_direction(GpuEnvironment env, vec2 uv) {
+  float theta = LIGHTS_PI * uv.y, phi = LIGHTS_PI - 2.0 * LIGHTS_PI * uv.x;
+  float st = sin(theta);
+  float x = st * cos(phi), y = st * sin(phi);
+  float c = env.transform.x, s = env.transform.y;
+  return vec3(c * x - s * y, s * x + c * y, cos(theta));
+}
+
+// Bilinear between texel centres, wrapping in u, clamping in v (no scale).
+vec3 env_lookup_uv(GpuEnvironment env, vec2 uv) {
+  int W = int(env.size.x), H = int(env.size.y);
+  float x = uv.x * float(W) - 0.5, y = uv.y * float(H) - 0.5;
+  float x0 = floor(x), y0 = floor(y);
+  float fx = x - x0, fy = y - y0;
+  int i0 = int(x0) % W;  // GLSL % of a negative int is undefined: wrap by hand
+  if (int(x0) < 0) i0 = W - 1;
+  int i1 = i0 + 1 >= W ? 0 : i0 + 1;
+  int j0 = clamp(int(y0), 0, H - 1), j1 = clamp(int(y0) + 1, 0, H - 1);
+  vec3 a = env_texels[j0 * W + i0].rgb, b = env_texels[j0 * W + i1].rgb;
+  vec3 c = env_texels[j1 * W + i0].rgb, d = env_texels[j1 * W + i1].rgb;
+  return mix(mix(a, b, fx), mix(c, d, fx), fy);
+}
+
+vec3 env_radiance(GpuEnvironment env, vec3 dir) {
+  return env.transform.z * env_lookup_uv(env, env_direction_to_uv(env, dir));
+}
+
+// The largest i in [0, n) with env_cdf[base + i] <= u, and u's place inside the
+// bin (host/light/PiecewiseConstant.h sample_cdf).
+uint env_sample_cdf(uint base, uint n, float u, out float offset) {
+  uint lo = 0u, hi = n - 1u;
+  while (lo < hi) {
+    uint mid = (lo + hi + 1u) / 2u;
+    if (env_cdf[base + mid] <= u) lo = mid; else hi = mid - 1u;
+  }
+  float a = env_cdf[base + lo], b = env_cdf[base + lo + 1u];
+  offset = b > a ? clamp((u - a) / (b - a), 0.0, 0.99999994) : 0.0;
+  return lo;
+}
+
+// Solid-angle pdf = p_uv / (2π² sinθ), p_uv the texel's piecewise-constant density.
+EnvSample env_sample(GpuEnvironment env, vec2 u2) {
+  EnvSample s;
+  s.dir = vec3(0.0, 0.0, 1.0);
+  s.pdf = 0.0;
+  s.radiance = vec3(0.0);
+  if (env.size.z == 0u) return s;
+  uint W = env.size.x, H = env.size.y;
+  float dv, du;
+  uint j = env_sample_cdf(0u, H, u2.y, dv);
+  uint i = env_sample_cdf((H + 1u) + j * (W + 1u), W, u2.x, du);
+  vec2 uv = vec2((float(i) + du) / float(W), (float(j) + dv) / float(H));
+  float sin_theta = sin(LIGHTS_PI * uv.y);
+  if (!(sin_theta > 0.0)) return s;
+  s.dir = env_uv_to_direction(env, uv);
+  s.pdf = env_texels[j * W + i].w / (2.0 * LIGHTS_PI * LIGHTS_PI * sin_theta);
+  s.radiance = env.transform.z * env_lookup_uv(env, uv);
+  return s;
+}
+
+float env_pdf(GpuEnvironment env, vec3 dir) {
+  if (env.size.z == 0u) return 0.0;
+  vec2 uv = env_direction_to_uv(env, dir);
+  float sin_theta = sin(LIGHTS_PI * uv.y);
+  if (!(sin_theta > 0.0)) return 0.0;
+  uint W = env.size.x, H = env.size.y;
+  uint i = min(uint(uv.x * float(W)), W - 1u), j = min(uint(uv.y * float(H)), H - 1u);
+  return env_texels[j * W + i].w / (2.0 * LIGHTS_PI * LIGHTS_PI * sin_theta);
+}
+
+#endif  // LIGHTS_ENVIRONMENT
+
+#ifdef LIGHTS_EMISSION
+
+struct EmissionSample {
+  vec3 p;     // world space
+  float pdf;  // VOLUME measure (1/unit³); from x in solid angle: pdf·|p − x|² (no cosine)
+  uint cell;  // linear cell index; 0xffffffff: no sample
+};
+
+// Cell by the inclusive CDF (the first entry whose CDF exceeds u), then a
+// uniform point in the cell's world-space parallelepiped.
+EmissionSample emission_sample(GpuEmissionCdf e, float u, vec3 u3) {
+  EmissionSample s;
+  s.p = vec3(0.0);
+  s.pdf = 0.0;
+  s.cell = 0xffffffffu;
+  uint n = e.cells.w;
+  if (n == 0u) return s;
+  uint base = e.offsets.x;
+  uint lo = 0u, hi = n - 1u;
+  while (lo < hi) {
+    uint mid = (lo + hi) / 2u;
+    if (emission_cdf[base + mid] <= u) lo = mid + 1u; else hi = mid;
+  }
+  uint cell = emission_cells[base + lo];
+  uint X = e.cells.x, Y = e.cells.y;
+  vec4 c1 = vec4(float(cell % X) + u3.x, float((cell / X) % Y) + u3.y, float(cell / (X * Y)) + u3.z, 1.0);
+  s.p = vec3(dot(e.cell_to_world_row0, c1), dot(e.cell_to_world_row1, c1), dot(e.cell_to_world_row2, c1));
+  s.pdf = emission_pmf[e.offsets.y + cell] * e.measure.y;
+  s.cell = cell;
+  return s;
+}
+
+// Volume pdf of the cell containing world point p (0 outside the grid's cells).
+float emission_pdf(GpuEmissionCdf e, vec3 p) {
+  if (e.cells.w == 0u) return 0.0;
+  vec4 p1 = vec4(p, 1.0);
+  vec3 c = floor(vec3(dot(e.world_to_cell_row0, p1), dot(e.world_to_cell_row1, p1), dot(e.world_to_cell_row2, p1)));
+  if (any(lessThan(c, vec3(0.0))) || any(greaterThanEqual(c, vec3(e.cells.xyz)))) return 0.0;
+  uint cell = (uint(c.z) * e.cells.y + uint(c.y)) * e.cells.x + uint(c.x);
+  return emission_pmf[e.offsets.y + cell] * e.measure.y;
+}
+
+#endif  // LIGHTS_EMISSION
+
+#endif  // PYROLUME_LIGHTS_GLSL

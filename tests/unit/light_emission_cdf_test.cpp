@@ -1,0 +1,368 @@
+// The emissive volume as a light (host/light/EmissionCdf): the point density
+// against the cell weights (chi-square, tests/support/Stats.h), pdf(point) vs
+// the sampled pdf, coverage of every emitting point (max over the corners and
+// over the temperature footprint), the empty case, and the demo fire.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "color/Blackbody.h"
+#include "color/ColorSpace.h"
+#include "light/EmissionCdf.h"
+#include "scene/Scene.h"
+#include "support/Stats.h"
+#include "volume/StoredVolume.h"
+
+using namespace pyrolume;
+
+namespace {
+
+// An affine index->world map with rotation, shear, anisotropic scale and an offset.
+glm::dmat4 skewed_map(double voxel, const glm::dvec3& translate) {
+  glm::dmat4 m = glm::translate(glm::dmat4(1.0), translate);
+  m = glm::rotate(m, 0.4, glm::normalize(glm::dvec3(1, 2, 3)));
+  glm::dmat4 shear(1.0);
+  shear[1][0] = 0.2;  // x += 0.2 y
+  m = m * shear * glm::scale(glm::dmat4(1.0), glm::dvec3(voxel, voxel * 1.3, voxel * 0.8));
+  return m;
+}
+
+DenseGrid make_grid(glm::ivec3 dims, glm::ivec3 origin, const glm::dmat4& index_to_world) {
+  DenseGrid g;
+  g.name = "g";
+  g.dims = dims;
+  g.origin = origin;
+  g.index_to_world = index_to_world;
+  g.world_to_index = glm::inverse(index_to_world);
+  g.values.assign(g.texel_count(), 0.0f);
+  return g;
+}
+
+float& at(DenseGrid& g, int i, int j, int k) {
+  return g.values[(size_t(k) * g.dims.y + j) * g.dims.x + i];
+}
+
+// Random density with zeros, padding 0 on every side (as the loader stores it).
+DenseGrid random_density(uint32_t seed) {
+  DenseGrid g = make_grid({9, 8, 7}, {-3, 2, 5}, skewed_map(0.25, {1.0, -0.5, 2.0}));
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> U(0.0f, 1.0f);
+  for (int k = 1; k < g.dims.z - 1; ++k)
+    for (int j = 1; j < g.dims.y - 1; ++j)
+      for (int i = 1; i < g.dims.x - 1; ++i) at(g, i, j, k) = U(rng) < 0.4f ? 0.0f : U(rng);
+  return g;
+}
+
+// A temperature grid at its own coarser, offset lattice over the same region.
+DenseGrid random_temperature(const DenseGrid& density, uint32_t seed) {
+  glm::dmat4 m = density.index_to_world * glm::translate(glm::dmat4(1.0), glm::dvec3(-3.3, 2.2, 4.6)) *
+                 glm::scale(glm::dmat4(1.0), glm::dvec3(1.7));
+  DenseGrid t = make_grid({7, 6, 6}, {0, 0, 0}, m);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> U(0.0f, 2.0f);
+  for (float& v : t.values) v = U(rng);  // T = v·1000 K: below and above the 800 K cutoff
+  return t;
+}
+
+EmissionParams temperature_params() {
+  EmissionParams p;
+  p.sigma_a = {1.0, 2.0, 0.5};
+  p.emits_temperature = true;
+  p.temperature.scale = 1000.0;
+  p.temperature.offset = 0.0;
+  p.temperature.cutoff_k = 800.0;
+  p.emission.scale = 3.0;
+  p.emission.blackbody = BlackbodyMode::Seed;
+  p.emission.is_grid = true;
+  return p;
+}
+
+EmissionParams rgb_params() {
+  EmissionParams p;
+  p.sigma_a = {1.0, 2.0, 0.5};
+  p.emits_rgb = true;
+  p.Le_rgb = {2.0, 1.0, 0.25};
+  return p;
+}
+
+// The emitted radiance per unit length at p, as the renderers compute it
+// (host/render/cpu/Media.h grid_sigma_a_Le), luminance only.
+double emitted_luminance(const DenseGrid& density, const DenseGrid* temperature, const EmissionParams& p,
+                         const glm::dvec3& x) {
+  const double rho = density.sample_world(x);
+  if (!(rho > 0.0)) return 0.0;
+  glm::dvec3 Le = p.Le_rgb;
+  if (!p.emits_rgb) {
+    const double T = (temperature->sample_world(x) - p.temperature.offset) * p.temperature.scale;
+    if (!(T > p.temperature.cutoff_k) || T < 100.0) return 0.0;
+    Le = p.emission.scale * color::blackbody_rgb_5nm(std::min(T, 1e6), p.emission.blackbody);
+  }
+  return color::srgb_luminance(p.sigma_a * rho * Le);
+}
+
+glm::ivec3 cell_of(const DenseGrid& density, const glm::dvec3& p) {
+  return glm::ivec3(glm::floor(glm::dvec3(density.world_to_index * glm::dvec4(p, 1.0)) - glm::dvec3(density.origin)));
+}
+
+// Chi-square of sampled points against per-cell weights, each cell split into
+// 2×2×2 sub-bins (uniformity inside the cell is tested too).
+test::ChiSquareResult chi_square_cells(const EmissionCdf& cdf, const DenseGrid& density,
+                                       const std::function<double(glm::ivec3)>& weight, int n, uint32_t seed) {
+  const glm::ivec3 C = cdf.cells();
+  const size_t nbins = cdf.cell_count() * 8;
+  std::vector<double> observed(nbins, 0.0), expected(nbins, 0.0);
+  double total = 0.0;
+  for (int k = 0; k < C.z; ++k)
+    for (int j = 0; j < C.y; ++j)
+      for (int i = 0; i < C.x; ++i) total += weight({i, j, k});
+  for (int k = 0; k < C.z; ++k)
+    for (int j = 0; j < C.y; ++j)
+      for (int i = 0; i < C.x; ++i)
+        for (int s = 0; s < 8; ++s) expected[size_t(cdf.linear_cell({i, j, k})) * 8 + s] = n * weight({i, j, k}) / total / 8;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  for (int k = 0; k < n; ++k) {
+    EmissionSample s = cdf.sample(U(rng), {U(rng), U(rng), U(rng)});
+    const glm::dvec3 c = glm::dvec3(density.world_to_index * glm::dvec4(s.p, 1.0)) - glm::dvec3(density.origin);
+    const glm::ivec3 cell = glm::ivec3(glm::floor(c));
+    const glm::dvec3 f = c - glm::floor(c);
+    if (glm::any(glm::lessThan(cell, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(cell, C))) {
+      ADD_FAILURE() << "sample outside the grid";
+      continue;
+    }
+    const int sub = (f.x >= 0.5) + 2 * (f.y >= 0.5) + 4 * (f.z >= 0.5);
+    observed[size_t(cdf.linear_cell(cell)) * 8 + sub] += 1.0;
+  }
+  return test::chi_square(observed, expected);
+}
+
+double corner_max(const DenseGrid& g, glm::ivec3 c) {
+  double m = 0.0;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) m = std::max(m, double(g.texel(c.x + i, c.y + j, c.z + k)));
+  return m;
+}
+
+}  // namespace
+
+TEST(EmissionCdf, ConstantEmissionWeightsAreTheCornerMaximaTimesLuminance) {
+  DenseGrid d = random_density(1);
+  EmissionParams p = rgb_params();
+  EmissionCdf cdf = EmissionCdf::build(d, nullptr, p);
+  ASSERT_FALSE(cdf.empty());
+  EXPECT_EQ(cdf.cells(), d.dims - 1);
+  const double E = color::srgb_luminance(p.sigma_a * p.Le_rgb);
+  double sum_pmf = 0.0;
+  for (int k = 0; k < cdf.cells().z; ++k)
+    for (int j = 0; j < cdf.cells().y; ++j)
+      for (int i = 0; i < cdf.cells().x; ++i) {
+        EXPECT_NEAR(cdf.cell_weight({i, j, k}), corner_max(d, {i, j, k}) * E, 1e-6);
+        sum_pmf += cdf.cell_pmf(cdf.linear_cell({i, j, k}));
+      }
+  EXPECT_NEAR(sum_pmf, 1.0, 1e-6);
+  // |det| of the cell: voxel 0.25 × 0.325 × 0.2 (rotation and shear keep volume).
+  EXPECT_NEAR(cdf.cell_volume(), 0.25 * 0.325 * 0.2, 1e-12);
+}
+
+TEST(EmissionCdf, PointsFollowTheCellWeightsChiSquare) {
+  DenseGrid d = random_density(2);
+  DenseGrid t = random_temperature(d, 3);
+  EmissionCdf cdf = EmissionCdf::build(d, &t, temperature_params());
+  ASSERT_FALSE(cdf.empty());
+  auto w = [&](glm::ivec3 c) { return cdf.cell_weight(c); };
+  test::ChiSquareResult r = chi_square_cells(cdf, d, w, 400000, 5);
+  std::printf("emission CDF chi-square: %s\n", r.summary().c_str());
+  EXPECT_GT(r.p_value, 0.01) << r.summary();
+  // The harness can fail: against weights from each cell's first corner only,
+  // the same samples are rejected.
+  test::ChiSquareResult wrong = chi_square_cells(
+      cdf, d, [&](glm::ivec3 c) { return cdf.cell_weight(c) > 0 ? std::max(double(d.texel(c.x, c.y, c.z)), 1e-3) : 0.0; },
+      400000, 5);
+  EXPECT_LT(wrong.p_value, 1e-6) << wrong.summary();
+  // With constant emission the expected weights are independent of the code.
+  EmissionCdf rgb = EmissionCdf::build(d, nullptr, rgb_params());
+  test::ChiSquareResult r2 = chi_square_cells(rgb, d, [&](glm::ivec3 c) { return corner_max(d, c); }, 400000, 6);
+  EXPECT_GT(r2.p_value, 0.01) << r2.summary();
+}
+
+TEST(EmissionCdf, PdfOfAPointEqualsTheSampledPdf) {
+  DenseGrid d = random_density(4);
+  DenseGrid t = random_temperature(d, 5);
+  EmissionCdf cdf = EmissionCdf::build(d, &t, temperature_params());
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  for (int k = 0; k < 20000; ++k) {
+    EmissionSample s = cdf.sample(U(rng), {U(rng), U(rng), U(rng)});
+    ASSERT_GT(s.pdf, 0.0);
+    ASSERT_EQ(cdf.pdf(s.p), s.pdf) << k;
+    ASSERT_EQ(cdf.linear_cell(cell_of(d, s.p)), s.cell);
+    ASSERT_NEAR(s.pdf, cdf.cell_pmf(s.cell) / cdf.cell_volume(), 1e-12 * s.pdf);
+  }
+  // ∫ pdf dV = 1 by Monte Carlo over the grid's cell box: E[pdf]·V_box.
+  double acc = 0.0;
+  const int n = 200000;
+  const glm::dvec3 C(cdf.cells());
+  for (int k = 0; k < n; ++k) acc += cdf.pdf(cdf.cell_to_world(C * glm::dvec3(U(rng), U(rng), U(rng))));
+  const double V = cdf.cell_volume() * C.x * C.y * C.z;
+  EXPECT_NEAR(acc / n * V, 1.0, 0.05);
+  EXPECT_EQ(cdf.pdf(cdf.cell_to_world({-0.01, 1, 1})), 0.0);  // outside
+  EXPECT_EQ(cdf.pdf(cdf.cell_to_world(C + 0.01)), 0.0);
+}
+
+TEST(EmissionCdf, EveryEmittingPointHasPositivePdf) {
+  // One density texel and emission blended into the 8 cells around it.
+  {
+    DenseGrid d = make_grid({9, 9, 9}, {0, 0, 0}, skewed_map(0.5, {0, 0, 0}));
+    at(d, 4, 4, 4) = 1.0f;
+    EmissionCdf cdf = EmissionCdf::build(d, nullptr, rgb_params());
+    EXPECT_EQ(cdf.entry_count(), 8u);
+    std::mt19937_64 rng(1);
+    std::uniform_real_distribution<double> U(2.5, 5.5);
+    int emitting = 0;
+    for (int k = 0; k < 20000; ++k) {
+      const glm::dvec3 x = cdf.cell_to_world({U(rng), U(rng), U(rng)});
+      if (emitted_luminance(d, nullptr, rgb_params(), x) > 0.0) {
+        ++emitting;
+        ASSERT_GT(cdf.pdf(x), 0.0);
+      }
+    }
+    EXPECT_GT(emitting, 2000);
+  }
+  // Dense smoke everywhere, one hot texel on a coarser, shifted temperature
+  // lattice: every cell its trilinear footprint reaches must be sampleable.
+  {
+    DenseGrid d = make_grid({12, 12, 12}, {0, 0, 0}, skewed_map(0.5, {0, 0, 0}));
+    for (int k = 1; k < 11; ++k)
+      for (int j = 1; j < 11; ++j)
+        for (int i = 1; i < 11; ++i) at(d, i, j, k) = 1.0f;
+    glm::dmat4 m = d.index_to_world * glm::translate(glm::dmat4(1.0), glm::dvec3(0.3, 0.7, 0.45)) *
+                   glm::scale(glm::dmat4(1.0), glm::dvec3(2.0));
+    DenseGrid t = make_grid({6, 6, 6}, {0, 0, 0}, m);
+    at(t, 3, 2, 3) = 1.5f;  // 1500 K; everything else 0 K
+    EmissionParams p = temperature_params();
+    EmissionCdf cdf = EmissionCdf::build(d, &t, p);
+    ASSERT_FALSE(cdf.empty());
+    // Cells whose own centre is cold but that the hot texel's footprint
+    // reaches: a centre-only weight would miss them.
+    std::mt19937_64 rng(2);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    int emitting = 0, cold_centre = 0;
+    const glm::dvec3 hot = glm::dvec3(t.index_to_world * glm::dvec4(3, 2, 3, 1));
+    const glm::dvec3 hot_c = cdf.world_to_cell(hot);
+    for (int k = 0; k < 50000; ++k) {
+      const glm::dvec3 c = hot_c + 5.0 * glm::dvec3(U(rng) - 0.5, U(rng) - 0.5, U(rng) - 0.5);
+      const glm::dvec3 x = cdf.cell_to_world(c);
+      if (emitted_luminance(d, &t, p, x) > 0.0) {
+        ++emitting;
+        ASSERT_GT(cdf.pdf(x), 0.0) << c.x << " " << c.y << " " << c.z;
+        const glm::dvec3 centre = cdf.cell_to_world(glm::floor(c) + 0.5);
+        if (emitted_luminance(d, &t, p, centre) == 0.0) ++cold_centre;
+      }
+    }
+    EXPECT_GT(emitting, 300);
+    EXPECT_GT(cold_centre, 0);
+  }
+  // Outside the temperature grid the value reads 0, which this mapping puts
+  // above the cutoff (T = (0 + 1)·1000 K): smoke there emits too.
+  {
+    DenseGrid d = random_density(8);
+    DenseGrid t = make_grid({3, 3, 3}, {0, 0, 0}, glm::scale(glm::dmat4(1.0), glm::dvec3(0.01)));
+    EmissionParams p = temperature_params();
+    p.temperature.offset = -1.0;
+    EmissionCdf cdf = EmissionCdf::build(d, &t, p);
+    ASSERT_FALSE(cdf.empty());
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    const glm::dvec3 C(cdf.cells());
+    int emitting = 0;
+    for (int k = 0; k < 20000; ++k) {
+      const glm::dvec3 x = cdf.cell_to_world(C * glm::dvec3(U(rng), U(rng), U(rng)));
+      if (emitted_luminance(d, &t, p, x) > 0.0) {
+        ++emitting;
+        ASSERT_GT(cdf.pdf(x), 0.0);
+      }
+    }
+    EXPECT_GT(emitting, 5000);
+  }
+}
+
+TEST(EmissionCdf, NoEmissionGivesNoDistribution) {
+  DenseGrid d = random_density(9);
+  DenseGrid t = random_temperature(d, 10);
+  auto expect_empty = [](const EmissionCdf& cdf, const char* what) {
+    EXPECT_TRUE(cdf.empty()) << what;
+    EXPECT_EQ(cdf.entry_count(), 0u) << what;
+    EXPECT_EQ(cdf.power(), 0.0) << what;
+    EXPECT_EQ(cdf.sample(0.5, {0.5, 0.5, 0.5}).pdf, 0.0) << what;
+    EXPECT_EQ(cdf.pdf(glm::dvec3(1.0, -0.5, 2.0)), 0.0) << what;
+    EXPECT_EQ(cdf.gpu_header().cells.w, 0u) << what;
+  };
+  DenseGrid zero = d;
+  std::fill(zero.values.begin(), zero.values.end(), 0.0f);
+  expect_empty(EmissionCdf::build(zero, &t, temperature_params()), "zero density");
+  EmissionParams cold = temperature_params();
+  cold.temperature.cutoff_k = 5000.0;  // every texel is below 2000 K
+  expect_empty(EmissionCdf::build(d, &t, cold), "all below the cutoff");
+  EmissionParams black = temperature_params();
+  black.sigma_a = glm::dvec3(0.0);
+  expect_empty(EmissionCdf::build(d, &t, black), "sigma_a 0");
+  expect_empty(EmissionCdf::build(d, nullptr, temperature_params()), "no temperature grid");
+  expect_empty(EmissionCdf::build(DenseGrid{}, &t, temperature_params()), "empty density grid");
+  expect_empty(EmissionCdf{}, "default");
+}
+
+TEST(EmissionCdf, DemoFireWithItsSceneParameters) {
+  const Scene scene = load_scene(std::filesystem::path(PYROLUME_SOURCE_DIR) / "assets/scenes/fire.json");
+  ASSERT_FALSE(scene.media.empty());
+  const Medium& m = scene.media[0];
+  const StoredVolume vol = load_stored_volume(m);
+  ASSERT_TRUE(vol.temperature);
+  const EmissionCdf cdf = EmissionCdf::build(m, vol);
+  ASSERT_FALSE(cdf.empty());
+  std::printf("fire.vdb: %d x %d x %d cells (%zu), %zu emitting (%.1f %%), built in %.1f ms, power %.4g\n",
+              cdf.cells().x, cdf.cells().y, cdf.cells().z, cdf.cell_count(), cdf.entry_count(),
+              100.0 * cdf.entry_count() / cdf.cell_count(), 1e3 * cdf.seconds_to_build(), cdf.power());
+  EXPECT_LT(cdf.entry_count(), cdf.cell_count());
+  const DenseGrid& d = vol.density.grid;
+  const DenseGrid& t = vol.temperature->grid;
+  const EmissionParams p = EmissionParams::from_medium(m);
+
+  // Chi-square on 8³-cell blocks against the summed pmf.
+  const glm::ivec3 B = (cdf.cells() + 7) / 8;
+  std::vector<double> expected(size_t(B.x) * B.y * B.z, 0.0), observed(expected.size(), 0.0);
+  auto block = [&](glm::ivec3 c) { return (size_t(c.z / 8) * B.y + c.y / 8) * B.x + c.x / 8; };
+  const int n = 400000;
+  for (int k = 0; k < cdf.cells().z; ++k)
+    for (int j = 0; j < cdf.cells().y; ++j)
+      for (int i = 0; i < cdf.cells().x; ++i) expected[block({i, j, k})] += n * cdf.cell_pmf(cdf.linear_cell({i, j, k}));
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  std::vector<glm::dvec3> points;
+  for (int k = 0; k < n; ++k) {
+    EmissionSample s = cdf.sample(U(rng), {U(rng), U(rng), U(rng)});
+    observed[block(cell_of(d, s.p))] += 1.0;
+    if (k < 20000) points.push_back(s.p);
+  }
+  test::ChiSquareResult r = test::chi_square(observed, expected);
+  std::printf("fire.vdb block chi-square: %s\n", r.summary().c_str());
+  EXPECT_GT(r.p_value, 0.01) << r.summary();
+
+  // Coverage near the emitting region: sampled points moved by up to ±2 cells
+  // (into the blended fringe) still have pdf > 0 wherever they emit.
+  int emitting = 0;
+  for (const glm::dvec3& x0 : points) {
+    const glm::dvec3 c = cdf.world_to_cell(x0) + 4.0 * glm::dvec3(U(rng) - 0.5, U(rng) - 0.5, U(rng) - 0.5);
+    const glm::dvec3 x = cdf.cell_to_world(c);
+    if (emitted_luminance(d, &t, p, x) > 0.0) {
+      ++emitting;
+      ASSERT_GT(cdf.pdf(x), 0.0) << c.x << " " << c.y << " " << c.z;
+    }
+  }
+  EXPECT_GT(emitting, 10000);
+}
