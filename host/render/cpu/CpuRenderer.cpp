@@ -5,12 +5,17 @@
 #include <chrono>
 #include <cstdio>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 #include <vector>
 
 #include "color/Blackbody.h"
+#include "geometry/SceneSurfaces.h"
+#include "geometry/Surfaces.h"
+#include "light/EnvironmentMap.h"
 #include "render/cpu/Media.h"
 #include "render/cpu/Rng.h"
 #include "render/cpu/Sampling.h"
@@ -36,44 +41,88 @@ struct ThreadCounters {
   uint64_t nonfinite = 0;
 };
 
-// One analog random walk of a *grey* medium: colour channel c alone.
+// What every walk reads: the media, the surfaces, what escaping rays see, and
+// the integrator's settings.
+struct WalkScene {
+  const MediaData& md;
+  const geometry::Surfaces& surfaces;
+  const EnvironmentMap* environment;  // null: the constant background
+  glm::dvec3 background;
+  int max_depth;
+  bool collision_estimator;
+
+  // Radiance of channel c seen by a ray escaping along d (camera and scattered
+  // rays alike): the environment map replaces background.rgb (DESIGN.md).
+  double escaped(const glm::dvec3& d, int c) const {
+    return environment ? environment->radiance(d)[c] : background[c];
+  }
+};
+
+// One random walk of a *grey* world: colour channel c alone.
 //
-// Chromatic σ: each RGB channel is rendered as its own grey medium by an
-// independent scalar walk (σa_c, σs_c, Le_c, background_c). Each walk is the
-// textbook analog estimator of that channel's radiance, so the per-channel mean
-// is unbiased trivially; the walks share only the camera ray, which does not
-// bias a per-channel mean. (The GPU path instead tracks a max-channel majorant
-// with spectral weights; keeping this one different is the point.)
+// Chromatic σ and albedo: each RGB channel is rendered as its own grey world
+// by an independent scalar walk (σa_c, σs_c, Le_c, albedo_c, background_c).
+// Each walk is the textbook estimator of that channel's radiance, so the
+// per-channel mean is unbiased trivially; the walks share only the camera ray,
+// which does not bias a per-channel mean. (The GPU path instead tracks a
+// max-channel majorant with spectral weights; keeping this one different is
+// the point.)
 //
-// Free flights: delta tracking (Woodcock et al. 1965). Between consecutive
-// bounds crossings the set of media is fixed and its majorant σ̄ is the sum of
-// their global majorants (Media.h); tentative collisions are sampled from
-// σ̄ exp(−σ̄ t), restarting at each crossing (the exponential is memoryless).
-// At a tentative collision x one uniform u picks: absorption with probability
-// σa(x)/σ̄, scattering with σs(x)/σ̄, a null collision with 1 − σt(x)/σ̄. Where
-// only homogeneous media are present σt = σ̄ and this is the analog walk.
+// Each ray segment first finds the closest surface hit t_surf (Surfaces.h);
+// media beyond it are irrelevant.
 //
-// Emission estimators (integrator.emission_estimator):
-//  - "absorption": an absorbed path returns the absorbing mixture's
-//    Le = Σ σa_i Le_i / σa at x; escaping returns the background.
+// Free flights: delta tracking (Woodcock et al. 1965) on [0, t_surf). Between
+// consecutive bounds crossings the set of media is fixed and its majorant σ̄
+// is the sum of their global majorants (Media.h); tentative collisions are
+// sampled from σ̄ exp(−σ̄ t), restarting at each crossing and stopping at
+// t_surf (the exponential is memoryless). At a tentative collision x one
+// uniform u picks: absorption with probability σa(x)/σ̄, scattering with
+// σs(x)/σ̄, a null collision with 1 − σt(x)/σ̄. Where only homogeneous media
+// are present σt = σ̄ and this is the analog walk.
+//
+// Surfaces: no collision before t_surf ⇒ the path reaches the surface. Opaque,
+// two-sided Lambertian: the new direction is cosine-distributed around the
+// geometric normal flipped to the side the ray came from, n_f; f·cos θ/p =
+// albedo, so the path weight β is multiplied by albedo_c(uv) (BSDF sampling
+// only: no next-event estimation yet). The new ray starts at
+// offset_ray_origin(p, n_f) so it cannot hit the surface it leaves. Surfaces
+// do not emit.
+//
+// Emission estimators (integrator.emission_estimator), β the path weight
+// (the product of the surface albedos met so far; medium events keep it,
+// their probabilities equal the coefficient ratios):
+//  - "absorption": an absorbed path returns β · Le of the absorbing mixture,
+//    Le = Σ σa_i Le_i / σa at x; escaping returns β · background.
 //  - "collision" (pbrt-v4 §14.2, VolPathIntegrator: beta · σa · Le / σ_maj at
-//    every majorant sample): at EVERY tentative collision add Σ σa_i Le_i(x)/σ̄,
-//    then absorb (end), scatter or continue; escaping adds the background. In an
-//    analog grey walk the throughput stays 1: the event probabilities equal the
-//    coefficient ratios, so the weights cancel.
+//    every majorant sample): at EVERY tentative collision add β Σ σa_i Le_i(x)/σ̄,
+//    then absorb (end), scatter or continue; escaping adds β · background.
 // Scattering picks medium i's HG lobe with probability σs_i/σs (mixture phase
-// function). The (max_depth+1)-th scattering ends the path: the absorption
-// estimator returns 0, the collision estimator keeps what it collected before.
-double walk_channel(const MediaData& md, int c, double background, int max_depth, bool collision_estimator,
-                    glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt, Scratch& s) {
+// function). Medium scatterings and surface bounces count together toward
+// max_depth: the (max_depth+1)-th ends the path with nothing more (the
+// absorption estimator returns 0, the collision estimator keeps what it
+// collected before). Both count as real events.
+double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
+                    Scratch& s) {
+  const MediaData& md = ws.md;
+  const bool collision_estimator = ws.collision_estimator;
+  const bool has_surfaces = !ws.surfaces.empty();
   int scatters = 0;
-  double L = 0.0;  // the collision estimator's running sum
+  double beta = 1.0;  // path weight: product of the albedos of the surface bounces so far
+  double L = 0.0;     // the collision estimator's running sum
   for (;;) {
+    // The closest surface bounds this segment.
+    geometry::SurfaceHit hit;
+    const bool hit_surface = has_surfaces && geometry::intersect(ws.surfaces, geometry::Ray{o, d},
+                                                                 std::numeric_limits<double>::infinity(), hit);
+    const double t_surf = hit_surface ? hit.t : std::numeric_limits<double>::infinity();
+
     ray_spans(md, o, d, s.spans, s.cuts);
     bool scattered = false;
     for (size_t k = 0; k + 1 < s.cuts.size() && !scattered; ++k) {
-      const double a = s.cuts[k], b = s.cuts[k + 1];
-      const double sigma_maj = media_present(md, s.spans, a, b, c, s.present);
+      const double a = s.cuts[k];
+      if (!(a < t_surf)) break;
+      const double b = std::min(s.cuts[k + 1], t_surf);
+      const double sigma_maj = media_present(md, s.spans, a, s.cuts[k + 1], c, s.present);
       if (!(sigma_maj > 0.0)) continue;
       for (double t = a;;) {
         t += sample_free_flight(sigma_maj, rng.uniform());
@@ -102,16 +151,16 @@ double walk_channel(const MediaData& md, int c, double background, int max_depth
           }
           return e;
         };
-        if (collision_estimator && sigma_a > 0.0) L += emitted() / sigma_maj;
+        if (collision_estimator && sigma_a > 0.0) L += beta * emitted() / sigma_maj;
 
         const double u = rng.uniform() * sigma_maj;
         if (u < sigma_a) {
           ++cnt.collisions;
-          return collision_estimator ? L : emitted() / sigma_a;
+          return collision_estimator ? L : beta * emitted() / sigma_a;
         }
         if (!(u < sigma_a + sigma_s)) continue;  // null collision
         ++cnt.collisions;
-        if (scatters == max_depth) return collision_estimator ? L : 0.0;
+        if (scatters == ws.max_depth) return collision_estimator ? L : 0.0;
         ++scatters;
         // Given a scattering, u − σa is uniform on [0, σs): reuse it to pick the lobe.
         double pick = u - sigma_a, g = 0.0;
@@ -130,7 +179,19 @@ double walk_channel(const MediaData& md, int c, double background, int max_depth
         break;
       }
     }
-    if (!scattered) return L + background;
+    if (scattered) continue;
+    if (!hit_surface) return L + beta * ws.escaped(d, c);
+
+    // Reached the surface: a Lambertian bounce.
+    ++cnt.collisions;
+    if (scatters == ws.max_depth) return collision_estimator ? L : 0.0;
+    ++scatters;
+    beta *= geometry::albedo_at(ws.surfaces, hit)[c];
+    if (!(beta > 0.0)) return L;  // black surface: nothing more can arrive
+    const glm::dvec3 n_f = glm::dot(hit.normal, d) < 0.0 ? hit.normal : -hit.normal;
+    glm::dvec2 uv(rng.uniform(), rng.uniform());
+    d = sample_cosine_hemisphere(n_f, uv).direction;
+    o = geometry::offset_ray_origin(hit.position, n_f);
   }
 }
 
@@ -174,9 +235,16 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   const bool collision_estimator = estimator == "collision";
   const MediaData media = prepare_media(scene);  // loads the vdb media's grids
   for (const std::string& w : media.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  const geometry::Surfaces surfaces = geometry::build_surfaces(scene);  // meshes, textures, BVH
+  std::optional<EnvironmentMap> environment;
+  if (scene.environment)
+    environment = EnvironmentMap::load(scene.environment->file, scene.environment->scale,
+                                       scene.environment->rotation_deg);
 
   const int W = settings.width, H = settings.height;
   const int max_depth = std::max(0, scene.integrator.max_depth);
+  const WalkScene walk_scene{media,     surfaces, environment ? &*environment : nullptr, scene.background,
+                             max_depth, collision_estimator};
   RenderResult res;
   res.width = W;
   res.height = H;
@@ -213,8 +281,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
               glm::dvec3 dir = camera_ray_direction(scene.camera, W, H, fx, fy);
               glm::dvec3 L;
               for (int c = 0; c < 3; ++c)
-                L[c] = walk_channel(media, c, scene.background[c], max_depth, collision_estimator,
-                                    scene.camera.position, dir, rng, cnt, scratch);
+                L[c] = walk_channel(walk_scene, c, scene.camera.position, dir, rng, cnt, scratch);
               if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z)) {
                 ++cnt.nonfinite;
                 L = glm::dvec3(0.0);  // recorded as 0, counted in nonfinite_samples
@@ -253,8 +320,8 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   res.seconds = std::chrono::duration<double>(Clock::now() - render_start).count();
   // Both counters are summed over camera samples of the average over the three
   // channel walks (each walk's count, all three added, divided by 3):
-  //  - events: real collisions (absorptions + scatterings, including the one
-  //    that max_depth ends);
+  //  - events: real collisions (absorptions + scatterings) and surface
+  //    bounces, including the one that max_depth ends;
   //  - density_lookups: trilinear density-texture samples, one per vdb medium
   //    present at each tentative collision (real or null); homogeneous media
   //    read no texture. (Shadow rays, when MIS lands, add their ratio-tracking

@@ -2,9 +2,12 @@
 // The CPU reference renderer: plain, double precision, written independently of
 // the GLSL path so that it can catch the GPU path's mistakes (issue 2, part 3).
 // Homogeneous media (sphere / box bounds) and grid (vdb) media, overlapping media
-// add; delta tracking with one global majorant per medium (Media.h); constant
-// background; the "absorption" and "collision" emission estimators;
-// Henyey–Greenstein scattering.
+// add; delta tracking with one global majorant per medium (Media.h); opaque
+// two-sided Lambertian surfaces (meshes, spheres, planes, albedo textures;
+// geometry/Surfaces.h); a constant background or a lat-long environment map
+// (light/EnvironmentMap.h) for escaping rays; the "absorption" and "collision"
+// emission estimators; Henyey–Greenstein scattering. Directions are sampled
+// from the BSDF / phase function only (no next-event estimation yet).
 #include <string>
 
 #include <glm/glm.hpp>
@@ -24,9 +27,8 @@ class CpuRenderer : public Backend {
   std::string device_name() const override;  // "CPU reference (N threads)"
   int threads() const { return threads_; }
 
-  // Throws InputError for unreadable grids (as the loader) and
-  // std::invalid_argument for bad settings. Surfaces and environment maps are not
-  // rendered yet: they are ignored (the CLI warns), as on the Vulkan backend.
+  // Throws InputError for unreadable grids, meshes, textures and environment
+  // maps (naming the file) and std::invalid_argument for bad settings.
   RenderResult render(const Scene& scene, const RenderSettings& settings, const RenderControl& control) override;
 
   // Samples per pixel per progressive pass (progress/cancel/time-limit granularity).

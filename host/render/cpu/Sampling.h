@@ -73,6 +73,25 @@ inline PhaseSample sample_hg(const glm::dvec3& dir, double g, const glm::dvec2& 
   return {glm::normalize(w), hg_pdf(cos_theta, g)};
 }
 
+struct BsdfSample {
+  glm::dvec3 direction;  // new travel direction, unit length
+  double pdf = 0.0;      // solid-angle density, = cos θ / π
+};
+
+// Cosine-weighted direction on the hemisphere around unit n (the Lambertian
+// BSDF's importance sampling): p(ω) = cos θ / π, so f·cos θ/p = albedo exactly.
+// Malley's method: a uniform point on the unit disk (r = √u₁, φ = 2π u₂)
+// projected up onto the hemisphere (pbrt-v4 SampleCosineHemisphere, which uses
+// the concentric map for the disk; the plain polar map is the same density).
+inline BsdfSample sample_cosine_hemisphere(const glm::dvec3& n, const glm::dvec2& u) {
+  double r = std::sqrt(u.x), phi = 2.0 * std::numbers::pi * u.y;
+  double cos_theta = std::sqrt(std::max(0.0, 1.0 - u.x));
+  glm::dvec3 t, b;
+  orthonormal_basis(n, t, b);
+  glm::dvec3 w = r * std::cos(phi) * t + r * std::sin(phi) * b + cos_theta * n;
+  return {glm::normalize(w), cos_theta / std::numbers::pi};
+}
+
 // Free-flight distance in a homogeneous medium, sampled from
 // p(t) = σt exp(−σt t) by inversion: t = −ln(1 − u)/σt (pbrt-v4 SampleExponential).
 // σt <= 0: the photon never collides (infinity).
