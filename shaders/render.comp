@@ -30,6 +30,7 @@ layout(constant_id = SPEC_GRID_COUNT) const uint GRID_COUNT = 1;
 layout(constant_id = SPEC_HAS_SURFACES) const bool HAS_SURFACES = false;
 layout(constant_id = SPEC_SURFACE_SHAPE_COUNT) const uint SURFACE_SHAPE_COUNT = 0;
 layout(constant_id = SPEC_SURFACE_HAS_TRIANGLES) const bool SURFACE_HAS_TRIANGLES = false;
+layout(constant_id = SPEC_HAS_ENVIRONMENT) const bool HAS_ENVIRONMENT = false;
 
 layout(std140, set = 0, binding = BINDING_FRAME) uniform FrameBlock { FrameConstants frame; };
 // Media and grids are uniform blocks: every lane reads the same entries, which
@@ -54,6 +55,13 @@ layout(std430, set = 0, binding = BINDING_SURFACE_SHAPES) readonly buffer Surfac
 layout(std430, set = 0, binding = BINDING_MATERIALS) readonly buffer Materials { GpuMaterial surface_materials[]; };
 layout(set = 0, binding = BINDING_TEXTURES) uniform sampler2D albedo_tex[MAX_TEXTURES];
 #include "bvh.glsl"
+// The environment map (shaders/lights.glsl's contract).
+#include "shared/light_types.h"
+#define LIGHTS_ENVIRONMENT
+layout(std430, set = 0, binding = BINDING_ENV_TEXELS) readonly buffer EnvTexelBlock { vec4 env_texels[]; };
+layout(std430, set = 0, binding = BINDING_ENV_CDF) readonly buffer EnvCdfBlock { float env_cdf[]; };
+layout(std140, set = 0, binding = BINDING_ENV_HEADER) uniform EnvHeaderBlock { GpuEnvironment environment; };
+#include "lights.glsl"
 
 const float INF = 1.0 / 0.0;
 
@@ -297,8 +305,9 @@ struct PathState {
   SurfaceHit hit;   // the closest one (t = its distance)
 };
 
-// Radiance of a ray that leaves the scene.
-vec3 escaped_radiance(vec3 d) { return frame.background.rgb; }
+// Radiance of a ray that leaves the scene: the environment map (+Z up,
+// docs/lights.md), or the constant background.
+vec3 escaped_radiance(vec3 d) { return HAS_ENVIRONMENT ? env_radiance(environment, d) : frame.background.rgb; }
 
 // A Lambertian bounce at the surface ahead: weight × albedo (cosine sampling's
 // pdf cancels the cosine and 1/π), new direction on the side the ray came

@@ -59,9 +59,6 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   if (!scene.shapes.empty() && scene.integrator.mis)
     std::cerr << "pyrolume: warning: " << scene.file.string()
               << ": integrator.mis: light sampling is not implemented yet; surfaces are lit by BSDF sampling only\n";
-  if (scene.environment)
-    std::cerr << "pyrolume: warning: " << scene.file.string()
-              << ": environment: environment maps are not rendered yet; background.rgb is used\n";
 
   RenderSettings settings;
   settings.width = args.width.value_or(scene.film.width);

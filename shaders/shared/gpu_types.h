@@ -39,6 +39,9 @@ PYRO_CONST uint BINDING_SURFACE_SHAPES = 11; // readonly buffer GpuSurfaceShape[
 PYRO_CONST uint BINDING_MATERIALS = 12;      // readonly buffer GpuMaterial[]
 PYRO_CONST uint BINDING_TEXTURES = 13;       // sampler2D[MAX_TEXTURES]: albedo textures
 PYRO_CONST uint MAX_TEXTURES = 8;
+PYRO_CONST uint BINDING_ENV_TEXELS = 14;     // readonly buffer vec4[]: the environment map (shaders/lights.glsl)
+PYRO_CONST uint BINDING_ENV_CDF = 15;        // readonly buffer float[]: its sampling CDF
+PYRO_CONST uint BINDING_ENV_HEADER = 16;     // uniform GpuEnvironment (shared/light_types.h)
 
 // Specialisation constants of render.comp: a scene pays only for what it uses.
 PYRO_CONST uint SPEC_HAS_GRIDS = 0;
@@ -51,6 +54,7 @@ PYRO_CONST uint SPEC_GRID_COUNT = 6;
 PYRO_CONST uint SPEC_HAS_SURFACES = 7;
 PYRO_CONST uint SPEC_SURFACE_SHAPE_COUNT = 8;
 PYRO_CONST uint SPEC_SURFACE_HAS_TRIANGLES = 9;
+PYRO_CONST uint SPEC_HAS_ENVIRONMENT = 10;
 PYRO_CONST uint DEBUG_NONE = 0;
 PYRO_CONST uint DEBUG_RATIO_TRACKING = 1;  // camera rays return ratio-tracking transmittance
 PYRO_CONST uint DEBUG_DELTA_TRACKING = 2;  // camera rays return delta-tracking transmittance

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "geometry/SceneSurfaces.h"
+#include "light/EnvironmentMap.h"
 #include "render/vulkan/Spirv.h"
 #include "util/Error.h"
 
@@ -39,6 +40,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                       vk::MemoryKind::DeviceLocal, "accumulation");
   create_textures(scene);
   create_surfaces(scene);
+  create_environment(scene);
 
   // The shader variant: code for grids, scattering and emission only when used.
   auto flag = [](bool b) { return uint32_t(b ? 1 : 0); };
@@ -52,7 +54,8 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
       {gpu::SPEC_GRID_COUNT, uint32_t(gpu_scene_.grids.size())},
       {gpu::SPEC_HAS_SURFACES, flag(!scene.shapes.empty())},
       {gpu::SPEC_SURFACE_SHAPE_COUNT, gpu_surfaces_.shape_count},
-      {gpu::SPEC_SURFACE_HAS_TRIANGLES, flag(gpu_surfaces_.triangle_count > 0)}};
+      {gpu::SPEC_SURFACE_HAS_TRIANGLES, flag(gpu_surfaces_.triangle_count > 0)},
+      {gpu::SPEC_HAS_ENVIRONMENT, flag(scene.environment.has_value())}};
   pipeline_.emplace(ctx, vk::load_spirv("render.comp"),
                     std::vector<vk::ComputePipeline::Binding>{
                         {gpu::BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
@@ -68,7 +71,10 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                         {gpu::BINDING_BVH_ATTRIBUTES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_SURFACE_SHAPES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_MATERIALS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                        {gpu::BINDING_TEXTURES, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_TEXTURES}},
+                        {gpu::BINDING_TEXTURES, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_TEXTURES},
+                        {gpu::BINDING_ENV_TEXELS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_ENV_CDF, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_ENV_HEADER, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}},
                     uint32_t(sizeof(gpu::PassConstants)), spec, "render");
   set_.emplace(ctx, *pipeline_, "render set");
   set_->write_buffer(gpu::BINDING_FRAME, frame_buffer_);
@@ -89,6 +95,9 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   set_->write_buffer(gpu::BINDING_BVH_ATTRIBUTES, bvh_attributes_);
   set_->write_buffer(gpu::BINDING_SURFACE_SHAPES, surface_shapes_);
   set_->write_buffer(gpu::BINDING_MATERIALS, materials_);
+  set_->write_buffer(gpu::BINDING_ENV_TEXELS, env_texels_);
+  set_->write_buffer(gpu::BINDING_ENV_CDF, env_cdf_);
+  set_->write_buffer(gpu::BINDING_ENV_HEADER, env_header_);
   for (uint32_t slot = 0; slot < gpu::MAX_TEXTURES; ++slot)
     set_->write_image(gpu::BINDING_TEXTURES, textures_2d_[slot + 1 < textures_2d_.size() ? slot + 1 : 0], slot);
   upload_constants(scene);
@@ -201,6 +210,27 @@ void RenderSession::create_surfaces(const Scene& scene) {
       textures_2d_.back().upload(ctx_, texels.data(), texels.size() * sizeof(float));
     }
   }
+}
+
+// The lat-long environment map as a texel buffer plus its sampling CDF
+// (bilinear lookups in the shader, exactly like host/light/EnvironmentMap);
+// 1-element placeholders when the scene has none.
+void RenderSession::create_environment(const Scene& scene) {
+  std::vector<float> texels(4, 0.0f), cdf(1, 0.0f);
+  gpu::GpuEnvironment header{};
+  if (scene.environment) {
+    EnvironmentMap env = EnvironmentMap::load(scene.environment->file, scene.environment->scale,
+                                              scene.environment->rotation_deg);
+    texels = env.gpu_texels();
+    if (!env.gpu_cdf().empty()) cdf = env.gpu_cdf();
+    header = env.gpu_header();
+  }
+  env_texels_ = vk::Buffer(ctx_, texels.size() * sizeof(float), kStorage, vk::MemoryKind::DeviceLocal, "environment");
+  env_texels_.upload(ctx_, texels.data(), texels.size() * sizeof(float));
+  env_cdf_ = vk::Buffer(ctx_, cdf.size() * sizeof(float), kStorage, vk::MemoryKind::DeviceLocal, "environment cdf");
+  env_cdf_.upload(ctx_, cdf.data(), cdf.size() * sizeof(float));
+  env_header_ = vk::Buffer(ctx_, sizeof header, kUniform, vk::MemoryKind::HostVisible, "environment header");
+  env_header_.upload(ctx_, &header, sizeof header);
 }
 
 void RenderSession::upload_constants(const Scene& scene) {

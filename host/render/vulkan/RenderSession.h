@@ -48,6 +48,7 @@ class RenderSession {
   void upload_constants(const Scene& scene);
   void create_textures(const Scene& scene);
   void create_surfaces(const Scene& scene);
+  void create_environment(const Scene& scene);
 
   vk::Context& ctx_;
   RenderSettings settings_;
@@ -61,6 +62,8 @@ class RenderSession {
   geometry::GpuSurfaces gpu_surfaces_;
   vk::Buffer bvh_nodes_, bvh_triangles_, bvh_attributes_, surface_shapes_, materials_;
   std::vector<vk::Image2D> textures_2d_;  // [0] placeholder, then one per albedo texture
+  // The environment map: texels, sampling CDF, header.
+  vk::Buffer env_texels_, env_cdf_, env_header_;
   std::optional<vk::ComputePipeline> pipeline_;
   std::optional<vk::DescriptorSet> set_;
   int spp_done_ = 0;
