@@ -12,6 +12,7 @@
 
 #include "render/Backend.h"
 #include "render/cpu/CpuRenderer.h"
+#include "support/AnalyticScenes.h"
 #include "support/Stats.h"
 #include "support/TestSupport.h"
 #include "volume/StoredVolume.h"
@@ -21,14 +22,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-RenderSettings settings_for(const Scene& s) {
-  RenderSettings rs;
-  rs.width = s.film.width;
-  rs.height = s.film.height;
-  rs.spp = s.film.spp;
-  rs.seed = s.film.seed;
-  return rs;
-}
+using test::settings_for;
 
 class RealRender : public ::testing::Test {
  protected:

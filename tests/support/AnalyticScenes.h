@@ -16,11 +16,22 @@
 
 #include <glm/glm.hpp>
 
+#include "render/Render.h"
 #include "scene/Scene.h"
 
 namespace pyrolume::test {
 
 // ---------------------------------------------------------------- builders ----
+
+// The render settings a scene's film asks for (what the CLI does without overrides).
+inline RenderSettings settings_for(const Scene& s) {
+  RenderSettings rs;
+  rs.width = s.film.width;
+  rs.height = s.film.height;
+  rs.spp = s.film.spp;
+  rs.seed = s.film.seed;
+  return rs;
+}
 
 inline Scene analytic_base_scene(int width, int height, int spp) {
   Scene s;

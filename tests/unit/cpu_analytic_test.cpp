@@ -18,14 +18,7 @@ namespace {
 using test::ZTestOptions;
 using test::ZTestReport;
 
-RenderSettings settings_for(const Scene& s) {
-  RenderSettings rs;
-  rs.width = s.film.width;
-  rs.height = s.film.height;
-  rs.spp = s.film.spp;
-  rs.seed = s.film.seed;
-  return rs;
-}
+using test::settings_for;
 
 RenderResult render(const Scene& s, int threads = 0) {
   CpuRenderer r(threads);

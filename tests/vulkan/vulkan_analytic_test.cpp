@@ -10,14 +10,7 @@
 namespace pyrolume {
 namespace {
 
-RenderSettings settings_for(const Scene& s) {
-  RenderSettings rs;
-  rs.width = s.film.width;
-  rs.height = s.film.height;
-  rs.spp = s.film.spp;
-  rs.seed = s.film.seed;
-  return rs;
-}
+using test::settings_for;
 
 class VulkanAnalytic : public ::testing::Test {
  protected:

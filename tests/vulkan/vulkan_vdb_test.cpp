@@ -28,14 +28,7 @@ namespace {
 using test::ZTestOptions;
 using test::ZTestReport;
 
-RenderSettings settings_for(const Scene& s) {
-  RenderSettings rs;
-  rs.width = s.film.width;
-  rs.height = s.film.height;
-  rs.spp = s.film.spp;
-  rs.seed = s.film.seed;
-  return rs;
-}
+using test::settings_for;
 
 // Absorption-estimator samples are Bernoulli-like (Le or background): pool the
 // variance over 3×3 (Stats.h explains).
