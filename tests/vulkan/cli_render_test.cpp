@@ -111,3 +111,26 @@ TEST(CliInterrupt, SigintSavesImageAndExits130) {
   EXPECT_GT(img.at(32, 32, 0), 0.3);
   std::filesystem::remove_all(dir);
 }
+
+// No Vulkan driver: one line that points to --backend cpu, exit 2, no output;
+// the CPU backend still renders.
+TEST(CliNoDevice, PointsToCpuBackend) {
+  auto dir = temp_dir("nodev");
+  write_file(dir / "s.json", kScene);
+  const char* old = std::getenv("VK_ICD_FILENAMES");
+  std::string saved = old ? old : "";
+  setenv("VK_ICD_FILENAMES", "/nonexistent-icd.json", 1);
+  CliResult r = run_cli("render " + (dir / "s.json").string() + " -o " + (dir / "o.exr").string());
+  CliResult cpu = run_cli("render " + (dir / "s.json").string() + " -o " + (dir / "c.exr").string() + " --backend cpu");
+  CliResult devices = run_cli("devices");
+  if (old) setenv("VK_ICD_FILENAMES", saved.c_str(), 1);
+  else unsetenv("VK_ICD_FILENAMES");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("--backend cpu"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "o.exr"));
+  EXPECT_EQ(devices.status, 2) << devices.err;
+  EXPECT_EQ(cpu.status, 0) << cpu.err;
+  EXPECT_TRUE(std::filesystem::exists(dir / "c.exr"));
+  std::filesystem::remove_all(dir);
+}

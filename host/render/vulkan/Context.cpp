@@ -78,12 +78,10 @@ VKAPI_ATTR VkBool32 VKAPI_CALL Context::debug_callback(VkDebugUtilsMessageSeveri
     return VK_FALSE;
   std::string line = data && data->pMessage ? data->pMessage : "(no message)";
   std::replace(line.begin(), line.end(), '\n', ' ');
-  // GENERAL-only messages come from the loader (e.g. a broken driver manifest):
-  // worth showing, but they say nothing about our API use, so they don't count.
-  if (!(types & ~VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT)) {
-    std::fprintf(stderr, "vulkan loader: %s\n", line.c_str());
-    return VK_FALSE;
-  }
+  // GENERAL-only messages come from the loader (e.g. no driver manifest): they
+  // say nothing about our API use, and the error that follows already explains
+  // (errors are one line). VK_LOADER_DEBUG=all shows the loader's own log.
+  if (!(types & ~VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT)) return VK_FALSE;
   std::fprintf(stderr, "vulkan validation: %s\n", line.c_str());
   static_cast<Context*>(user)->validation_messages_++;
   g_total_validation_messages++;
