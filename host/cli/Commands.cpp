@@ -1,5 +1,6 @@
 #include "cli/Commands.h"
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -7,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli/Sequence.h"
 #include "color/Blackbody.h"
 #include "image/AtomicFile.h"
 #include "image/Compare.h"
@@ -14,6 +16,7 @@
 #include "image/RenderImage.h"
 #include "render/Backend.h"
 #include "render/vulkan/Devices.h"
+#include "render/vulkan/VulkanRenderer.h"
 #include "scene/Scene.h"
 #include "util/Error.h"
 #include "util/Progress.h"
@@ -37,35 +40,200 @@ std::string format_seconds(double s) {
 
 }  // namespace
 
-int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
-  Scene scene = load_scene(args.scene);
+namespace {
 
-  std::filesystem::path output = args.output.empty()
-                                     ? std::filesystem::path(std::filesystem::path(args.scene).stem().string() + ".exr")
-                                     : std::filesystem::path(args.output);
-  std::string ext = lower_extension(output);
-  if (ext != ".exr" && ext != ".png")
-    throw input_error(output.string(), "", "unknown image type \"" + ext + "\" (use .exr or .png)");
-  if (args.variance && ext != ".exr") throw input_error(output.string(), "", "--variance needs an .exr output");
-  if (output.has_parent_path() && !std::filesystem::is_directory(output.parent_path()))
-    throw input_error(output.string(), "", "output folder does not exist");
-  if (!args.stats.empty()) {
-    std::filesystem::path sp(args.stats);
-    if (sp.has_parent_path() && !std::filesystem::is_directory(sp.parent_path()))
-      throw input_error(args.stats, "", "stats folder does not exist");
-  }
+// Where one frame goes: the image, and the stats JSON when asked for.
+struct FrameOutputs {
+  std::filesystem::path image, stats;
+};
 
-  // Accepted by the v1 format but not rendered yet: say so rather than ignore silently.
-  if (!scene.shapes.empty() && scene.integrator.mis)
-    std::cerr << "pyrolume: warning: " << scene.file.string()
-              << ": integrator.mis: light sampling is not implemented yet; surfaces are lit by BSDF sampling only\n";
+void check_folder(const std::filesystem::path& file, const std::string& what) {
+  if (file.has_parent_path() && !std::filesystem::is_directory(file.parent_path()))
+    throw input_error(file.string(), "", what + " folder does not exist");
+}
 
+// The stats JSON of one render (DESIGN.md "--stats").
+void write_stats(const std::filesystem::path& file, const RenderArgs& args, const std::filesystem::path& output,
+                 const RenderResult& result, std::optional<int> frame) {
+  const double samples = double(result.width) * result.height * result.spp;
+  nlohmann::ordered_json j;
+  j["backend"] = result.backend;
+  j["device"] = result.device;
+  j["scene"] = args.scene;
+  j["output"] = output.string();
+  if (frame) j["frame"] = *frame;
+  j["width"] = result.width;
+  j["height"] = result.height;
+  j["spp"] = result.spp;
+  j["seconds"] = result.seconds;
+  j["load_seconds"] = result.load_seconds;
+  j["samples_per_second"] = result.seconds > 0 ? samples / result.seconds : 0.0;
+  j["peak_rss_mb"] = peak_rss_mb();
+  j["density_lookups_per_ray"] = samples > 0 ? result.density_lookups / samples : 0.0;
+  j["lookups_per_second"] = result.seconds > 0 ? result.density_lookups / result.seconds : 0.0;
+  j["events_per_path"] = samples > 0 ? result.events / samples : 0.0;
+  j["nonfinite_samples"] = result.nonfinite_samples;
+  j["cancelled"] = result.cancelled;
+  write_text_atomic(file, j.dump(2) + "\n");
+}
+
+// "OUT: WxH, N spp, S s, M Msamples/s, DEVICE (BACKEND)" on stdout.
+void print_summary(const std::filesystem::path& output, const RenderResult& result) {
+  const double samples = double(result.width) * result.height * result.spp;
+  char line[512];
+  std::snprintf(line, sizeof line, "%s: %dx%d, %d spp, %s s, %.2f Msamples/s, %s (%s)", output.string().c_str(),
+                result.width, result.height, result.spp, format_seconds(result.seconds).c_str(),
+                result.seconds > 0 ? samples / result.seconds * 1e-6 : 0.0, result.device.c_str(),
+                result.backend.c_str());
+  std::cout << line << std::endl;
+}
+
+void print_warnings(const RenderResult& result, const std::string& prefix) {
+  for (const auto& w : result.warnings) std::cerr << "pyrolume: warning: " << prefix << w << "\n";
+  if (result.nonfinite_samples > 0)
+    std::cerr << "pyrolume: warning: " << prefix << result.nonfinite_samples
+              << " non-finite samples were recorded as 0\n";
+}
+
+RenderSettings settings_from(const RenderArgs& args, const Scene& scene) {
   RenderSettings settings;
   settings.width = args.width.value_or(scene.film.width);
   settings.height = args.height.value_or(scene.film.height);
   settings.spp = args.spp.value_or(scene.film.spp);
   settings.seed = args.seed.value_or(scene.film.seed);
   settings.time_limit = args.time_limit;
+  return settings;
+}
+
+// The media whose file is a frame pattern and whose file for this frame is
+// missing: "media[i].file: PATH" each.
+std::vector<std::string> missing_inputs(const Scene& pattern_scene, const Scene& frame_scene) {
+  std::vector<std::string> missing;
+  for (size_t i = 0; i < frame_scene.media.size(); ++i) {
+    const Medium& m = frame_scene.media[i];
+    if (m.type != Medium::Type::Vdb || !has_frame_pattern(pattern_scene.media[i].file.string())) continue;
+    std::error_code ec;
+    if (!std::filesystem::exists(m.file, ec)) missing.push_back("media[" + std::to_string(i) + "].file: " + m.file.string());
+  }
+  return missing;
+}
+
+// `render --frames`: one backend (one Vulkan device and, through frame reuse,
+// one pipeline and BVH) for every frame; each frame is rendered exactly as
+// `--frames N-N` would render it alone.
+int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesystem::path& output,
+                 const std::atomic<bool>& cancel) {
+  const FrameRange range = parse_frame_range(args.frames);
+  if (!has_frame_pattern(output.string()))
+    throw input_error(output.string(), "",
+                      "with --frames the output must be a frame pattern (#### or $F4), e.g. out_####.exr");
+  if (!args.stats.empty() && !has_frame_pattern(args.stats))
+    throw input_error(args.stats, "", "with --frames --stats must be a frame pattern too, e.g. stats_####.json");
+  check_folder(expand_frame_pattern(output.string(), range.first), "output");
+  if (!args.stats.empty()) check_folder(expand_frame_pattern(args.stats, range.first), "stats");
+
+  const auto t0 = std::chrono::steady_clock::now();
+  BackendOptions options;
+  options.device_index = args.device;
+  auto backend = make_backend(args.backend, options);
+  if (auto* vulkan = dynamic_cast<VulkanRenderer*>(backend.get())) vulkan->set_frame_reuse(true);
+
+  int rendered = 0, skipped = 0, missing = 0;
+  double load_seconds = 0.0, render_seconds = 0.0;
+  for (int frame : range.frames()) {
+    if (cancel.load()) break;
+    const std::string tag = "frame " + std::to_string(frame) + ": ";
+    FrameOutputs out{expand_frame_pattern(output.string(), frame),
+                     args.stats.empty() ? std::filesystem::path() : std::filesystem::path(expand_frame_pattern(args.stats, frame))};
+    // Outputs are written atomically (temp + rename), so an existing one is complete.
+    std::error_code ec;
+    if (args.skip_existing && std::filesystem::exists(out.image, ec)) {
+      std::cerr << "pyrolume: " << tag << out.image.string() << " exists, skipped\n";
+      ++skipped;
+      continue;
+    }
+    Scene frame_scene = scene_at_frame(scene, frame);
+    std::vector<std::string> absent = missing_inputs(scene, frame_scene);
+    if (!absent.empty()) {
+      for (const auto& a : absent) std::cerr << "pyrolume: " << tag << "missing input " << a << "\n";
+      if (args.strict) {
+        std::cerr << "pyrolume: stopping at the missing frame " << frame << " (--strict)\n";
+        return 2;
+      }
+      ++missing;
+      continue;
+    }
+
+    RenderSettings settings = settings_from(args, frame_scene);
+    settings.frame = uint32_t(frame);
+    ProgressBar bar("frame " + std::to_string(frame));
+    RenderControl control;
+    control.progress = [&](int done, int target) { bar.update(done, target); };
+    control.cancel = &cancel;
+    RenderResult result = backend->render(frame_scene, settings, control);
+    bar.finish();
+    if (result.cancelled) {
+      // A partly converged frame is not complete: write nothing, so that
+      // --skip-existing renders it again.
+      std::cerr << "pyrolume: interrupted in frame " << frame << " after " << result.spp
+                << " spp; that frame is not written (rerun with --skip-existing to resume)\n";
+      break;
+    }
+    write_image(out.image, image_from_render(result, args.variance), frame_scene.film.exposure);
+    if (!out.stats.empty()) write_stats(out.stats, args, out.image, result, frame);
+    print_warnings(result, tag);
+    print_summary(out.image, result);
+    ++rendered;
+    load_seconds += result.load_seconds;
+    render_seconds += result.seconds;
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "frames %s: %d rendered, %d skipped, %d missing; %s s (%s s loading, %s s rendering)",
+                args.frames.c_str(), rendered, skipped, missing, format_seconds(wall).c_str(),
+                format_seconds(load_seconds).c_str(), format_seconds(render_seconds).c_str());
+  std::cout << line << std::endl;
+  return 0;
+}
+
+}  // namespace
+
+int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
+  Scene scene = load_scene(args.scene);
+
+  const bool sequence = !args.frames.empty();
+  std::filesystem::path output =
+      !args.output.empty() ? std::filesystem::path(args.output)
+      : sequence           ? std::filesystem::path(std::filesystem::path(args.scene).stem().string() + "_####.exr")
+                           : std::filesystem::path(std::filesystem::path(args.scene).stem().string() + ".exr");
+  std::string ext = lower_extension(output);
+  if (ext != ".exr" && ext != ".png")
+    throw input_error(output.string(), "", "unknown image type \"" + ext + "\" (use .exr or .png)");
+  if (args.variance && ext != ".exr") throw input_error(output.string(), "", "--variance needs an .exr output");
+
+  // Accepted by the v1 format but not rendered yet: say so rather than ignore silently.
+  if (!scene.shapes.empty() && scene.integrator.mis)
+    std::cerr << "pyrolume: warning: " << scene.file.string()
+              << ": integrator.mis: light sampling is not implemented yet; surfaces are lit by BSDF sampling only\n";
+
+  if (sequence) return run_sequence(args, scene, output, cancel);
+
+  if (args.skip_existing) throw input_error("--skip-existing", "", "needs --frames");
+  if (args.strict) throw input_error("--strict", "", "needs --frames");
+  if (has_frame_pattern(output.string()))
+    throw input_error(output.string(), "", "the output is a frame pattern: give --frames A-B (or one frame, --frames N)");
+  for (size_t i = 0; i < scene.media.size(); ++i)
+    if (scene.media[i].type == Medium::Type::Vdb && has_frame_pattern(scene.media[i].file.string()))
+      throw input_error(scene.file.string(), "media[" + std::to_string(i) + "].file",
+                        "is a frame pattern: give --frames A-B (or one frame, --frames N)");
+  check_folder(output, "output");
+  if (!args.stats.empty()) check_folder(args.stats, "stats");
+
+  // Without --frames the render is frame 0: keys evaluate there (clamped) and
+  // the RNG is keyed with frame 0, as before animation existed.
+  RenderSettings settings = settings_from(args, scene);
+  settings.frame = 0;
 
   BackendOptions options;
   options.device_index = args.device;
@@ -80,39 +248,10 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
 
   Image image = image_from_render(result, args.variance);
   write_image(output, image, scene.film.exposure);
-
-  const double samples = double(result.width) * result.height * result.spp;
-  if (!args.stats.empty()) {
-    nlohmann::ordered_json j;
-    j["backend"] = result.backend;
-    j["device"] = result.device;
-    j["scene"] = args.scene;
-    j["output"] = output.string();
-    j["width"] = result.width;
-    j["height"] = result.height;
-    j["spp"] = result.spp;
-    j["seconds"] = result.seconds;
-    j["load_seconds"] = result.load_seconds;
-    j["samples_per_second"] = result.seconds > 0 ? samples / result.seconds : 0.0;
-    j["peak_rss_mb"] = peak_rss_mb();
-    j["density_lookups_per_ray"] = samples > 0 ? result.density_lookups / samples : 0.0;
-    j["lookups_per_second"] = result.seconds > 0 ? result.density_lookups / result.seconds : 0.0;
-    j["events_per_path"] = samples > 0 ? result.events / samples : 0.0;
-    j["nonfinite_samples"] = result.nonfinite_samples;
-    j["cancelled"] = result.cancelled;
-    write_text_atomic(args.stats, j.dump(2) + "\n");
-  }
-  for (const auto& w : result.warnings) std::cerr << "pyrolume: warning: " << w << "\n";
-  if (result.nonfinite_samples > 0)
-    std::cerr << "pyrolume: warning: " << result.nonfinite_samples << " non-finite samples were recorded as 0\n";
+  if (!args.stats.empty()) write_stats(args.stats, args, output, result, std::nullopt);
+  print_warnings(result, "");
   if (result.cancelled) std::cerr << "pyrolume: interrupted after " << result.spp << " spp; the image so far is saved\n";
-
-  char line[512];
-  std::snprintf(line, sizeof line, "%s: %dx%d, %d spp, %s s, %.2f Msamples/s, %s (%s)", output.string().c_str(),
-                result.width, result.height, result.spp, format_seconds(result.seconds).c_str(),
-                result.seconds > 0 ? samples / result.seconds * 1e-6 : 0.0, result.device.c_str(),
-                result.backend.c_str());
-  std::cout << line << std::endl;
+  print_summary(output, result);
   return 0;
 }
 

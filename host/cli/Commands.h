@@ -13,6 +13,11 @@ struct RenderArgs {
   double time_limit = 0.0;
   bool variance = false;
   int device = -1;
+  // Sequences (docs/animation.md): "A-B[:step]"; output and stats are then
+  // patterns (out_####.exr, stats_####.json), one file per frame.
+  std::string frames;
+  bool skip_existing = false;  // skip frames whose output exists (resume)
+  bool strict = false;         // stop with exit 2 at the first missing input frame
 };
 int run_render(const RenderArgs& args, const std::atomic<bool>& cancel);
 

@@ -42,6 +42,10 @@ int main(int argc, char** argv) {
   render->add_option("--stats", render_args.stats, "Write render statistics as JSON");
   render->add_flag("--variance", render_args.variance, "EXR: add the per-pixel variance of the mean (variance.R/G/B)");
   render->add_option("--device", render_args.device, "Vulkan device index (see `pyrolume devices`)")->check(CLI::NonNegativeNumber);
+  render->add_option("--frames", render_args.frames,
+                     "Render frames A-B[:step] (or one frame A); -o and --stats are then patterns: out_####.exr");
+  render->add_flag("--skip-existing", render_args.skip_existing, "With --frames: skip frames whose output exists");
+  render->add_flag("--strict", render_args.strict, "With --frames: stop (exit 2) at the first missing input frame");
 
   PreviewArgs pv;
   auto* preview = app.add_subcommand("preview", "Open a window that shows the render converging");

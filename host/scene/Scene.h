@@ -12,9 +12,31 @@
 
 namespace pyrolume {
 
+// A keyframed parameter: {"keys": [[frame, value], ...]} in the scene JSON
+// (docs/animation.md). Frames increase strictly; between keys the value is
+// interpolated linearly, outside the key range it is held at the first / last
+// key (clamped). Empty = not animated (the plain value applies to every frame).
+template <typename T>
+struct Keyframes {
+  std::vector<double> frames;
+  std::vector<T> values;
+
+  bool animated() const { return !frames.empty(); }
+  T at(double frame) const {
+    if (frame <= frames.front()) return values.front();
+    if (frame >= frames.back()) return values.back();
+    size_t hi = 1;
+    while (frames[hi] < frame) ++hi;
+    if (frames[hi] == frame) return values[hi];  // exact at a key, no rounding
+    const double t = (frame - frames[hi - 1]) / (frames[hi] - frames[hi - 1]);
+    return values[hi - 1] + (values[hi] - values[hi - 1]) * t;
+  }
+};
+
 struct Camera {
   glm::dvec3 position{0, 1, -6};
   glm::dvec3 look_at{0, 1, 0};
+  Keyframes<glm::dvec3> position_keys, look_at_keys;
   glm::dvec3 up{0, 1, 0};
   double fov_deg = 40.0;  // vertical field of view
 };
@@ -24,6 +46,7 @@ struct Film {
   int height = 360;
   int spp = 64;
   double exposure = 0.0;  // stops, applied to PNG output only
+  Keyframes<double> exposure_keys;
   uint32_t seed = 1;
 };
 
@@ -57,6 +80,7 @@ struct Emission {
   std::optional<glm::dvec3> rgb;
   std::optional<double> temperature_k;
   double scale = 1.0;
+  Keyframes<double> scale_keys;
   BlackbodyMode blackbody = BlackbodyMode::Seed;
   int observer = 2;  // CIE 1931 2° or CIE 1964 10°
   std::optional<double> adapt_to_k;
@@ -85,7 +109,7 @@ struct Medium {
   double g = 0.0;  // Henyey–Greenstein, g > 0 scatters forward
   Emission emission;
   // vdb only
-  std::filesystem::path file;
+  std::filesystem::path file;  // may hold a frame pattern (####, $F4, $F): see scene_at_frame
   std::string density_grid;      // empty: default "density"
   std::string temperature_grid;  // empty: first of temperature, heat, flame
   double density_scale = 1.0;
@@ -123,7 +147,24 @@ struct Scene {
 };
 
 // Parse and validate. Throws InputError("FILE: key.path: reason").
+// Keyframed values are also stored evaluated at frame 0 (clamped), the frame
+// a render without --frames shows; medium files keep their frame patterns.
 Scene load_scene(const std::filesystem::path& file);
 Scene parse_scene(const std::string& json_text, const std::filesystem::path& file);
+
+// ---- animation (host/scene/Animation.cpp, docs/animation.md) ----
+
+// True when `pattern` holds a frame pattern: a run of '#' (zero-padded to the
+// run's length) or Houdini's $F<width> / $F (unpadded).
+bool has_frame_pattern(const std::string& pattern);
+// Every pattern in `pattern` replaced by `frame`.
+std::string expand_frame_pattern(const std::string& pattern, int frame);
+// True when any medium file is a pattern or any parameter has keys.
+bool scene_is_animated(const Scene& scene);
+bool scene_has_file_patterns(const Scene& scene);
+// The scene at `frame`: keyframed values evaluated, medium file patterns
+// expanded, keys kept (so it can be evaluated again). Validates what the
+// keys may break (camera position vs look_at) with errors naming the frame.
+Scene scene_at_frame(const Scene& scene, int frame);
 
 }  // namespace pyrolume

@@ -87,6 +87,32 @@ class Reader {
     }
     return r;
   }
+  // A number, or {"keys": [[frame, number], ...]}: returns the value at frame 0
+  // and fills `keys` (docs/animation.md).
+  double number_keyed(const std::string& key, double fallback, Keyframes<double>& keys) {
+    if (!has(key) || !j_.at(key).is_object()) return number(key, fallback);
+    read_keys(key, keys, [&](const json& v, const std::string& at) {
+      if (!v.is_number()) fail(at, "expected a number as the key's value, got " + type_name(v));
+      double d = v.get<double>();
+      if (!std::isfinite(d)) fail(at, "must be finite");
+      return d;
+    });
+    return keys.at(0.0);
+  }
+  glm::dvec3 vec3_keyed(const std::string& key, glm::dvec3 fallback, Keyframes<glm::dvec3>& keys) {
+    if (!has(key) || !j_.at(key).is_object()) return vec3(key, fallback);
+    read_keys(key, keys, [&](const json& v, const std::string& at) {
+      if (!v.is_array() || v.size() != 3) fail(at, "expected [x, y, z] as the key's value");
+      glm::dvec3 r;
+      for (int i = 0; i < 3; ++i) {
+        if (!v[i].is_number()) fail(at, "expected [x, y, z] as the key's value");
+        r[i] = v[i].get<double>();
+        if (!std::isfinite(r[i])) fail(at, "must be finite");
+      }
+      return r;
+    });
+    return keys.at(0.0);
+  }
   glm::dvec3 vec3_required(const std::string& key) {
     if (!has(key)) fail(key, "missing required key");
     return vec3(key, {});
@@ -110,6 +136,29 @@ class Reader {
   static std::string type_name(const json& v) { return v.type_name(); }
 
  private:
+  // {"keys": [[frame, value], ...]}: non-empty, frames finite and strictly
+  // increasing, every value of the parameter's type (parse_value checks).
+  template <typename T, typename Parse>
+  void read_keys(const std::string& key, Keyframes<T>& keys, Parse parse_value) {
+    Reader k = child(key);
+    if (!k.has("keys")) k.fail("keys", "missing: a keyframed value is {\"keys\": [[frame, value], ...]}");
+    const json& list = k.raw("keys");
+    k.finish();
+    if (!list.is_array() || list.empty()) fail(key + ".keys", "expected a non-empty array of [frame, value] pairs");
+    keys = {};
+    for (size_t n = 0; n < list.size(); ++n) {
+      const std::string at = key + ".keys[" + std::to_string(n) + "]";
+      const json& e = list[n];
+      if (!e.is_array() || e.size() != 2) fail(at, "expected [frame, value]");
+      if (!e[0].is_number() || !std::isfinite(e[0].get<double>())) fail(at, "the frame must be a finite number");
+      const double frame = e[0].get<double>();
+      if (!keys.frames.empty() && !(frame > keys.frames.back()))
+        fail(at, "frames must increase strictly (" + json(frame).dump() + " after " + json(keys.frames.back()).dump() + ")");
+      keys.frames.push_back(frame);
+      keys.values.push_back(parse_value(e[1], at));
+    }
+  }
+
   const json& j_;
   std::string path_;
   const std::string& file_;
@@ -160,8 +209,10 @@ Emission read_emission(Reader r, bool grid) {
     e.temperature_k = t;
   }
   if (e.rgb && e.temperature_k) r.fail("rgb", "give either rgb or temperature_k, not both");
-  e.scale = r.number("scale", 1.0);
+  e.scale = r.number_keyed("scale", 1.0, e.scale_keys);
   if (e.scale < 0) r.fail("scale", "must be >= 0");
+  for (size_t n = 0; n < e.scale_keys.values.size(); ++n)
+    if (e.scale_keys.values[n] < 0) r.fail("scale.keys[" + std::to_string(n) + "]", "must be >= 0");
   e.blackbody = read_blackbody(r);
   e.observer = r.integer("observer", 2, 2, 10);
   if (e.observer != 2 && e.observer != 10) r.fail("observer", "must be 2 (CIE 1931) or 10 (CIE 1964)");
@@ -289,8 +340,8 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
 
   if (r.has("camera")) {
     Reader c = r.child("camera");
-    s.camera.position = c.vec3("position", s.camera.position);
-    s.camera.look_at = c.vec3("look_at", s.camera.look_at);
+    s.camera.position = c.vec3_keyed("position", s.camera.position, s.camera.position_keys);
+    s.camera.look_at = c.vec3_keyed("look_at", s.camera.look_at, s.camera.look_at_keys);
     s.camera.up = c.vec3("up", s.camera.up);
     s.camera.fov_deg = c.number("fov_deg", s.camera.fov_deg);
     if (!(s.camera.fov_deg > 0 && s.camera.fov_deg < 180)) c.fail("fov_deg", "must be in (0, 180) degrees");
@@ -304,7 +355,7 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
     s.film.width = f.integer("width", s.film.width, 1, 16384);
     s.film.height = f.integer("height", s.film.height, 1, 16384);
     s.film.spp = f.integer("spp", s.film.spp, 1, 1 << 24);
-    s.film.exposure = f.number("exposure", s.film.exposure);
+    s.film.exposure = f.number_keyed("exposure", s.film.exposure, s.film.exposure_keys);
     s.film.seed = static_cast<uint32_t>(f.integer("seed", static_cast<int>(s.film.seed), 0, 2147483647));
     f.finish();
   }

@@ -42,20 +42,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   create_surfaces(scene);
   create_environment(scene);
 
-  // The shader variant: code for grids, scattering and emission only when used.
-  auto flag = [](bool b) { return uint32_t(b ? 1 : 0); };
-  std::vector<std::pair<uint32_t, uint32_t>> spec = {
-      {gpu::SPEC_HAS_GRIDS, flag(gpu_scene_.has_grids)},
-      {gpu::SPEC_HAS_SCATTERING, flag(gpu_scene_.has_scattering && scene.integrator.max_depth > 0)},
-      {gpu::SPEC_HAS_EMISSION, flag(gpu_scene_.has_emission)},
-      {gpu::SPEC_COLLISION_ESTIMATOR, flag(scene.integrator.emission_estimator == "collision")},
-      {gpu::SPEC_DEBUG_MODE, settings.debug_mode},
-      {gpu::SPEC_MEDIUM_COUNT, uint32_t(gpu_scene_.media.size())},
-      {gpu::SPEC_GRID_COUNT, uint32_t(gpu_scene_.grids.size())},
-      {gpu::SPEC_HAS_SURFACES, flag(!scene.shapes.empty())},
-      {gpu::SPEC_SURFACE_SHAPE_COUNT, gpu_surfaces_.shape_count},
-      {gpu::SPEC_SURFACE_HAS_TRIANGLES, flag(gpu_surfaces_.triangle_count > 0)},
-      {gpu::SPEC_HAS_ENVIRONMENT, flag(scene.environment.has_value())}};
+  spec_ = spec_constants(scene, gpu_scene_, settings);
   pipeline_.emplace(ctx, vk::load_spirv("render.comp"),
                     std::vector<vk::ComputePipeline::Binding>{
                         {gpu::BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
@@ -75,21 +62,13 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                         {gpu::BINDING_ENV_TEXELS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_ENV_CDF, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_ENV_HEADER, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}},
-                    uint32_t(sizeof(gpu::PassConstants)), spec, "render");
+                    uint32_t(sizeof(gpu::PassConstants)), spec_, "render");
   set_.emplace(ctx, *pipeline_, "render set");
   set_->write_buffer(gpu::BINDING_FRAME, frame_buffer_);
   set_->write_buffer(gpu::BINDING_MEDIA, media_buffer_);
   set_->write_buffer(gpu::BINDING_ACCUM, accum_);
   set_->write_buffer(gpu::BINDING_GRIDS, grid_buffer_);
-  set_->write_buffer(gpu::BINDING_MAJORANTS, majorant_buffer_);
-  // textures_3d_[0] / textures_1d_[0] are 1-texel placeholders for unused slots.
-  for (uint32_t slot = 0; slot < gpu::MAX_GRIDS; ++slot) {
-    const bool used = slot < gpu_scene_.grid_sources.size();
-    const size_t d = used ? 1 + 2 * slot : 0, t = used ? 2 + 2 * slot : 0, b = used ? 1 + slot : 0;
-    set_->write_image(gpu::BINDING_DENSITY, textures_3d_[d], slot);
-    set_->write_image(gpu::BINDING_TEMPERATURE, textures_3d_[t], slot);
-    set_->write_image(gpu::BINDING_BLACKBODY, textures_1d_[b], slot);
-  }
+  write_grid_descriptors();
   set_->write_buffer(gpu::BINDING_BVH_NODES, bvh_nodes_);
   set_->write_buffer(gpu::BINDING_BVH_TRIANGLES, bvh_triangles_);
   set_->write_buffer(gpu::BINDING_BVH_ATTRIBUTES, bvh_attributes_);
@@ -110,6 +89,71 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
     pipeline_->push(cmd, nothing);
     vkCmdDispatch(cmd, 1, 1, 1);
   });
+}
+
+// The shader variant: code for grids, scattering and emission only when used.
+std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const Scene& scene, const GpuScene& g,
+                                                                        const RenderSettings& settings) const {
+  auto flag = [](bool b) { return uint32_t(b ? 1 : 0); };
+  return {{gpu::SPEC_HAS_GRIDS, flag(g.has_grids)},
+          {gpu::SPEC_HAS_SCATTERING, flag(g.has_scattering && scene.integrator.max_depth > 0)},
+          {gpu::SPEC_HAS_EMISSION, flag(g.has_emission)},
+          {gpu::SPEC_COLLISION_ESTIMATOR, flag(scene.integrator.emission_estimator == "collision")},
+          {gpu::SPEC_DEBUG_MODE, settings.debug_mode},
+          {gpu::SPEC_MEDIUM_COUNT, uint32_t(g.media.size())},
+          {gpu::SPEC_GRID_COUNT, uint32_t(g.grids.size())},
+          {gpu::SPEC_HAS_SURFACES, flag(!scene.shapes.empty())},
+          {gpu::SPEC_SURFACE_SHAPE_COUNT, gpu_surfaces_.shape_count},
+          {gpu::SPEC_SURFACE_HAS_TRIANGLES, flag(gpu_surfaces_.triangle_count > 0)},
+          {gpu::SPEC_HAS_ENVIRONMENT, flag(scene.environment.has_value())}};
+}
+
+// The bindings that change with the media's grids.
+void RenderSession::write_grid_descriptors() {
+  set_->write_buffer(gpu::BINDING_MAJORANTS, majorant_buffer_);
+  // textures_3d_[0] / textures_1d_[0] are 1-texel placeholders for unused slots.
+  for (uint32_t slot = 0; slot < gpu::MAX_GRIDS; ++slot) {
+    const bool used = slot < gpu_scene_.grid_sources.size();
+    const size_t d = used ? 1 + 2 * slot : 0, t = used ? 2 + 2 * slot : 0, b = used ? 1 + slot : 0;
+    set_->write_image(gpu::BINDING_DENSITY, textures_3d_[d], slot);
+    set_->write_image(gpu::BINDING_TEMPERATURE, textures_3d_[t], slot);
+    set_->write_image(gpu::BINDING_BLACKBODY, textures_1d_[b], slot);
+  }
+}
+
+bool RenderSession::load_frame(const Scene& scene, const RenderSettings& settings) {
+  if (settings.width != settings_.width || settings.height != settings_.height ||
+      settings.debug_mode != settings_.debug_mode || scene.media.size() != volumes_.size())
+    return false;
+  // Load into locals first: a bad frame (or a different variant) leaves the
+  // session as it was.
+  std::vector<std::optional<StoredVolume>> volumes(scene.media.size());
+  for (size_t i = 0; i < scene.media.size(); ++i)
+    if (scene.media[i].type == Medium::Type::Vdb) volumes[i] = load_stored_volume(scene.media[i]);
+  GpuScene gpu_scene = build_gpu_scene(scene, volumes);
+  if (spec_constants(scene, gpu_scene, settings) != spec_) return false;
+
+  // The previous frame's textures live until the descriptors point at the new
+  // ones (every pass was waited for, so none is in flight).
+  auto old_3d = std::move(textures_3d_);
+  auto old_1d = std::move(textures_1d_);
+  textures_3d_.clear();
+  textures_1d_.clear();
+  volumes_ = std::move(volumes);
+  gpu_scene_ = std::move(gpu_scene);
+  settings_ = settings;
+  warnings_.clear();
+  for (const auto& v : volumes_)
+    if (v)
+      for (const auto& w : v->warnings) warnings_.push_back(w);
+  majorant_buffer_ = vk::Buffer(ctx_, std::max<size_t>(1, gpu_scene_.majorants.size()) * sizeof(float), kStorage,
+                                vk::MemoryKind::DeviceLocal, "majorant cells");
+  if (!gpu_scene_.majorants.empty())
+    majorant_buffer_.upload(ctx_, gpu_scene_.majorants.data(), gpu_scene_.majorants.size() * sizeof(float));
+  create_textures(scene);
+  write_grid_descriptors();
+  upload_constants(scene);
+  return true;
 }
 
 // One 3D texture per grid, each over its own active bounding box with its own

@@ -22,6 +22,16 @@ class RenderSession {
  public:
   RenderSession(vk::Context& ctx, const Scene& scene, const RenderSettings& settings);
 
+  // The next frame of a sequence (docs/animation.md): reload the media's grids
+  // and re-upload only what depends on them (3D textures, majorant cells,
+  // blackbody LUTs, constants), keeping the pipeline, the surfaces' BVH and
+  // textures, the environment map and the accumulation buffer. Returns false,
+  // changing nothing, when the frame needs a different session (another image
+  // size, debug mode, medium count or shader variant); the caller then builds
+  // a new one. Assumes the shapes and the environment are the ones this
+  // session was built with (a sequence changes only media and keyed values).
+  bool load_frame(const Scene& scene, const RenderSettings& settings);
+
   // Re-upload what the scene changes (camera, media parameters, temperature
   // mapping, density scale) and restart the accumulation. Image size, grids,
   // textures and the shader variant stay as constructed.
@@ -49,6 +59,9 @@ class RenderSession {
   void create_textures(const Scene& scene);
   void create_surfaces(const Scene& scene);
   void create_environment(const Scene& scene);
+  std::vector<std::pair<uint32_t, uint32_t>> spec_constants(const Scene& scene, const GpuScene& gpu_scene,
+                                                           const RenderSettings& settings) const;
+  void write_grid_descriptors();
 
   vk::Context& ctx_;
   RenderSettings settings_;
@@ -66,6 +79,7 @@ class RenderSession {
   vk::Buffer env_texels_, env_cdf_, env_header_;
   std::optional<vk::ComputePipeline> pipeline_;
   std::optional<vk::DescriptorSet> set_;
+  std::vector<std::pair<uint32_t, uint32_t>> spec_;  // the variant pipeline_ was compiled for
   int spp_done_ = 0;
   bool needs_clear_ = true;
 };

@@ -29,6 +29,11 @@ std::string VulkanRenderer::device_name() const { return context_->info().name; 
 
 uint64_t VulkanRenderer::validation_messages() const { return context_->validation_messages(); }
 
+void VulkanRenderer::set_frame_reuse(bool on) {
+  frame_reuse_ = on;
+  if (!on) kept_.reset();
+}
+
 int VulkanRenderer::spp_per_pass(int width, int height, int spp) {
   // About 2^19 paths per dispatch: tens of milliseconds on lavapipe for simple
   // scenes, far below any GPU watchdog, and large enough that per-dispatch
@@ -40,7 +45,15 @@ int VulkanRenderer::spp_per_pass(int width, int height, int spp) {
 
 RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& settings, const RenderControl& control) {
   auto load_start = Clock::now();
-  RenderSession session(*context_, scene, settings);
+  std::unique_ptr<RenderSession> fresh;
+  if (frame_reuse_ && kept_ && kept_->load_frame(scene, settings)) {
+    ++reused_frames_;
+  } else {
+    kept_.reset();  // free the previous frame's memory before allocating the next
+    fresh = std::make_unique<RenderSession>(*context_, scene, settings);
+  }
+  if (fresh && frame_reuse_) kept_ = std::move(fresh);
+  RenderSession& session = fresh ? *fresh : *kept_;
   RenderResult result;
   result.backend = name();
   result.device = device_name();

@@ -11,6 +11,7 @@ namespace pyrolume {
 namespace vk {
 class Context;
 }
+class RenderSession;
 
 class VulkanRenderer : public Backend {
  public:
@@ -26,8 +27,21 @@ class VulkanRenderer : public Backend {
   // timing and reruns are bit-identical.
   static int spp_per_pass(int width, int height, int spp);
 
+  // Sequences (docs/animation.md): keep the session between renders and, when
+  // the next scene differs only in its media's grids and keyed values (same
+  // image size, shapes, environment and shader variant), reload just the
+  // grids, majorants and LUTs into it: the pipeline, BVH and environment are
+  // built once per sequence. Off by default: a renderer that renders
+  // unrelated scenes (tests, bench) must not hold on to one.
+  void set_frame_reuse(bool on);
+  // Renders that reused the kept session (tests, stats).
+  int reused_frames() const { return reused_frames_; }
+
  private:
   std::unique_ptr<vk::Context> context_;
+  std::unique_ptr<RenderSession> kept_;
+  bool frame_reuse_ = false;
+  int reused_frames_ = 0;
   double context_seconds_ = 0.0;  // instance + device creation, charged to the first render's load_seconds
 };
 
