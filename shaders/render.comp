@@ -173,7 +173,7 @@ void media_spans(vec3 o, vec3 d, out vec2 span[MEDIA_N], out bool any_hit) {
 // Majorant of grid medium m over the DDA cell the ray is in at t, and the t at
 // which the ray leaves that cell. Stateless: the cell is found at t + a small
 // nudge along the ray, so a point on a face belongs to the cell being entered.
-float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, inout float t_next) {
+float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, float t_span_end, inout float t_next) {
   uint slot = uint(m.bounds0.x);
   vec3 u = density_texel(slot, o + t * d);
   vec3 du = density_texel_dir(slot, d);
@@ -182,16 +182,39 @@ float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, inout float t_next) {
   vec3 cs = cell_info.xyz;
   vec3 inv_du = 1.0 / du;
   float nudge = 1e-4 * min3(cs) / max(max3(abs(du)), 1e-30);
+  // At least a few float ulps of t, so t always moves on (a far camera loses
+  // precision in u; see also the origin shift in path_step).
+  float min_step = max(nudge, abs(t) * 1e-6);
   ivec3 res = ivec3(res4.xyz);
   ivec3 cell = clamp(ivec3(floor((u + du * nudge) / cs)), ivec3(0), res - 1);
   vec3 bound = (vec3(cell) + step(vec3(0.0), du)) * cs;
   vec3 tx = (bound - u) * inv_du;  // ±inf on axes the ray runs parallel to
-  // At least a few float ulps of t, so t always moves on (a far camera loses
-  // precision in u; see also the origin shift in path_step).
-  float t_exit = t + max(min3(mix(tx, vec3(INF), isnan(tx))), max(nudge, abs(t) * 1e-6));
-  t_next = min(t_next, t_exit);
+  vec3 t_axis = t + mix(tx, vec3(INF), isnan(tx));  // where the ray crosses each axis' next face
   uint index = res4.w + uint((cell.z * res.y + cell.y) * res.x + cell.x);
-  return majorants[index] * cell_info.w;
+  float majorant = majorants[index];
+  if (majorant > 0.0) {
+    t_next = min(t_next, max(min3(t_axis), t + min_step));
+    return majorant * cell_info.w;
+  }
+  // An empty cell: walk the DDA on to the first non-empty cell (or out of the
+  // grid) right here, so a run of empty cells costs one tracking step.
+  vec3 t_delta = abs(cs * inv_du);
+  ivec3 dir = ivec3(sign(du));
+  float t_enter = min3(t_axis);
+  for (uint n = 0u; n < 256u && t_enter < t_span_end; ++n) {
+    int a = t_axis.x <= t_axis.y ? (t_axis.x <= t_axis.z ? 0 : 2) : (t_axis.y <= t_axis.z ? 1 : 2);
+    cell[a] += dir[a];
+    if (cell[a] < 0 || cell[a] >= res[a]) {
+      t_enter = INF;  // left the grid: empty up to the span's end
+      break;
+    }
+    t_axis[a] += t_delta[a];
+    index = res4.w + uint((cell.z * res.y + cell.y) * res.x + cell.x);
+    if (majorants[index] > 0.0) break;
+    t_enter = min3(t_axis);
+  }
+  t_next = min(t_next, max(t_enter, t + min_step));
+  return 0.0;
 }
 
 // Media coefficients at a tentative collision; rho[i] keeps each grid's
@@ -247,7 +270,7 @@ float majorant_at(vec3 o, vec3 d, float t, vec2 span[MEDIA_N], out float t_next,
     }
     t_next = min(t_next, s.y);
     GpuMedium m = media[i];
-    if (HAS_GRIDS && uint(m.sigma_a.w) == SHAPE_GRID) sigma_bar += grid_majorant(m, o, d, t, t_next);
+    if (HAS_GRIDS && uint(m.sigma_a.w) == SHAPE_GRID) sigma_bar += grid_majorant(m, o, d, t, s.y, t_next);
     else sigma_bar += max3(m.sigma_a.rgb + m.sigma_s.rgb);
   }
   return sigma_bar;
