@@ -58,6 +58,7 @@ GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<Sto
 
       gpu::GpuGrid grid{};
       GpuGridSource src;
+      src.medium = i;
       src.density = &v.density;
       texel_rows(v.density.grid, grid.density_row0, grid.density_row1, grid.density_row2);
       grid.density_dims = v4(glm::dvec3(v.density.grid.dims), m.density_scale);

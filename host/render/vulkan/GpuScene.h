@@ -15,6 +15,7 @@ struct GpuGridSource {
   const StoredGrid* density = nullptr;
   const StoredGrid* temperature = nullptr;  // null unless the medium emits from its temperature
   std::optional<color::BlackbodyLut> blackbody;
+  size_t medium = 0;  // index into Scene::media
 };
 
 struct GpuScene {

@@ -130,7 +130,23 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
   std::vector<std::optional<StoredVolume>> volumes(scene.media.size());
   for (size_t i = 0; i < scene.media.size(); ++i)
     if (scene.media[i].type == Medium::Type::Vdb) volumes[i] = load_stored_volume(scene.media[i]);
-  GpuScene gpu_scene = build_gpu_scene(scene, volumes);
+  // The blackbody LUTs depend only on the emission's mode, observer and
+  // adaptation: bake them once per sequence and reuse them frame after frame.
+  GpuScene gpu_scene = build_gpu_scene(scene, volumes, /*with_luts=*/false);
+  for (size_t slot = 0; slot < gpu_scene.grid_sources.size(); ++slot) {
+    GpuGridSource& src = gpu_scene.grid_sources[slot];
+    if (!src.temperature) continue;
+    const Emission& e = scene.media[src.medium].emission;
+    for (const GpuGridSource& old : gpu_scene_.grid_sources)
+      if (old.blackbody && old.blackbody->mode() == e.blackbody && old.blackbody->observer() == e.observer &&
+          old.blackbody->adapt_to_k() == e.adapt_to_k) {
+        src.blackbody = old.blackbody;
+        break;
+      }
+    if (!src.blackbody) src.blackbody.emplace(e.blackbody, e.observer, e.adapt_to_k);
+    const color::BlackbodyLutParams& p = src.blackbody->params();
+    gpu_scene.grids[slot].blackbody_lut = gpu::vec4(p.log_scale, p.log_bias, p.t_min_k, 0.f);
+  }
   if (spec_constants(scene, gpu_scene, settings) != spec_) return false;
 
   // The previous frame's textures live until the descriptors point at the new
