@@ -29,6 +29,7 @@
 
 #include "scene/Scene.h"
 #include "support/AnalyticScenes.h"
+#include "support/TestSupport.h"
 
 namespace pyrolume::test {
 
@@ -439,5 +440,29 @@ std::function<glm::dvec3(int, int)> transmittance_exact(const Scene& s, const Fi
       },
       base, max_level, steep_rel);
 }
+
+// The constant box both backends' vdb tests render (cpu_vdb_test,
+// vulkan_vdb_test): 17 × 13 × 15 voxels of 0.1 holding c = 0.75 (exact in
+// half), viewed obliquely; the VDB is written into `dir`.
+struct ConstantBoxSetup {
+  explicit ConstantBoxSetup(const std::string& tag) : dir(temp_dir(tag)) {}
+  std::filesystem::path dir;
+  Lattice lat{0.1, {0.02, -0.01, 0.03}};
+  VoxelBox box{{-8, -6, -7}, {8, 6, 7}};
+  float c = 0.75f;
+
+  Scene constant_box_scene(int w, int h, int spp, glm::dvec3 sigma_a, glm::dvec3 sigma_s,
+                           std::optional<glm::dvec3> Le = glm::dvec3(1.0, 0.6, 0.3), double scale = 1.5) {
+    Scene s = vdb_base_scene(w, h, spp);
+    s.camera.position = {2.0, 1.5, -4.0};
+    s.camera.look_at = {0.1, 0.05, 0.0};
+    s.background = {0.05, 0.1, 0.2};
+    s.media.push_back(
+        vdb_medium("box", write_constant_box_vdb(dir / "box.vdb", lat, box, c), sigma_a, sigma_s, 0.3, Le, scale));
+    s.media[0].density_scale = 1.5;
+    return s;
+  }
+  ConstantBoxField field() const { return {lat, box, double(c)}; }
+};
 
 }  // namespace pyrolume::test

@@ -50,27 +50,11 @@ ZTestOptions pooled() {
 
 const char* kEstimators[] = {"absorption", "collision"};
 
-class CpuVdb : public ::testing::Test {
+// The constant box (lat, box, c, dir, constant_box_scene, field) comes from
+// test::ConstantBoxSetup, shared with vulkan_vdb_test.
+class CpuVdb : public ::testing::Test, public test::ConstantBoxSetup {
  protected:
-  std::filesystem::path dir = test::temp_dir("cpu_vdb");
-
-  // A constant box of 17 × 13 × 15 voxels of 0.1 (c = 0.75, exact in half).
-  test::Lattice lat{0.1, {0.02, -0.01, 0.03}};
-  test::VoxelBox box{{-8, -6, -7}, {8, 6, 7}};
-  float c = 0.75f;
-
-  Scene constant_box_scene(int w, int h, int spp, glm::dvec3 sigma_a, glm::dvec3 sigma_s,
-                           std::optional<glm::dvec3> Le = glm::dvec3(1.0, 0.6, 0.3), double scale = 1.5) {
-    Scene s = test::vdb_base_scene(w, h, spp);
-    s.camera.position = {2.0, 1.5, -4.0};
-    s.camera.look_at = {0.1, 0.05, 0.0};
-    s.background = {0.05, 0.1, 0.2};
-    s.media.push_back(test::vdb_medium("box", test::write_constant_box_vdb(dir / "box.vdb", lat, box, c), sigma_a,
-                                       sigma_s, 0.3, Le, scale));
-    s.media[0].density_scale = 1.5;
-    return s;
-  }
-  test::ConstantBoxField field() const { return {lat, box, double(c)}; }
+  CpuVdb() : test::ConstantBoxSetup("cpu_vdb") {}
 
   void expect_closed_form(Scene s, const test::ConstantBoxField& f, const char* what) {
     auto exact = test::constant_box_exact(s, f);

@@ -43,7 +43,9 @@ double per_sample(double count, const RenderResult& r) { return count / (double(
 
 const char* kEstimators[] = {"absorption", "collision"};
 
-class VulkanVdb : public ::testing::Test {
+// The constant box (lat, box, c, dir, constant_box_scene, field) comes from
+// test::ConstantBoxSetup, shared with cpu_vdb_test.
+class VulkanVdb : public ::testing::Test, public test::ConstantBoxSetup {
  protected:
   static void SetUpTestSuite() {
     BackendOptions o;
@@ -63,26 +65,7 @@ class VulkanVdb : public ::testing::Test {
 
   static std::unique_ptr<Backend> backend_;
 
-  std::filesystem::path dir = test::temp_dir("vulkan_vdb");
-
-  // A constant box of 17 × 13 × 15 voxels of 0.1 (c = 0.75, exact in half):
-  // the same as cpu_vdb_test's.
-  test::Lattice lat{0.1, {0.02, -0.01, 0.03}};
-  test::VoxelBox box{{-8, -6, -7}, {8, 6, 7}};
-  float c = 0.75f;
-
-  Scene constant_box_scene(int w, int h, int spp, glm::dvec3 sigma_a, glm::dvec3 sigma_s,
-                           std::optional<glm::dvec3> Le = glm::dvec3(1.0, 0.6, 0.3), double scale = 1.5) {
-    Scene s = test::vdb_base_scene(w, h, spp);
-    s.camera.position = {2.0, 1.5, -4.0};
-    s.camera.look_at = {0.1, 0.05, 0.0};
-    s.background = {0.05, 0.1, 0.2};
-    s.media.push_back(test::vdb_medium("box", test::write_constant_box_vdb(dir / "box.vdb", lat, box, c), sigma_a,
-                                       sigma_s, 0.3, Le, scale));
-    s.media[0].density_scale = 1.5;
-    return s;
-  }
-  test::ConstantBoxField field() const { return {lat, box, double(c)}; }
+  VulkanVdb() : test::ConstantBoxSetup("vulkan_vdb") {}
 
   // Both estimators against the exact image; returns the last render.
   RenderResult expect_closed_form(Scene s, const std::function<glm::dvec3(int, int)>& exact, const char* what,
