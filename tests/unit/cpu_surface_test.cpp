@@ -20,11 +20,19 @@
 #include "render/cpu/Sampling.h"
 #include "support/AnalyticScenes.h"
 #include "support/Stats.h"
+#include "support/SurfaceScenes.h"
 #include "support/TestSupport.h"
 
 namespace pyrolume {
 namespace {
 
+using test::plane_shape;
+using test::srgb_to_linear;
+using test::sphere_shape;
+using test::TexelBytes;
+using test::texture_lookup;
+using test::TexVariant;
+using test::write_open_box_obj;
 using test::ZTestOptions;
 using test::ZTestReport;
 
@@ -60,25 +68,8 @@ double pixel_spread(const RenderResult& r, int x, int y) {
   return worst;
 }
 
-Shape sphere_shape(glm::dvec3 center, double radius, glm::dvec3 albedo) {
-  Shape s;
-  s.type = Shape::Type::Sphere;
-  s.center = center;
-  s.radius = radius;
-  s.albedo = albedo;
-  return s;
-}
 
 // size 0: unbounded along that axis.
-Shape plane_shape(glm::dvec3 center, glm::dvec3 normal, glm::dvec2 size, glm::dvec3 albedo) {
-  Shape s;
-  s.type = Shape::Type::Plane;
-  s.center = center;
-  s.normal = normal;
-  s.size = size;
-  s.albedo = albedo;
-  return s;
-}
 
 ZTestOptions pooled(double tolerance = 0.005) {
   ZTestOptions o;
@@ -87,8 +78,6 @@ ZTestOptions pooled(double tolerance = 0.005) {
   return o;
 }
 
-// IEC 61966-2-1 decode, written here independently of image/ImageIo.
-double srgb_to_linear(double v) { return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4); }
 
 // ------------------------------------------------------------- sampler ----
 
@@ -226,19 +215,6 @@ TEST(CpuSurface, SurfaceBounceCountsAsOneEvent) {
 // that escapes returns exactly 1 (white furnace), whatever the number of
 // bounces, with either estimator; with max_depth = 1 paths needing a second
 // bounce die, so the image must darken (this scene does inter-reflect).
-std::filesystem::path write_open_box_obj(const std::filesystem::path& dir) {
-  // Unit cube [-1, 1]³ without its +y face.
-  std::string obj =
-      "v -1 -1 -1\nv 1 -1 -1\nv 1 -1 1\nv -1 -1 1\nv -1 1 -1\nv 1 1 -1\nv 1 1 1\nv -1 1 1\n"
-      "f 1 2 3 4\n"   // bottom
-      "f 1 5 6 2\n"   // z = -1
-      "f 2 6 7 3\n"   // x = +1
-      "f 3 7 8 4\n"   // z = +1
-      "f 4 8 5 1\n";  // x = -1
-  std::filesystem::path p = dir / "open_box.obj";
-  test::write_file(p, obj);
-  return p;
-}
 
 Scene concave_furnace_scene(const std::filesystem::path& obj, int max_depth) {
   Scene s = test::analytic_base_scene(24, 24, 16);
@@ -288,48 +264,12 @@ TEST(CpuSurface, FurnaceConcaveMeshSphereAndMediumIsOne) {
 // bilinear/wrap lookup with the documented v flip (uv (0, 0) = the image's
 // bottom-left). Wrong decoding (bytes taken as linear) or a missing flip must
 // fail the same z-test.
-struct TexelBytes {
-  int w = 4, h = 4;
-  std::vector<uint8_t> rgb;  // row 0 = top
-  TexelBytes() {
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        rgb.push_back(uint8_t(30 + 60 * x));             // r: left → right
-        rgb.push_back(uint8_t(230 - 65 * y));            // g: top bright, bottom dark
-        rgb.push_back(uint8_t((x + y) % 2 ? 200 : 40));  // b: checker
-      }
-  }
-};
-
-enum class TexVariant { Correct, NoFlip, NoDecode };
-
-glm::dvec3 texture_lookup(const TexelBytes& t, glm::dvec2 uv, TexVariant v, int* sig) {
-  auto texel = [&](int x, int y) {
-    x = ((x % t.w) + t.w) % t.w;
-    y = ((y % t.h) + t.h) % t.h;
-    glm::dvec3 c;
-    for (int k = 0; k < 3; ++k) {
-      const double e = t.rgb[(size_t(y) * t.w + x) * 3 + k] / 255.0;
-      c[k] = v == TexVariant::NoDecode ? e : srgb_to_linear(e);
-    }
-    return c;
-  };
-  const double X = uv.x * t.w - 0.5;
-  const double Y = (v == TexVariant::NoFlip ? uv.y : 1.0 - uv.y) * t.h - 0.5;
-  const double x0 = std::floor(X), y0 = std::floor(Y), fx = X - x0, fy = Y - y0;
-  if (sig) *sig = int(x0) * 1000 + int(y0);
-  const int i = int(x0), j = int(y0);
-  return (1 - fy) * ((1 - fx) * texel(i, j) + fx * texel(i + 1, j)) + fy * ((1 - fx) * texel(i, j + 1) + fx * texel(i + 1, j + 1));
-}
 
 TEST(CpuSurface, TexturedPlaneShowsLinearisedTexture) {
   const TexelBytes bytes;
   auto dir = test::temp_dir("cpu_surface_texture");
   // Linear values that encode to exactly these bytes (round(255·encode(decode(b/255))) = b).
-  Image img = make_image(bytes.w, bytes.h);
-  for (size_t k = 0; k < bytes.rgb.size(); ++k) img.rgb[k] = float(srgb_to_linear(bytes.rgb[k] / 255.0));
-  const auto png = dir / "albedo.png";
-  write_image(png, img);
+  const auto png = test::write_texel_png(bytes, dir);
 
   Scene s = test::analytic_base_scene(24, 24, 128);
   s.background = glm::dvec3(1.0);
