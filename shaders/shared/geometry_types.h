@@ -8,17 +8,9 @@
 #ifndef PYROLUME_GEOMETRY_TYPES_H
 #define PYROLUME_GEOMETRY_TYPES_H
 
+#include "shared/common.h"
 #ifdef __cplusplus
-#include <cstddef>
-#include <cstdint>
-#include <glm/glm.hpp>
 namespace pyrolume::gpu {
-using vec4 = glm::vec4;
-using uvec4 = glm::uvec4;
-using uint = uint32_t;
-#define PYRO_CONST constexpr
-#else
-#define PYRO_CONST const
 #endif
 
 // Traversal keeps a fixed stack of this many node indices; the builder caps the
@@ -97,5 +89,4 @@ static_assert(sizeof(GpuSurfaceShape) == 64);
 static_assert(sizeof(GpuMaterial) == 32);
 }  // namespace pyrolume::gpu
 #endif
-#undef PYRO_CONST
 #endif

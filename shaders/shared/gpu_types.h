@@ -5,17 +5,9 @@
 #ifndef PYROLUME_GPU_TYPES_H
 #define PYROLUME_GPU_TYPES_H
 
+#include "shared/common.h"
 #ifdef __cplusplus
-#include <cstddef>
-#include <cstdint>
-#include <glm/glm.hpp>
 namespace pyrolume::gpu {
-using vec4 = glm::vec4;
-using uvec4 = glm::uvec4;
-using uint = uint32_t;
-#define PYRO_CONST constexpr
-#else
-#define PYRO_CONST const
 #endif
 
 PYRO_CONST uint WORKGROUP_SIZE_X = 8;
@@ -134,5 +126,4 @@ static_assert(sizeof(PassConstants) == 16);
 static_assert(sizeof(AccumTexel) == 64);
 }  // namespace pyrolume::gpu
 #endif
-#undef PYRO_CONST
 #endif

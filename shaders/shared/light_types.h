@@ -8,14 +8,9 @@
 #ifndef PYROLUME_LIGHT_TYPES_H
 #define PYROLUME_LIGHT_TYPES_H
 
+#include "shared/common.h"
 #ifdef __cplusplus
-#include <cstddef>
-#include <cstdint>
-#include <glm/glm.hpp>
 namespace pyrolume::gpu {
-using vec4 = glm::vec4;
-using uvec4 = glm::uvec4;
-using uint = uint32_t;
 #endif
 
 // A lat-long environment map (32 bytes). +Z up, Blender's equirectangular

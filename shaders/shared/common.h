@@ -1,0 +1,21 @@
+// The common subset of GLSL and C++ that every header in shaders/shared/ is
+// written in: on the C++ side GLM's vec4/uvec4 and `uint` inside
+// pyrolume::gpu, and PYRO_CONST for constants both languages accept.
+#ifndef PYROLUME_SHARED_COMMON_H
+#define PYROLUME_SHARED_COMMON_H
+
+#ifdef __cplusplus
+#include <cstddef>
+#include <cstdint>
+#include <glm/glm.hpp>
+namespace pyrolume::gpu {
+using vec4 = glm::vec4;
+using uvec4 = glm::uvec4;
+using uint = uint32_t;
+}  // namespace pyrolume::gpu
+#define PYRO_CONST constexpr
+#else
+#define PYRO_CONST const
+#endif
+
+#endif
