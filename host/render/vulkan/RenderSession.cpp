@@ -12,6 +12,17 @@ namespace {
 constexpr VkBufferUsageFlags kUniform = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 
+// A device-local storage buffer holding `values`; an empty vector gets one
+// zeroed element (Vulkan has no empty buffers; the shader never reads it).
+template <typename T>
+vk::Buffer storage_buffer(vk::Context& ctx, const std::vector<T>& values, const char* name) {
+  const std::vector<T> one(1);
+  const std::vector<T>& v = values.empty() ? one : values;
+  vk::Buffer b(ctx, v.size() * sizeof(T), kStorage, vk::MemoryKind::DeviceLocal, name);
+  b.upload(ctx, v.data(), v.size() * sizeof(T));
+  return b;
+}
+
 std::string mib(double bytes) { return std::to_string(int(bytes / (1024.0 * 1024.0) + 0.5)) + " MiB"; }
 }  // namespace
 
@@ -30,10 +41,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                              vk::MemoryKind::HostVisible, "frame constants");
   media_buffer_ = vk::Buffer(ctx, gpu::MAX_MEDIA * sizeof(gpu::GpuMedium), kUniform, vk::MemoryKind::HostVisible, "media");
   grid_buffer_ = vk::Buffer(ctx, gpu::MAX_GRIDS * sizeof(gpu::GpuGrid), kUniform, vk::MemoryKind::HostVisible, "grids");
-  majorant_buffer_ = vk::Buffer(ctx, std::max<size_t>(1, gpu_scene_.majorants.size()) * sizeof(float), kStorage,
-                                vk::MemoryKind::DeviceLocal, "majorant cells");
-  if (!gpu_scene_.majorants.empty())
-    majorant_buffer_.upload(ctx, gpu_scene_.majorants.data(), gpu_scene_.majorants.size() * sizeof(float));
+  majorant_buffer_ = storage_buffer(ctx, gpu_scene_.majorants, "majorant cells");
   accum_ = vk::Buffer(ctx, size_t(settings.width) * size_t(settings.height) * sizeof(gpu::AccumTexel),
                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                           VK_BUFFER_USAGE_TRANSFER_DST_BIT,
@@ -162,10 +170,7 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
   for (const auto& v : volumes_)
     if (v)
       for (const auto& w : v->warnings) warnings_.push_back(w);
-  majorant_buffer_ = vk::Buffer(ctx_, std::max<size_t>(1, gpu_scene_.majorants.size()) * sizeof(float), kStorage,
-                                vk::MemoryKind::DeviceLocal, "majorant cells");
-  if (!gpu_scene_.majorants.empty())
-    majorant_buffer_.upload(ctx_, gpu_scene_.majorants.data(), gpu_scene_.majorants.size() * sizeof(float));
+  majorant_buffer_ = storage_buffer(ctx_, gpu_scene_.majorants, "majorant cells");
   create_textures(scene);
   write_grid_descriptors();
   upload_constants(scene);
@@ -242,16 +247,12 @@ void RenderSession::create_surfaces(const Scene& scene) {
     throw input_error(scene.file.string(), "shapes",
                       "at most " + std::to_string(gpu::MAX_TEXTURES) + " different albedo textures per scene");
   gpu_surfaces_ = geometry::pack_gpu_surfaces(surfaces);
-  auto storage = [&](vk::Buffer& b, const void* data, size_t bytes, const char* name) {
-    b = vk::Buffer(ctx_, bytes, kStorage, vk::MemoryKind::DeviceLocal, name);
-    b.upload(ctx_, data, bytes);
-  };
   const auto& g = gpu_surfaces_;
-  storage(bvh_nodes_, g.nodes.data(), g.nodes.size() * sizeof(g.nodes[0]), "bvh nodes");
-  storage(bvh_triangles_, g.triangles.data(), g.triangles.size() * sizeof(g.triangles[0]), "bvh triangles");
-  storage(bvh_attributes_, g.attributes.data(), g.attributes.size() * sizeof(g.attributes[0]), "bvh attributes");
-  storage(surface_shapes_, g.shapes.data(), g.shapes.size() * sizeof(g.shapes[0]), "surface shapes");
-  storage(materials_, g.materials.data(), g.materials.size() * sizeof(g.materials[0]), "materials");
+  bvh_nodes_ = storage_buffer(ctx_, g.nodes, "bvh nodes");
+  bvh_triangles_ = storage_buffer(ctx_, g.triangles, "bvh triangles");
+  bvh_attributes_ = storage_buffer(ctx_, g.attributes, "bvh attributes");
+  surface_shapes_ = storage_buffer(ctx_, g.shapes, "surface shapes");
+  materials_ = storage_buffer(ctx_, g.materials, "materials");
 
   const uint8_t white[4] = {255, 255, 255, 255};
   textures_2d_.emplace_back(ctx_, 1, 1, VK_FORMAT_R8G8B8A8_SRGB, VK_SAMPLER_ADDRESS_MODE_REPEAT,
@@ -276,19 +277,17 @@ void RenderSession::create_surfaces(const Scene& scene) {
 // (bilinear lookups in the shader, exactly like host/light/EnvironmentMap);
 // 1-element placeholders when the scene has none.
 void RenderSession::create_environment(const Scene& scene) {
-  std::vector<float> texels(4, 0.0f), cdf(1, 0.0f);
+  std::vector<float> texels(4, 0.0f), cdf;  // texels are vec4s: the placeholder is one
   gpu::GpuEnvironment header{};
   if (scene.environment) {
     EnvironmentMap env = EnvironmentMap::load(scene.environment->file, scene.environment->scale,
                                               scene.environment->rotation_deg);
     texels = env.gpu_texels();
-    if (!env.gpu_cdf().empty()) cdf = env.gpu_cdf();
+    cdf = env.gpu_cdf();
     header = env.gpu_header();
   }
-  env_texels_ = vk::Buffer(ctx_, texels.size() * sizeof(float), kStorage, vk::MemoryKind::DeviceLocal, "environment");
-  env_texels_.upload(ctx_, texels.data(), texels.size() * sizeof(float));
-  env_cdf_ = vk::Buffer(ctx_, cdf.size() * sizeof(float), kStorage, vk::MemoryKind::DeviceLocal, "environment cdf");
-  env_cdf_.upload(ctx_, cdf.data(), cdf.size() * sizeof(float));
+  env_texels_ = storage_buffer(ctx_, texels, "environment");
+  env_cdf_ = storage_buffer(ctx_, cdf, "environment cdf");
   env_header_ = vk::Buffer(ctx_, sizeof header, kUniform, vk::MemoryKind::HostVisible, "environment header");
   env_header_.upload(ctx_, &header, sizeof header);
 }
