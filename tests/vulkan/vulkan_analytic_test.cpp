@@ -4,6 +4,7 @@
 
 #include "render/Backend.h"
 #include "render/cpu/CpuRenderer.h"
+#include "support/VulkanFixture.h"
 #include "support/AnalyticScenes.h"
 #include "support/Stats.h"
 
@@ -12,21 +13,12 @@ namespace {
 
 using test::settings_for;
 
-class VulkanAnalytic : public ::testing::Test {
+class VulkanAnalytic : public test::VulkanFixture {
  protected:
-  static void SetUpTestSuite() {
-    BackendOptions o;
-    o.validation = true;
-    backend_ = make_backend("vulkan", o);
-  }
-  static void TearDownTestSuite() { backend_.reset(); }
-  void TearDown() override { EXPECT_EQ(backend_->validation_messages(), 0u) << "Vulkan validation reported problems"; }
 
   RenderResult render(const Scene& s) { return backend_->render(s, settings_for(s), {}); }
 
-  static std::unique_ptr<Backend> backend_;
 };
-std::unique_ptr<Backend> VulkanAnalytic::backend_;
 
 test::ZTestOptions pooled() {
   test::ZTestOptions o;

@@ -23,6 +23,7 @@
 #include "render/Backend.h"
 #include "render/cpu/CpuRenderer.h"
 #include "scene/Scene.h"
+#include "support/VulkanFixture.h"
 #include "support/AnalyticScenes.h"
 #include "support/Stats.h"
 #include "support/SurfaceScenes.h"
@@ -62,15 +63,8 @@ ZTestOptions pooled(double tolerance = 0.005) {
 // bilinear blend of equal texels is within a few ulps of the exact value.
 constexpr double kFloatTol = 2e-6;
 
-class VulkanSurface : public ::testing::Test {
+class VulkanSurface : public test::VulkanFixture {
  protected:
-  static void SetUpTestSuite() {
-    BackendOptions o;
-    o.validation = true;
-    backend_ = make_backend("vulkan", o);
-  }
-  static void TearDownTestSuite() { backend_.reset(); }
-  void TearDown() override { EXPECT_EQ(backend_->validation_messages(), 0u) << "Vulkan validation reported problems"; }
 
   RenderResult render(const Scene& s) {
     RenderResult r = backend_->render(s, test::settings_for(s), {});
@@ -86,9 +80,7 @@ class VulkanSurface : public ::testing::Test {
     return r;
   }
 
-  static std::unique_ptr<Backend> backend_;
 };
-std::unique_ptr<Backend> VulkanSurface::backend_;
 
 // ------------------------------------------------------------ furnaces ----
 

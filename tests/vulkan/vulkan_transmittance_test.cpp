@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "render/Backend.h"
+#include "support/VulkanFixture.h"
 #include "support/AnalyticScenes.h"
 #include "support/Stats.h"
 #include "support/TestSupport.h"
@@ -39,15 +40,8 @@ ZTestOptions pooled(double tolerance = 0.002) {
 
 const char* tracker_name(uint32_t mode) { return mode == 1 ? "ratio" : "delta"; }
 
-class VulkanTransmittance : public ::testing::Test {
+class VulkanTransmittance : public test::VulkanFixture {
  protected:
-  static void SetUpTestSuite() {
-    BackendOptions o;
-    o.validation = true;
-    backend_ = make_backend("vulkan", o);
-  }
-  static void TearDownTestSuite() { backend_.reset(); }
-  void TearDown() override { EXPECT_EQ(backend_->validation_messages(), 0u) << "Vulkan validation reported problems"; }
 
   RenderResult render(const Scene& s, uint32_t debug_mode) {
     RenderSettings rs;
@@ -82,10 +76,8 @@ class VulkanTransmittance : public ::testing::Test {
     return ratio;
   }
 
-  static std::unique_ptr<Backend> backend_;
   std::filesystem::path dir = test::temp_dir("vulkan_transmittance");
 };
-std::unique_ptr<Backend> VulkanTransmittance::backend_;
 
 // ρ = a + b·i on voxels i = 0..20 (every value exact in half), chromatic σt.
 // Seen obliquely so that rays cross the ramp's axis at many angles and the

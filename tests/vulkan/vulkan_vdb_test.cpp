@@ -16,6 +16,7 @@
 #include "render/Backend.h"
 #include "render/cpu/CpuRenderer.h"
 #include "render/cpu/Intersect.h"
+#include "support/VulkanFixture.h"
 #include "support/AnalyticScenes.h"
 #include "support/Stats.h"
 #include "support/TestSupport.h"
@@ -45,15 +46,8 @@ const char* kEstimators[] = {"absorption", "collision"};
 
 // The constant box (lat, box, c, dir, constant_box_scene, field) comes from
 // test::ConstantBoxSetup, shared with cpu_vdb_test.
-class VulkanVdb : public ::testing::Test, public test::ConstantBoxSetup {
+class VulkanVdb : public test::VulkanFixture, public test::ConstantBoxSetup {
  protected:
-  static void SetUpTestSuite() {
-    BackendOptions o;
-    o.validation = true;
-    backend_ = make_backend("vulkan", o);
-  }
-  static void TearDownTestSuite() { backend_.reset(); }
-  void TearDown() override { EXPECT_EQ(backend_->validation_messages(), 0u) << "Vulkan validation reported problems"; }
 
   RenderResult render(const Scene& s) {
     RenderResult r = backend_->render(s, settings_for(s), {});
@@ -63,7 +57,6 @@ class VulkanVdb : public ::testing::Test, public test::ConstantBoxSetup {
     return r;
   }
 
-  static std::unique_ptr<Backend> backend_;
 
   VulkanVdb() : test::ConstantBoxSetup("vulkan_vdb") {}
 
@@ -83,7 +76,6 @@ class VulkanVdb : public ::testing::Test, public test::ConstantBoxSetup {
     return r;
   }
 };
-std::unique_ptr<Backend> VulkanVdb::backend_;
 
 // A constant grid equals the closed form of the field it really is (the
 // constant in the centre box, the separable ramp to 0 around it), seen
