@@ -11,7 +11,7 @@ PYROLUME_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libvulkan-dev mesa-vulkan-drivers vulkan-tools vulkan-validationlayers glslang-tools
   libopenvdb-dev libboost-iostreams-dev libnanovdb-dev libtbb-dev
-  libglfw3-dev xvfb xauth python3 python3-matplotlib
+  libglfw3-dev xvfb xauth python3 python3-matplotlib libtinyobjloader-dev
   libopenexr-dev libglm-dev nlohmann-json3-dev libcli11-dev libstb-dev libgtest-dev
 )
 
