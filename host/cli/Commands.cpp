@@ -1,4 +1,5 @@
 #include "cli/Commands.h"
+#include "light/LightSelection.h"
 
 #include <chrono>
 #include <cmath>
@@ -212,10 +213,9 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
     throw input_error(output.string(), "", "unknown image type \"" + ext + "\" (use .exr or .png)");
   if (args.variance && ext != ".exr") throw input_error(output.string(), "", "--variance needs an .exr output");
 
-  // Accepted by the v1 format but not rendered yet: say so rather than ignore silently.
-  if (!scene.shapes.empty() && scene.integrator.mis)
-    std::cerr << "pyrolume: warning: " << scene.file.string()
-              << ": integrator.mis: light sampling is not implemented yet; surfaces are lit by BSDF sampling only\n";
+  // Asked for but not possible with these settings: say so rather than ignore silently.
+  if (const std::string w = light_strategy_warning(scene); !w.empty())
+    std::cerr << "pyrolume: warning: " << scene.file.string() << ": " << w << "\n";
 
   if (sequence) return run_sequence(args, scene, output, cancel);
 

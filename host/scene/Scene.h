@@ -52,7 +52,8 @@ struct Film {
 
 struct Integrator {
   int max_depth = 8;
-  bool mis = true;  // accepted; used once MIS lands
+  bool mis = true;  // next-event estimation + MIS (needs the collision estimator; docs/mis.md)
+  bool light_only = false;  // debug: next-event estimation only, no BSDF/phase-found light (docs/mis.md)
   std::string emission_estimator = "absorption";  // "absorption" | "collision"
   std::string majorant = "grid";                  // "grid" | "global"
   std::optional<glm::ivec3> majorant_grid;

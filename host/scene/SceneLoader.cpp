@@ -363,6 +363,7 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
     Reader i = r.child("integrator");
     s.integrator.max_depth = i.integer("max_depth", s.integrator.max_depth, 0, 100000);
     s.integrator.mis = i.boolean("mis", s.integrator.mis);
+    s.integrator.light_only = i.boolean("light_only", s.integrator.light_only);
     s.integrator.emission_estimator = i.choice("emission_estimator", "absorption", {"absorption", "collision"});
     s.integrator.majorant = i.choice("majorant", "grid", {"grid", "global"});
     if (i.has("majorant_grid")) {

@@ -15,10 +15,13 @@
 #include "color/Blackbody.h"
 #include "geometry/SceneSurfaces.h"
 #include "geometry/Surfaces.h"
+#include "light/EmissionCdf.h"
 #include "light/EnvironmentMap.h"
+#include "light/LightSelection.h"
 #include "render/cpu/Media.h"
 #include "render/cpu/Rng.h"
 #include "render/cpu/Sampling.h"
+#include "render/cpu/Transmittance.h"
 
 namespace pyrolume {
 namespace cpu {
@@ -31,6 +34,7 @@ struct Scratch {
   std::vector<double> cuts;
   std::vector<int> present;
   std::vector<double> rho;  // density looked up at the current collision, per present medium
+  std::vector<double> lobe_w, lobe_g;  // the phase mixture at a scattering: σs_i/σs and g_i
   LeCache Le_cache;
 };
 
@@ -41,8 +45,15 @@ struct ThreadCounters {
   uint64_t nonfinite = 0;
 };
 
-// What every walk reads: the media, the surfaces, what escaping rays see, and
-// the integrator's settings.
+// What next-event estimation samples (host/light/LightSelection.h).
+struct WalkLights {
+  LightSelection selection;
+  std::vector<const EmissionCdf*> cdf;  // per scene medium; null: not a light
+  bool active() const { return selection.strategy != LightStrategy::Bsdf; }
+};
+
+// What every walk reads: the media, the surfaces, what escaping rays see, the
+// lights and the integrator's settings.
 struct WalkScene {
   const MediaData& md;
   const geometry::Surfaces& surfaces;
@@ -50,6 +61,7 @@ struct WalkScene {
   glm::dvec3 background;
   int max_depth;
   bool collision_estimator;
+  const WalkLights& lights;
 
   // Radiance of channel c seen by a ray escaping along d (camera and scattered
   // rays alike): the environment map replaces background.rgb (DESIGN.md).
@@ -57,6 +69,93 @@ struct WalkScene {
     return environment ? environment->radiance(d)[c] : background[c];
   }
 };
+
+// The MIS state of the ray being tracked (docs/mis.md): the solid-angle pdf
+// with which its direction was sampled at its vertex (0 for the camera ray,
+// whose light is never found by next-event estimation), and R, the product of
+// the null probabilities 1 − σt/σ̄ taken since that vertex.
+struct RayMis {
+  double pdf_dir = 0.0;
+  double R = 1.0;
+};
+
+// MIS weight of emission that BSDF/phase sampling found: light `p_light`
+// (the pdf next-event estimation would have had, in the same measure) against
+// p_unidirectional. 1 where the light cannot be sampled or there is no NEE.
+double unidirectional_weight(const WalkLights& lights, const RayMis& mis, double p_unidirectional, double p_light) {
+  if (!lights.active() || !(mis.pdf_dir > 0.0) || !(p_light > 0.0)) return 1.0;
+  if (lights.selection.strategy == LightStrategy::LightOnly) return 0.0;
+  return power_heuristic(p_unidirectional, p_light);
+}
+
+// The value f (BSDF·|cos| or phase function, channel c) and the solid-angle pdf
+// with which the vertex's own sampling picks direction w.
+struct VertexLobe {
+  double f = 0.0, pdf = 0.0;
+};
+
+// One next-event estimate from vertex o (the offset origin the continuing ray
+// also uses): pick a light, sample it, trace a shadow ray (surfaces block;
+// ratio tracking through the media), weight by the power heuristic against the
+// vertex's own sampling. Returns the radiance toward the vertex times f / pdf,
+// MIS-weighted, without the path weight β.
+template <class Lobe>
+double next_event(const WalkScene& ws, int c, const glm::dvec3& o, Lobe lobe, Pcg32& rng, ThreadCounters& cnt,
+                  Scratch& s) {
+  const WalkLights& lights = ws.lights;
+  const bool light_only = lights.selection.strategy == LightStrategy::LightOnly;
+  double u = rng.uniform();
+  const double u_env = rng.uniform(), v_env = rng.uniform();
+  const glm::dvec3 u3(rng.uniform(), rng.uniform(), rng.uniform());
+  TrackingCounters tc;
+  double result = 0.0;
+  if (u < lights.selection.p_env) {
+    const EnvSample es = ws.environment->sample({u_env, v_env});
+    if (!(es.pdf > 0.0)) return 0.0;
+    const VertexLobe l = lobe(es.dir);
+    if (!(l.f > 0.0)) return 0.0;
+    if (!ws.surfaces.empty() && geometry::occluded(ws.surfaces, geometry::Ray{o, es.dir},
+                                                   std::numeric_limits<double>::infinity()))
+      return 0.0;
+    const ShadowTracking st =
+        ratio_tracking_to(ws.md, c, o, es.dir, std::numeric_limits<double>::infinity(), rng, &tc);
+    const double p_light = lights.selection.p_env * es.pdf;
+    const double w = light_only ? 1.0 : power_heuristic(p_light, l.pdf * st.T);
+    result = l.f * st.T * es.radiance[c] * w / p_light;
+  } else {
+    u -= lights.selection.p_env;
+    int j = -1;
+    for (size_t i = 0; i < lights.cdf.size(); ++i) {
+      const double p = lights.selection.p_medium[i];
+      if (!(p > 0.0)) continue;
+      j = int(i);
+      if (u < p) break;
+      u -= p;
+    }
+    if (j < 0) return 0.0;
+    const EmissionSample es = lights.cdf[j]->sample(u_env, u3);
+    if (!(es.pdf > 0.0)) return 0.0;
+    const glm::dvec3 v = es.p - o;
+    const double r = glm::length(v);
+    if (!(r > 0.0)) return 0.0;
+    const glm::dvec3 w_dir = v / r;
+    const VertexLobe l = lobe(w_dir);
+    if (!(l.f > 0.0)) return 0.0;
+    if (!ws.surfaces.empty() && geometry::occluded(ws.surfaces, geometry::Ray{o, w_dir}, r)) return 0.0;
+    const ShadowTracking st = ratio_tracking_to(ws.md, c, o, w_dir, r, rng, &tc);
+    const MediumData& m = ws.md.media[j];
+    const double rho = grid_density(m, es.p);
+    ++tc.density_lookups;
+    const double e = grid_sigma_a_Le(m, j, c, es.p, rho, s.Le_cache);  // σa_j Le_j at the light point
+    // Volume → solid angle at o: × r², no cosine (a medium has no surface).
+    const double p_light = lights.selection.p_medium[j] * es.pdf * r * r;
+    const double w = light_only ? 1.0 : power_heuristic(p_light, l.pdf * st.sigma_maj_end * st.T);
+    result = l.f * st.T * e * w / p_light;
+  }
+  cnt.density_lookups += tc.density_lookups;
+  cnt.majorant_violations += tc.majorant_violations;
+  return result;
+}
 
 // One random walk of a *grey* world: colour channel c alone.
 //
@@ -83,10 +182,9 @@ struct WalkScene {
 // Surfaces: no collision before t_surf ⇒ the path reaches the surface. Opaque,
 // two-sided Lambertian: the new direction is cosine-distributed around the
 // geometric normal flipped to the side the ray came from, n_f; f·cos θ/p =
-// albedo, so the path weight β is multiplied by albedo_c(uv) (BSDF sampling
-// only: no next-event estimation yet). The new ray starts at
-// offset_ray_origin(p, n_f) so it cannot hit the surface it leaves. Surfaces
-// do not emit.
+// albedo, so the path weight β is multiplied by albedo_c(uv). The new ray
+// starts at offset_ray_origin(p, n_f) so it cannot hit the surface it leaves.
+// Surfaces do not emit.
 //
 // Emission estimators (integrator.emission_estimator), β the path weight
 // (the product of the surface albedos met so far; medium events keep it,
@@ -101,14 +199,23 @@ struct WalkScene {
 // max_depth: the (max_depth+1)-th ends the path with nothing more (the
 // absorption estimator returns 0, the collision estimator keeps what it
 // collected before). Both count as real events.
+//
+// Next-event estimation (docs/mis.md), with the collision estimator only: at
+// every scattering and surface vertex that max_depth allows, one light sample
+// (next_event); emission from a light that the walk itself then finds (σa_j Le_j
+// of an emissive grid at a tentative collision, the environment on escape) is
+// weighted by the power heuristic with the unidirectional pdf
+// pdf_dir · σ̄(x) · R (per unit volume: / t², which the light pdf × t² cancels).
 double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
                     Scratch& s) {
   const MediaData& md = ws.md;
+  const WalkLights& lights = ws.lights;
   const bool collision_estimator = ws.collision_estimator;
   const bool has_surfaces = !ws.surfaces.empty();
   int scatters = 0;
   double beta = 1.0;  // path weight: product of the albedos of the surface bounces so far
   double L = 0.0;     // the collision estimator's running sum
+  RayMis mis;         // the camera ray: never MIS-weighted
   for (;;) {
     // The closest surface bounds this segment.
     geometry::SurfaceHit hit;
@@ -143,55 +250,93 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
           sigma_s += m.sigma_s[c] * rho;
         }
         if (exceeds_majorant(sigma_a + sigma_s, sigma_maj)) ++cnt.majorant_violations;
-        auto emitted = [&] {  // Σ σa_i Le_i at x
+        auto emitted = [&](bool mis_weighted) {  // Σ σa_i Le_i at x (× each light's MIS weight)
           double e = 0.0;
           for (size_t j = 0; j < s.present.size(); ++j) {
-            const MediumData& m = md.media[s.present[j]];
-            e += m.is_vdb() ? grid_sigma_a_Le(m, s.present[j], c, x, s.rho[j], s.Le_cache) : m.sigma_a_Le[c];
+            const int i = s.present[j];
+            const MediumData& m = md.media[i];
+            double e_i = m.is_vdb() ? grid_sigma_a_Le(m, i, c, x, s.rho[j], s.Le_cache) : m.sigma_a_Le[c];
+            if (mis_weighted && e_i > 0.0 && lights.active() && lights.cdf[i]) {
+              const double p_light = lights.selection.p_medium[i] * lights.cdf[i]->pdf(x) * t * t;
+              e_i *= unidirectional_weight(lights, mis, mis.pdf_dir * sigma_maj * mis.R, p_light);
+            }
+            e += e_i;
           }
           return e;
         };
-        if (collision_estimator && sigma_a > 0.0) L += beta * emitted() / sigma_maj;
+        if (collision_estimator && sigma_a > 0.0) L += beta * emitted(true) / sigma_maj;
 
         const double u = rng.uniform() * sigma_maj;
         if (u < sigma_a) {
           ++cnt.collisions;
-          return collision_estimator ? L : beta * emitted() / sigma_a;
+          return collision_estimator ? L : beta * emitted(false) / sigma_a;
         }
-        if (!(u < sigma_a + sigma_s)) continue;  // null collision
+        if (!(u < sigma_a + sigma_s)) {  // null collision
+          mis.R *= 1.0 - (sigma_a + sigma_s) / sigma_maj;
+          continue;
+        }
         ++cnt.collisions;
         if (scatters == ws.max_depth) return collision_estimator ? L : 0.0;
         ++scatters;
-        // Given a scattering, u − σa is uniform on [0, σs): reuse it to pick the lobe.
-        double pick = u - sigma_a, g = 0.0;
+        // The phase function of the mixture: Σ_i (σs_i/σs) HG(g_i).
+        s.lobe_w.clear();
+        s.lobe_g.clear();
         for (size_t j = 0; j < s.present.size(); ++j) {
           const MediumData& m = md.media[s.present[j]];
           const double ss = m.sigma_s[c] * s.rho[j];
           if (!(ss > 0.0)) continue;
-          g = m.g;
-          pick -= ss;
+          s.lobe_w.push_back(ss / sigma_s);
+          s.lobe_g.push_back(m.g);
+        }
+        const glm::dvec3 d_in = d;
+        auto phase = [&](const glm::dvec3& w) {
+          double p = 0.0;
+          for (size_t l = 0; l < s.lobe_w.size(); ++l) p += s.lobe_w[l] * hg_pdf(glm::dot(d_in, w), s.lobe_g[l]);
+          return VertexLobe{p, p};  // sampled exactly: pdf = value
+        };
+        if (lights.active()) L += beta * next_event(ws, c, x, phase, rng, cnt, s);
+        // Given a scattering, u − σa is uniform on [0, σs): reuse it to pick the lobe.
+        double pick = (u - sigma_a) / sigma_s, g = 0.0;
+        for (size_t l = 0; l < s.lobe_w.size(); ++l) {
+          g = s.lobe_g[l];
+          pick -= s.lobe_w[l];
           if (pick < 0.0) break;
         }
         glm::dvec2 uv(rng.uniform(), rng.uniform());
         o = x;
-        d = sample_hg(d, g, uv).direction;
+        d = sample_hg(d_in, g, uv).direction;
+        mis = RayMis{phase(d).pdf, 1.0};
         scattered = true;
         break;
       }
     }
     if (scattered) continue;
-    if (!hit_surface) return L + beta * ws.escaped(d, c);
+    if (!hit_surface) {
+      double w = 1.0;
+      if (ws.environment && lights.selection.p_env > 0.0)
+        w = unidirectional_weight(lights, mis, mis.pdf_dir * mis.R,
+                                  lights.selection.p_env * ws.environment->pdf(d));
+      return L + beta * w * ws.escaped(d, c);
+    }
 
     // Reached the surface: a Lambertian bounce.
     ++cnt.collisions;
     if (scatters == ws.max_depth) return collision_estimator ? L : 0.0;
     ++scatters;
-    beta *= geometry::albedo_at(ws.surfaces, hit)[c];
-    if (!(beta > 0.0)) return L;  // black surface: nothing more can arrive
+    const double albedo = geometry::albedo_at(ws.surfaces, hit)[c];
+    if (!(beta * albedo > 0.0)) return L;  // black surface: nothing more can arrive
     const glm::dvec3 n_f = glm::dot(hit.normal, d) < 0.0 ? hit.normal : -hit.normal;
-    glm::dvec2 uv(rng.uniform(), rng.uniform());
-    d = sample_cosine_hemisphere(n_f, uv).direction;
     o = geometry::offset_ray_origin(hit.position, n_f);
+    auto lambert = [&](const glm::dvec3& w) {
+      const double cos_theta = std::max(0.0, glm::dot(n_f, w));
+      return VertexLobe{albedo * cos_theta / std::numbers::pi, cos_theta / std::numbers::pi};
+    };
+    if (lights.active()) L += beta * next_event(ws, c, o, lambert, rng, cnt, s);
+    beta *= albedo;
+    glm::dvec2 uv(rng.uniform(), rng.uniform());
+    const BsdfSample bs = sample_cosine_hemisphere(n_f, uv);
+    d = bs.direction;
+    mis = RayMis{bs.pdf, 1.0};
   }
 }
 
@@ -243,8 +388,20 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
 
   const int W = settings.width, H = settings.height;
   const int max_depth = std::max(0, scene.integrator.max_depth);
-  const WalkScene walk_scene{media,     surfaces, environment ? &*environment : nullptr, scene.background,
-                             max_depth, collision_estimator};
+  // Lights for next-event estimation: the environment map and every grid
+  // medium that emits (its emission CDF over the grid as stored).
+  std::vector<std::optional<EmissionCdf>> cdfs(scene.media.size());
+  WalkLights lights;
+  lights.cdf.assign(scene.media.size(), nullptr);
+  if (scene.integrator.mis && collision_estimator)
+    for (size_t i = 0; i < scene.media.size(); ++i)
+      if (media.media[i].is_vdb() && media.media[i].volume && scene.media[i].emission.emits()) {
+        cdfs[i] = EmissionCdf::build(scene.media[i], *media.media[i].volume);
+        if (!cdfs[i]->empty()) lights.cdf[i] = &*cdfs[i];
+      }
+  lights.selection = select_lights(scene, environment ? &*environment : nullptr, lights.cdf);
+  const WalkScene walk_scene{media,     surfaces,           environment ? &*environment : nullptr, scene.background,
+                             max_depth, collision_estimator, lights};
   RenderResult res;
   res.width = W;
   res.height = H;

@@ -66,4 +66,24 @@ double delta_tracking_transmittance(const MediaData& md, int c, const glm::dvec3
   return escaped ? 1.0 : 0.0;
 }
 
+ShadowTracking ratio_tracking_to(const MediaData& md, int c, const glm::dvec3& o, const glm::dvec3& d, double t_max,
+                                 Pcg32& rng, TrackingCounters* counters) {
+  ShadowTracking r;
+  for_each_tentative_collision(md, c, o, d, t_max, rng, counters, [&](double sigma_t, double sigma_maj) {
+    r.T *= 1.0 - sigma_t / sigma_maj;
+    return r.T != 0.0;
+  });
+  // The majorant of the segment holding t_max (the cuts are the spans' own ends).
+  thread_local std::vector<Span> spans;
+  thread_local std::vector<double> cuts;
+  thread_local std::vector<int> present;
+  ray_spans(md, o, d, spans, cuts);
+  for (size_t k = 0; k + 1 < cuts.size(); ++k)
+    if (cuts[k] < t_max && t_max <= cuts[k + 1]) {
+      r.sigma_maj_end = media_present(md, spans, cuts[k], cuts[k + 1], c, present);
+      break;
+    }
+  return r;
+}
+
 }  // namespace pyrolume::cpu

@@ -1,0 +1,55 @@
+#pragma once
+// Which lights next-event estimation samples, with what probability, and how
+// its samples are combined with BSDF/phase sampling (docs/mis.md). Shared by
+// both backends so they make the same choices.
+#include <string>
+#include <vector>
+
+#include "scene/Scene.h"
+
+namespace pyrolume {
+
+class EnvironmentMap;
+class EmissionCdf;
+
+// How emission from sampleable lights is estimated.
+enum class LightStrategy {
+  Bsdf,       // BSDF/phase sampling only (integrator.mis false, or nothing to sample)
+  Mis,        // both strategies, power heuristic
+  LightOnly,  // debug (integrator.light_only): next-event estimation only
+};
+
+struct LightSelection {
+  // Probability that one next-event sample picks the environment map.
+  double p_env = 0.0;
+  // Per scene medium: probability of picking its emission CDF (0: not a light).
+  std::vector<double> p_medium;
+  LightStrategy strategy = LightStrategy::Bsdf;
+
+  bool any() const;
+};
+
+// env: the loaded environment map or null; cdfs: per scene medium, its emission
+// CDF or null (homogeneous media and grids that emit nothing are not lights).
+//
+// Choice between lights: the environment and the emissive media get 1/2 each
+// when both exist (their powers, ∫Y dω and ∫Y(σa Le) dV, have different units,
+// so their ratio means nothing without a distance); among the emissive media,
+// by power ∫ w dV (EmissionCdf::power).
+//
+// Strategy: Mis or LightOnly needs integrator.mis, the collision emission
+// estimator (Miller et al. 2019: MIS pdfs come from σ̄·T_maj, which the
+// absorption estimator does not have), max_depth ≥ 1 and at least one light.
+LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs);
+
+// One line for stderr when the scene asks for MIS but cannot get it (empty: none).
+std::string light_strategy_warning(const Scene& scene);
+
+// Power heuristic, β = 2 (Veach 1997, eq. 9.13), for the strategy with pdf
+// p_this against p_other; 1 when p_other is 0.
+inline double power_heuristic(double p_this, double p_other) {
+  const double a = p_this * p_this, b = p_other * p_other;
+  return a + b > 0.0 ? a / (a + b) : 0.0;
+}
+
+}  // namespace pyrolume

@@ -1,0 +1,75 @@
+#pragma once
+// Scenes for next-event estimation and MIS (docs/mis.md), shared by the CPU
+// reference tests and the GPU tests: an emissive, scattering grid above a
+// diffuse plane under a dim uniform sky, and an emissive scattering grid on
+// its own. Each can be rendered with any light strategy.
+#include <filesystem>
+#include <string>
+
+#include "image/ImageIo.h"
+#include "support/AnalyticScenes.h"
+#include "support/SurfaceScenes.h"
+#include "support/VdbScenes.h"
+
+namespace pyrolume::test {
+
+enum class Strategy { Bsdf, Mis, LightOnly };
+
+inline void set_strategy(Scene& s, Strategy k) {
+  s.integrator.emission_estimator = "collision";
+  s.integrator.mis = k != Strategy::Bsdf;
+  s.integrator.light_only = k == Strategy::LightOnly;
+}
+
+// A uniform lat-long sky of radiance `value` (written once per folder).
+inline std::filesystem::path write_uniform_sky(const std::filesystem::path& dir, glm::vec3 value) {
+  const auto exr = dir / "uniform_sky.exr";
+  write_image(exr, uniform_image(8, 4, value));
+  return exr;
+}
+
+// A small hot constant box of smoke (5³ voxels of 0.1, temperature 2500 K,
+// σa 2, σs 1.5 or 0, g 0.3) floating above a white-ish plane, Y up, seen from
+// above at an angle so most pixels are plane lit by the fire; optional dim
+// uniform sky. Light sampling alone has infinite variance inside a scattering
+// emitter (1/r² at a vertex next to the light point), so its tests use
+// scattering = false. `dir` holds the scene's files.
+inline Scene fire_over_plane_scene(const std::filesystem::path& dir, Strategy k, bool sky, bool scattering = true,
+                                   int width = 24, int height = 18, int spp = 256) {
+  Scene s = analytic_base_scene(width, height, spp);
+  s.camera.position = {0, 2.2, -3.2};
+  s.camera.look_at = {0, -0.2, 0};
+  s.integrator.max_depth = 4;
+  const Lattice l{0.1, {-0.2, 0.4, -0.2}};
+  const VoxelBox box{{0, 0, 0}, {4, 4, 4}};
+  const auto vdb = dir / "fire_box.vdb";
+  if (!std::filesystem::exists(vdb))
+    write_constant_box_vdb(vdb, l, box, 1.0f, TemperatureBox{l, box, 2500.0f});
+  s.media.push_back(vdb_medium("fire", vdb, glm::dvec3(2.0), glm::dvec3(scattering ? 1.5 : 0.0), 0.3, std::nullopt,
+                               6.0, true));
+  s.shapes.push_back(plane_shape({0, -0.3, 0}, {0, 1, 0}, {0, 0}, glm::dvec3(0.8, 0.7, 0.6)));
+  if (sky) s.environment = Environment{write_uniform_sky(dir, glm::vec3(0.05f, 0.07f, 0.1f)), 1.0, 0.0};
+  set_strategy(s, k);
+  return s;
+}
+
+// An emissive, strongly scattering grid (albedo 0.75, g −0.2) seen from
+// outside: its light reaches the camera mostly after scattering inside it.
+inline Scene scattering_fire_scene(const std::filesystem::path& dir, Strategy k, int width = 16, int height = 16,
+                                   int spp = 256) {
+  Scene s = analytic_base_scene(width, height, spp);
+  s.camera.position = {0, 0, -2.2};
+  s.integrator.max_depth = 16;
+  const Lattice l{0.1, {-0.4, -0.4, -0.4}};
+  const VoxelBox box{{0, 0, 0}, {8, 8, 8}};
+  const VoxelBox hot{{2, 2, 2}, {6, 6, 6}};  // a hot core inside the smoke
+  const auto vdb = dir / "scattering_fire.vdb";
+  if (!std::filesystem::exists(vdb))
+    write_constant_box_vdb(vdb, l, box, 1.0f, TemperatureBox{l, hot, 3000.0f});
+  s.media.push_back(vdb_medium("fire", vdb, glm::dvec3(0.5), glm::dvec3(1.5), -0.2, std::nullopt, 4.0, true));
+  s.media.back().temperature.cutoff_k = 500.0;
+  set_strategy(s, k);
+  return s;
+}
+
+}  // namespace pyrolume::test
