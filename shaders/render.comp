@@ -3,7 +3,9 @@
 // per dispatch. Homogeneous spheres/boxes and grid (vdb) media, delta tracking
 // against per-cell majorants (a coarse grid walked by 3D DDA), the "absorption"
 // or "collision" emission estimator, Henyey–Greenstein scattering; escaping
-// paths see the background.
+// paths see the background. With MIS, next-event estimation of the environment
+// and the emissive grids at every scattering and surface vertex, combined with
+// phase/BSDF sampling by the power heuristic (docs/mis.md).
 #extension GL_GOOGLE_include_directive : require
 
 #include "shared/gpu_types.h"
@@ -31,6 +33,8 @@ layout(constant_id = SPEC_HAS_SURFACES) const bool HAS_SURFACES = false;
 layout(constant_id = SPEC_SURFACE_SHAPE_COUNT) const uint SURFACE_SHAPE_COUNT = 0;
 layout(constant_id = SPEC_SURFACE_HAS_TRIANGLES) const bool SURFACE_HAS_TRIANGLES = false;
 layout(constant_id = SPEC_HAS_ENVIRONMENT) const bool HAS_ENVIRONMENT = false;
+layout(constant_id = SPEC_LIGHT_STRATEGY) const uint LIGHT_STRATEGY = LIGHT_STRATEGY_BSDF;
+const bool NEE = LIGHT_STRATEGY != LIGHT_STRATEGY_BSDF;  // next-event estimation (with the collision estimator)
 
 layout(std140, set = 0, binding = BINDING_FRAME) uniform FrameBlock { FrameConstants frame; };
 // Media and grids are uniform blocks: every lane reads the same entries, which
@@ -61,6 +65,13 @@ layout(set = 0, binding = BINDING_TEXTURES) uniform sampler2D albedo_tex[MAX_TEX
 layout(std430, set = 0, binding = BINDING_ENV_TEXELS) readonly buffer EnvTexelBlock { vec4 env_texels[]; };
 layout(std430, set = 0, binding = BINDING_ENV_CDF) readonly buffer EnvCdfBlock { float env_cdf[]; };
 layout(std140, set = 0, binding = BINDING_ENV_HEADER) uniform EnvHeaderBlock { GpuEnvironment environment; };
+#define LIGHTS_EMISSION
+layout(std430, set = 0, binding = BINDING_EMISSION_CDF) readonly buffer EmissionCdfBlock { float emission_cdf[]; };
+layout(std430, set = 0, binding = BINDING_EMISSION_CELLS) readonly buffer EmissionCellBlock { uint emission_cells[]; };
+layout(std430, set = 0, binding = BINDING_EMISSION_PMF) readonly buffer EmissionPmfBlock { float emission_pmf[]; };
+layout(std140, set = 0, binding = BINDING_EMISSION_HEADERS) uniform EmissionHeaderBlock {
+  GpuEmissionCdf emission_lights[MAX_GRIDS];  // by grid slot; measure.w: probability of picking it
+};
 #include "lights.glsl"
 
 const float INF = 1.0 / 0.0;
@@ -240,14 +251,42 @@ void coefficients_at(vec3 x, float t, vec2 span[MEDIA_N], out vec3 sigma_a, out 
   }
 }
 
+// MIS weight of light that phase/BSDF sampling found, against next-event
+// estimation's pdf p_light for it (same measure): the power heuristic (Veach
+// 1997 eq. 9.13) as 1/(1 + r²), which cannot overflow. pdf_dir = 0 marks a
+// camera ray, whose light next-event estimation never finds: weight 1.
+float unidirectional_weight(float pdf_dir, float p_unidirectional, float p_light) {
+  if (!NEE || !(pdf_dir > 0.0) || !(p_light > 0.0)) return 1.0;
+  if (LIGHT_STRATEGY == LIGHT_STRATEGY_LIGHT_ONLY) return 0.0;
+  float r = p_light / p_unidirectional;
+  return 1.0 / (1.0 + r * r);
+}
+float light_weight(float p_light, float p_unidirectional) {
+  if (LIGHT_STRATEGY == LIGHT_STRATEGY_LIGHT_ONLY) return 1.0;
+  float r = p_unidirectional / p_light;
+  return 1.0 / (1.0 + r * r);
+}
+
 // Emitted power per unit length, Σ sigma_a_i(x)·Le_i(x), over the media at t.
-vec3 emission_at(vec3 x, float t, vec2 span[MEDIA_N], float rho[MEDIA_N]) {
+// With next-event estimation each emissive grid's term is MIS-weighted: the
+// walk found x with pdf p_unidirectional = pdf_dir·σ̄·R, next-event estimation
+// would have with P_i·pdf_V(x)·dist² (docs/mis.md).
+vec3 emission_at(vec3 x, float t, vec2 span[MEDIA_N], float rho[MEDIA_N], float pdf_dir, float p_unidirectional,
+                 float dist) {
   vec3 E = vec3(0.0);
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     if (!(span[i].x <= t && t < span[i].y)) continue;
     GpuMedium m = media[i];
     if (HAS_GRIDS && uint(m.sigma_a.w) == SHAPE_GRID) {
-      if (rho[i] > 0.0) E += rho[i] * m.sigma_a.rgb * grid_le(m, uint(m.bounds0.x), x);
+      if (rho[i] > 0.0) {
+        uint slot = uint(m.bounds0.x);
+        vec3 e = rho[i] * m.sigma_a.rgb * grid_le(m, slot, x);
+        if (NEE && pdf_dir > 0.0 && emission_lights[slot].measure.w > 0.0 && max3(e) > 0.0) {
+          float p_light = emission_lights[slot].measure.w * emission_pdf(emission_lights[slot], x) * dist * dist;
+          e *= unidirectional_weight(pdf_dir, p_unidirectional, p_light);
+        }
+        E += e;
+      }
     } else {
       E += m.emission.rgb;
     }
@@ -315,6 +354,119 @@ vec3 transmittance(vec3 o, vec3 d, bool ratio, inout uint rng, inout PathStats s
   return T;
 }
 
+// Ratio tracking along a shadow ray for next-event estimation, to t_max (INF:
+// to infinity); 0 if a surface is in the way. Returns the transmittance
+// estimate T (with Russian roulette, as transmittance() above). R: the product
+// of the null-event probabilities the walk's spectral tracking would have
+// taken at the same tentative collisions, for a path of weight w (only ratios
+// of w matter), without the roulette (docs/mis.md); sigma_end: the majorant
+// at t_max, the rate at which the walk samples a collision there.
+vec3 shadow_transmittance(vec3 o, vec3 d, float t_max, vec3 w, inout uint rng, inout PathStats stats, out float R,
+                          out float sigma_end) {
+  R = 1.0;
+  sigma_end = 0.0;
+  if (HAS_SURFACES && occluded_surfaces(o, d, t_max)) return vec3(0.0);
+  vec2 span[MEDIA_N];
+  bool any_hit;
+  media_spans(o, d, span, any_hit);
+  if (!any_hit) return vec3(1.0);
+  vec3 T = vec3(1.0);
+  float t = 0.0;
+  for (uint n = 0u; n < 65535u; ++n) {
+    float t_next;
+    bool any_ahead;
+    float sigma_bar = majorant_at(o, d, t, span, t_next, any_ahead);
+    if (!any_ahead || t >= t_max) break;
+    if (sigma_bar <= 0.0) { t = t_next; continue; }
+    float dt = sample_free_flight(sigma_bar, rng_next(rng));
+    if (t + dt >= min(t_next, t_max)) { t = min(t_next, t_max); continue; }
+    t += dt;
+    vec3 sigma_a, sigma_s;
+    float rho[MEDIA_N];
+    coefficients_at(o + t * d, t, span, sigma_a, sigma_s, rho, stats);
+    vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
+    float p_null = avg3(sigma_n * w) / (sigma_bar * avg3(w));
+    R *= p_null;
+    w *= sigma_n / (sigma_bar * max(p_null, 1e-30));
+    T *= sigma_n / sigma_bar;
+    float q = max3(T);
+    if (q < 0.1) {  // Russian roulette on the estimate only: R stays the walk's probability
+      if (rng_next(rng) >= q) return vec3(0.0);
+      T /= q;
+    }
+  }
+  if (!isinf(t_max)) {
+    float t_next;
+    bool any_ahead;
+    sigma_end = majorant_at(o, d, t_max, span, t_next, any_ahead);
+  }
+  return T;
+}
+
+// A light sample for next-event estimation from point o: direction, distance
+// (INF for the environment), solid-angle pdf (light choice included; 0: none),
+// and the radiance it sends along -dir before attenuation: the environment's
+// radiance, or σa·Le per unit length at the sampled point of an emissive grid
+// (volume pdf × dist², no cosine: docs/mis.md).
+struct LightSample {
+  vec3 dir;
+  float dist;
+  float pdf;
+  vec3 Le;
+  bool volume;
+};
+
+LightSample sample_light(vec3 o, inout uint rng, inout PathStats stats) {
+  LightSample ls;
+  ls.dir = vec3(0.0, 0.0, 1.0);
+  ls.dist = INF;
+  ls.pdf = 0.0;
+  ls.Le = vec3(0.0);
+  ls.volume = false;
+  float u = rng_next(rng);
+  vec2 u2 = vec2(rng_next(rng), rng_next(rng));
+  float u_z = rng_next(rng);
+  if (HAS_ENVIRONMENT && u < frame.lights.x) {
+    EnvSample es = env_sample(environment, u2);
+    ls.dir = es.dir;
+    ls.pdf = frame.lights.x * es.pdf;
+    ls.Le = es.radiance;
+    return ls;
+  }
+  if (!HAS_GRIDS || !HAS_EMISSION) return ls;
+  u -= frame.lights.x;
+  // The grid medium whose light probability covers u.
+  // (The last light when rounding leaves u past them all, like the CPU reference.)
+  uint pick = MEDIUM_COUNT;
+  float p_pick = 0.0;
+  bool found = false;
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+    if (uint(media[i].sigma_a.w) != SHAPE_GRID) continue;
+    float p = emission_lights[uint(media[i].bounds0.x)].measure.w;
+    if (!(p > 0.0) || found) continue;
+    pick = i;
+    p_pick = p;
+    if (u < p) found = true; else u -= p;
+  }
+  if (pick == MEDIUM_COUNT) return ls;
+  GpuMedium m = media[pick];
+  uint slot = uint(m.bounds0.x);
+  EmissionSample es = emission_sample(emission_lights[slot], rng_next(rng), vec3(u2, u_z));
+  if (!(es.pdf > 0.0)) return ls;
+  vec3 v = es.p - o;
+  float dist = length(v);
+  if (!(dist > 0.0)) return ls;
+  vec4 dims = grids[slot].density_dims;
+  float rho = dims.w * density_at(slot, density_texel(slot, es.p) / dims.xyz);
+  stats.lookups += 1.0;
+  ls.dir = v / dist;
+  ls.dist = dist;
+  ls.pdf = p_pick * es.pdf * dist * dist;
+  ls.Le = rho * m.sigma_a.rgb * grid_le(m, slot, es.p);
+  ls.volume = true;
+  return ls;
+}
+
 // One path's state between tracking steps (see main: paths are regenerated
 // within a lane, so the state must live outside any per-path loop).
 struct PathState {
@@ -324,6 +476,11 @@ struct PathState {
   float t;     // distance along the current ray
   uint depth;  // scattering events (medium and surface) so far
   bool fresh;  // the ray changed: recompute the media spans and the surface hit
+  // MIS (docs/mis.md): the solid-angle pdf with which the ray's direction was
+  // sampled at its vertex (0: camera ray); R, the product of the null-event
+  // probabilities taken since; t_shift, how far the origin has moved from the
+  // vertex (the shift to the first thing the ray reaches).
+  float pdf_dir, R, t_shift;
   bool has_hit;     // a surface lies ahead on the current ray
   SurfaceHit hit;   // the closest one (t = its distance)
 };
@@ -331,6 +488,25 @@ struct PathState {
 // Radiance of a ray that leaves the scene: the environment map (+Z up,
 // docs/lights.md), or the constant background.
 vec3 escaped_radiance(vec3 d) { return HAS_ENVIRONMENT ? env_radiance(environment, d) : frame.background.rgb; }
+
+// The path leaves the scene: add what it sees, MIS-weighted when the
+// environment is a light.
+void escape(inout PathState p) {
+  float w = 1.0;
+  if (NEE && HAS_ENVIRONMENT && frame.lights.x > 0.0)
+    w = unidirectional_weight(p.pdf_dir, p.pdf_dir * p.R, frame.lights.x * env_pdf(environment, p.d));
+  p.L += w * p.w * escaped_radiance(p.d);
+}
+
+// Start a new ray at a vertex, its direction sampled with solid-angle pdf pdf_dir.
+void new_ray(inout PathState p, vec3 o, vec3 d, float pdf_dir) {
+  p.o = o;
+  p.d = d;
+  p.fresh = true;
+  p.pdf_dir = pdf_dir;
+  p.R = 1.0;
+  p.t_shift = 0.0;
+}
 
 // A Lambertian bounce at the surface ahead: weight × albedo (cosine sampling's
 // pdf cancels the cosine and 1/π), new direction on the side the ray came
@@ -343,11 +519,23 @@ bool surface_bounce(inout PathState p, inout uint rng, inout PathStats stats) {
   GpuMaterial m = surface_materials[si.material];
   vec3 albedo = m.albedo.rgb;
   if (m.info.x != NO_TEXTURE) albedo *= albedo_texture_at(m.info.x, vec2(si.uv.x, 1.0 - si.uv.y));  // OBJ v=0 at the bottom
-  p.w *= albedo;
   vec3 n = dot(si.normal, p.d) < 0.0 ? si.normal : -si.normal;
-  p.o = offset_ray_origin(si.position, n);
-  p.d = sample_cosine_hemisphere(n, vec2(rng_next(rng), rng_next(rng)));
-  p.fresh = true;
+  vec3 o = offset_ray_origin(si.position, n);
+  if (NEE && max3(p.w * albedo) > 0.0) {
+    // Next-event estimation: f·cos = albedo·cos/π, BSDF pdf cos/π.
+    LightSample ls = sample_light(o, rng, stats);
+    float cos_l = dot(n, ls.dir);
+    if (ls.pdf > 0.0 && cos_l > 0.0 && max3(ls.Le) > 0.0) {
+      float R, sigma_end;
+      vec3 T = shadow_transmittance(o, ls.dir, ls.dist, p.w * albedo, rng, stats, R, sigma_end);
+      float pdf_bsdf = cos_l * (1.0 / PI);
+      float p_uni = pdf_bsdf * R * (ls.volume ? sigma_end : 1.0);
+      p.L += p.w * albedo * pdf_bsdf * T * ls.Le * (light_weight(ls.pdf, p_uni) / ls.pdf);
+    }
+  }
+  p.w *= albedo;
+  vec3 d = sample_cosine_hemisphere(n, vec2(rng_next(rng), rng_next(rng)));
+  new_ray(p, o, d, max(dot(n, d), 0.0) * (1.0 / PI));
   return max3(p.w) <= 0.0;
 }
 
@@ -370,7 +558,7 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     p.fresh = false;
     p.t = 0.0;
     if (!any_hit && !p.has_hit) {
-      p.L += p.w * escaped_radiance(p.d);
+      escape(p);
       return true;
     }
     // Move the origin to the first thing the ray reaches, so every later
@@ -382,6 +570,7 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
       if (span[i].y > 0.0) t0 = min(t0, span[i].x);
     if (t0 > 0.0 && !isinf(t0)) {
       p.o += t0 * p.d;
+      p.t_shift += t0;
       for (uint i = 0u; i < MEDIUM_COUNT; ++i)
         if (span[i].y > 0.0) span[i] -= t0;
       if (p.has_hit) p.hit.t -= t0;
@@ -394,7 +583,7 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   // Media beyond the closest surface do not matter: free flights end there.
   const float t_surface = p.has_hit ? p.hit.t : INF;
   if (isinf(t_next) && !p.has_hit) {
-    p.L += p.w * escaped_radiance(p.d);
+    escape(p);
     return true;
   }
   const float t_end = min(t_next, t_surface);
@@ -412,7 +601,7 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   coefficients_at(x, p.t, span, sigma_a, sigma_s, rho, stats);
   if (HAS_EMISSION && COLLISION_ESTIMATOR) {
     // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.
-    p.L += p.w * emission_at(x, p.t, span, rho) / sigma_bar;
+    p.L += p.w * emission_at(x, p.t, span, rho, p.pdf_dir, p.pdf_dir * sigma_bar * p.R, p.t_shift + p.t) / sigma_bar;
   }
   vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
   float c = sigma_bar * avg3(p.w);
@@ -422,36 +611,63 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   if (u < p_a) {
     // Absorbed: the absorption estimator collects sigma_a·Le / (sigma_bar·P_a).
     stats.events += 1.0;
-    if (HAS_EMISSION && !COLLISION_ESTIMATOR) p.L += p.w * emission_at(x, p.t, span, rho) / (sigma_bar * p_a);
+    if (HAS_EMISSION && !COLLISION_ESTIMATOR) p.L += p.w * emission_at(x, p.t, span, rho, 0.0, 0.0, 0.0) / (sigma_bar * p_a);
     return true;
   } else if (HAS_SCATTERING && u < p_a + p_s) {
     stats.events += 1.0;
     if (p.depth >= frame.image.w) return true;  // max_depth reached
     ++p.depth;
     p.w *= sigma_s / (sigma_bar * p_s);
-    // Phase function of the mixture sum_i (sigma_s_i / sigma_s) p_i: pick medium i
-    // with q_i ∝ avg(share_i ⊙ w), sample its HG lobe, weight share_i / q_i.
+    // Phase function of the mixture f = Σ_i share_i·HG_i, share_i = σs_i/σs (per
+    // channel): sample lobe i with q_i ∝ avg(share_i ⊙ w); the direction's pdf
+    // is the mixture's, Σ_i q_i·HG_i, and the weight f/pdf.
     vec3 inv_sigma_s = 1.0 / max(sigma_s, vec3(1e-30));
+    vec3 share[MEDIA_N];
+    float q[MEDIA_N];
     float total = 0.0;
-    for (uint i = 0u; i < MEDIUM_COUNT; ++i) total += avg3(rho[i] * media[i].sigma_s.rgb * inv_sigma_s * p.w);
-    float pick = rng_next(rng) * total;
-    float acc = 0.0, g = 0.0;
-    vec3 mix_w = vec3(0.0);
     for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-      vec3 share = rho[i] * media[i].sigma_s.rgb * inv_sigma_s;
-      float p_i = avg3(share * p.w);
-      if (p_i <= 0.0) continue;
-      acc += p_i;
+      share[i] = rho[i] * media[i].sigma_s.rgb * inv_sigma_s;
+      q[i] = avg3(share[i] * p.w);
+      total += q[i];
+    }
+    for (uint i = 0u; i < MEDIUM_COUNT; ++i) q[i] /= total;
+    if (NEE) {
+      LightSample ls = sample_light(x, rng, stats);
+      if (ls.pdf > 0.0 && max3(ls.Le) > 0.0) {
+        vec3 f = vec3(0.0);
+        float pdf_phase = 0.0;
+        for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+          float hg = hg_pdf(dot(p.d, ls.dir), media[i].sigma_s.w);
+          f += share[i] * hg;
+          pdf_phase += q[i] * hg;
+        }
+        float R, sigma_end;
+        vec3 T = shadow_transmittance(x, ls.dir, ls.dist, p.w * f / pdf_phase, rng, stats, R, sigma_end);
+        float p_uni = pdf_phase * R * (ls.volume ? sigma_end : 1.0);
+        p.L += p.w * f * T * ls.Le * (light_weight(ls.pdf, p_uni) / ls.pdf);
+      }
+    }
+    float pick = rng_next(rng), acc = 0.0, g = 0.0;
+    for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+      if (q[i] <= 0.0) continue;
+      acc += q[i];
       g = media[i].sigma_s.w;
-      mix_w = share * (total / p_i);
       if (pick < acc) break;
     }
-    p.w *= mix_w;
-    p.o = x;
-    p.d = sample_hg(p.d, g, vec2(rng_next(rng), rng_next(rng)));
-    p.fresh = true;
+    vec3 d = sample_hg(p.d, g, vec2(rng_next(rng), rng_next(rng)));
+    vec3 f = vec3(0.0);
+    float pdf_phase = 0.0;
+    for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+      float hg = hg_pdf(dot(p.d, d), media[i].sigma_s.w);
+      f += share[i] * hg;
+      pdf_phase += q[i] * hg;
+    }
+    p.w *= f / pdf_phase;
+    new_ray(p, x, d, pdf_phase);
   } else {
-    p.w *= sigma_n / (sigma_bar * (1.0 - p_a - p_s));
+    float p_n = 1.0 - p_a - p_s;
+    p.w *= sigma_n / (sigma_bar * p_n);
+    p.R *= p_n;
   }
   return max3(p.w) <= 0.0;
 }
@@ -476,6 +692,9 @@ PathState camera_path(uvec2 pixel, uint k, out uint rng) {
   p.depth = 0u;
   p.fresh = true;
   p.has_hit = false;
+  p.pdf_dir = 0.0;
+  p.R = 1.0;
+  p.t_shift = 0.0;
   return p;
 }
 

@@ -34,6 +34,10 @@ PYRO_CONST uint MAX_TEXTURES = 8;
 PYRO_CONST uint BINDING_ENV_TEXELS = 14;     // readonly buffer vec4[]: the environment map (shaders/lights.glsl)
 PYRO_CONST uint BINDING_ENV_CDF = 15;        // readonly buffer float[]: its sampling CDF
 PYRO_CONST uint BINDING_ENV_HEADER = 16;     // uniform GpuEnvironment (shared/light_types.h)
+PYRO_CONST uint BINDING_EMISSION_CDF = 17;     // readonly buffer float[]: every emissive grid's emission CDF
+PYRO_CONST uint BINDING_EMISSION_CELLS = 18;   // readonly buffer uint[]: the cells of its entries
+PYRO_CONST uint BINDING_EMISSION_PMF = 19;     // readonly buffer float[]: per-cell probabilities
+PYRO_CONST uint BINDING_EMISSION_HEADERS = 20; // uniform GpuEmissionCdf[MAX_GRIDS], by grid slot
 
 // Specialisation constants of render.comp: a scene pays only for what it uses.
 PYRO_CONST uint SPEC_HAS_GRIDS = 0;
@@ -47,6 +51,10 @@ PYRO_CONST uint SPEC_HAS_SURFACES = 7;
 PYRO_CONST uint SPEC_SURFACE_SHAPE_COUNT = 8;
 PYRO_CONST uint SPEC_SURFACE_HAS_TRIANGLES = 9;
 PYRO_CONST uint SPEC_HAS_ENVIRONMENT = 10;
+PYRO_CONST uint SPEC_LIGHT_STRATEGY = 11;  // LIGHT_STRATEGY_*: next-event estimation and MIS (docs/mis.md)
+PYRO_CONST uint LIGHT_STRATEGY_BSDF = 0;        // BSDF/phase sampling only: no light sampling code
+PYRO_CONST uint LIGHT_STRATEGY_MIS = 1;         // both, power heuristic
+PYRO_CONST uint LIGHT_STRATEGY_LIGHT_ONLY = 2;  // debug: next-event estimation only
 PYRO_CONST uint DEBUG_NONE = 0;
 PYRO_CONST uint DEBUG_RATIO_TRACKING = 1;  // camera rays return ratio-tracking transmittance
 PYRO_CONST uint DEBUG_DELTA_TRACKING = 2;  // camera rays return delta-tracking transmittance
@@ -98,6 +106,8 @@ struct FrameConstants {
   vec4 background;       // rgb radiance of escaping rays
   uvec4 image;           // x width, y height, z medium count, w max_depth
   uvec4 sampling;        // x seed, y frame, z unused, w unused
+  vec4 lights;           // x: probability that next-event estimation picks the environment
+                         // (each emissive grid's is its GpuEmissionCdf measure.w); yzw: unused
 };
 
 // Per-pass values (push constants).
@@ -120,7 +130,7 @@ struct AccumTexel {
 #ifdef __cplusplus
 static_assert(sizeof(GpuMedium) == 96);
 static_assert(sizeof(GpuGrid) == 192);
-static_assert(sizeof(FrameConstants) == 112);
+static_assert(sizeof(FrameConstants) == 128);
 static_assert(offsetof(FrameConstants, image) == 80);
 static_assert(sizeof(PassConstants) == 16);
 static_assert(sizeof(AccumTexel) == 64);

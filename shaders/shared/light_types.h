@@ -45,7 +45,8 @@ struct GpuEmissionCdf {
   vec4 cell_to_world_row2;
   uvec4 cells;    // xyz: cells per axis (= density dims − 1); w: entry count (cells of weight > 0)
   uvec4 offsets;  // x: first entry in emission_cdf / emission_cells; y: first cell in emission_pmf; zw: 0
-  vec4 measure;   // x: cell volume |det| (world units³); y: 1 / volume; z: power ∫ w dV; w: 0
+  vec4 measure;   // x: cell volume |det| (world units³); y: 1 / volume; z: power ∫ w dV;
+                  // w: probability that next-event estimation picks this light (render.comp)
 };
 
 #ifdef __cplusplus

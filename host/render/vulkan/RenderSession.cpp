@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "geometry/SceneSurfaces.h"
+#include "light/EmissionCdf.h"
 #include "light/EnvironmentMap.h"
 #include "render/vulkan/Spirv.h"
 #include "util/Error.h"
@@ -49,8 +50,11 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   create_textures(scene);
   create_surfaces(scene);
   create_environment(scene);
+  emission_headers_ = vk::Buffer(ctx, gpu::MAX_GRIDS * sizeof(gpu::GpuEmissionCdf), kUniform,
+                                 vk::MemoryKind::HostVisible, "emission light headers");
+  upload_emission_lights(build_emission_lights(scene, volumes_, gpu_scene_));
 
-  spec_ = spec_constants(scene, gpu_scene_, settings);
+  spec_ = spec_constants(scene, gpu_scene_, settings, light_selection_);
   pipeline_.emplace(ctx, vk::load_spirv("render.comp"),
                     std::vector<vk::ComputePipeline::Binding>{
                         {gpu::BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
@@ -69,7 +73,11 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                         {gpu::BINDING_TEXTURES, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_TEXTURES},
                         {gpu::BINDING_ENV_TEXELS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_ENV_CDF, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                        {gpu::BINDING_ENV_HEADER, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}},
+                        {gpu::BINDING_ENV_HEADER, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+                        {gpu::BINDING_EMISSION_CDF, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_EMISSION_CELLS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_EMISSION_PMF, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_EMISSION_HEADERS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}},
                     uint32_t(sizeof(gpu::PassConstants)), spec_, "render");
   set_.emplace(ctx, *pipeline_, "render set");
   set_->write_buffer(gpu::BINDING_FRAME, frame_buffer_);
@@ -101,7 +109,8 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
 
 // The shader variant: code for grids, scattering and emission only when used.
 std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const Scene& scene, const GpuScene& g,
-                                                                        const RenderSettings& settings) const {
+                                                                        const RenderSettings& settings,
+                                                                        const LightSelection& lights) const {
   auto flag = [](bool b) { return uint32_t(b ? 1 : 0); };
   return {{gpu::SPEC_HAS_GRIDS, flag(g.has_grids)},
           {gpu::SPEC_HAS_SCATTERING, flag(g.has_scattering && scene.integrator.max_depth > 0)},
@@ -113,12 +122,19 @@ std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const S
           {gpu::SPEC_HAS_SURFACES, flag(!scene.shapes.empty())},
           {gpu::SPEC_SURFACE_SHAPE_COUNT, gpu_surfaces_.shape_count},
           {gpu::SPEC_SURFACE_HAS_TRIANGLES, flag(gpu_surfaces_.triangle_count > 0)},
-          {gpu::SPEC_HAS_ENVIRONMENT, flag(scene.environment.has_value())}};
+          {gpu::SPEC_HAS_ENVIRONMENT, flag(scene.environment.has_value())},
+          {gpu::SPEC_LIGHT_STRATEGY, lights.strategy == LightStrategy::Mis         ? gpu::LIGHT_STRATEGY_MIS
+                                     : lights.strategy == LightStrategy::LightOnly ? gpu::LIGHT_STRATEGY_LIGHT_ONLY
+                                                                                   : gpu::LIGHT_STRATEGY_BSDF}};
 }
 
 // The bindings that change with the media's grids.
 void RenderSession::write_grid_descriptors() {
   set_->write_buffer(gpu::BINDING_MAJORANTS, majorant_buffer_);
+  set_->write_buffer(gpu::BINDING_EMISSION_CDF, emission_cdf_);
+  set_->write_buffer(gpu::BINDING_EMISSION_CELLS, emission_cells_);
+  set_->write_buffer(gpu::BINDING_EMISSION_PMF, emission_pmf_);
+  set_->write_buffer(gpu::BINDING_EMISSION_HEADERS, emission_headers_);
   // textures_3d_[0] / textures_1d_[0] are 1-texel placeholders for unused slots.
   for (uint32_t slot = 0; slot < gpu::MAX_GRIDS; ++slot) {
     const bool used = slot < gpu_scene_.grid_sources.size();
@@ -155,7 +171,8 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
     const color::BlackbodyLutParams& p = src.blackbody->params();
     gpu_scene.grids[slot].blackbody_lut = gpu::vec4(p.log_scale, p.log_bias, p.t_min_k, 0.f);
   }
-  if (spec_constants(scene, gpu_scene, settings) != spec_) return false;
+  EmissionLights lights = build_emission_lights(scene, volumes, gpu_scene);
+  if (spec_constants(scene, gpu_scene, settings, lights.selection) != spec_) return false;
 
   // The previous frame's textures live until the descriptors point at the new
   // ones (every pass was waited for, so none is in flight).
@@ -171,6 +188,7 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
     if (v)
       for (const auto& w : v->warnings) warnings_.push_back(w);
   majorant_buffer_ = storage_buffer(ctx_, gpu_scene_.majorants, "majorant cells");
+  upload_emission_lights(lights);
   create_textures(scene);
   write_grid_descriptors();
   upload_constants(scene);
@@ -285,11 +303,54 @@ void RenderSession::create_environment(const Scene& scene) {
     texels = env.gpu_texels();
     cdf = env.gpu_cdf();
     header = env.gpu_header();
+    environment_ = std::move(env);
   }
   env_texels_ = storage_buffer(ctx_, texels, "environment");
   env_cdf_ = storage_buffer(ctx_, cdf, "environment cdf");
   env_header_ = vk::Buffer(ctx_, sizeof header, kUniform, vk::MemoryKind::HostVisible, "environment header");
   env_header_.upload(ctx_, &header, sizeof header);
+}
+
+// Each emissive grid medium as a light: its emission CDF over the grid as
+// stored (host/light/EmissionCdf), packed one after another. Built only when
+// the scene can use next-event estimation. The preview's live edits of the
+// emission (update) keep these CDFs: a stale distribution is still a valid
+// light sampler, because MIS evaluates the same tables it samples from.
+RenderSession::EmissionLights RenderSession::build_emission_lights(
+    const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes, const GpuScene& g) const {
+  EmissionLights out;
+  out.headers.assign(gpu::MAX_GRIDS, gpu::GpuEmissionCdf{});
+  std::vector<std::optional<EmissionCdf>> cdfs(scene.media.size());
+  std::vector<const EmissionCdf*> by_medium(scene.media.size(), nullptr);
+  if (scene.integrator.mis && scene.integrator.emission_estimator == "collision")
+    for (const GpuGridSource& src : g.grid_sources) {
+      const Medium& m = scene.media[src.medium];
+      if (!m.emission.emits() || !volumes[src.medium]) continue;
+      cdfs[src.medium] = EmissionCdf::build(m, *volumes[src.medium]);
+      if (!cdfs[src.medium]->empty()) by_medium[src.medium] = &*cdfs[src.medium];
+    }
+  out.selection = select_lights(scene, environment_ ? &*environment_ : nullptr, by_medium);
+  if (out.selection.strategy == LightStrategy::Bsdf) return out;
+  for (size_t slot = 0; slot < g.grid_sources.size(); ++slot) {
+    const size_t i = g.grid_sources[slot].medium;
+    if (!by_medium[i] || !(out.selection.p_medium[i] > 0.0)) continue;
+    const EmissionCdf& c = *by_medium[i];
+    gpu::GpuEmissionCdf h = c.gpu_header(uint32_t(out.cdf.size()), uint32_t(out.pmf.size()));
+    h.measure.w = float(out.selection.p_medium[i]);
+    out.headers[slot] = h;
+    out.cdf.insert(out.cdf.end(), c.gpu_cdf().begin(), c.gpu_cdf().end());
+    out.cells.insert(out.cells.end(), c.gpu_cells().begin(), c.gpu_cells().end());
+    out.pmf.insert(out.pmf.end(), c.gpu_pmf().begin(), c.gpu_pmf().end());
+  }
+  return out;
+}
+
+void RenderSession::upload_emission_lights(const EmissionLights& lights) {
+  light_selection_ = lights.selection;
+  emission_cdf_ = storage_buffer(ctx_, lights.cdf, "emission cdf");
+  emission_cells_ = storage_buffer(ctx_, lights.cells, "emission cells");
+  emission_pmf_ = storage_buffer(ctx_, lights.pmf, "emission pmf");
+  emission_headers_.upload(ctx_, lights.headers.data(), lights.headers.size() * sizeof(gpu::GpuEmissionCdf));
 }
 
 void RenderSession::upload_constants(const Scene& scene) {
@@ -298,6 +359,7 @@ void RenderSession::upload_constants(const Scene& scene) {
   for (size_t i = 0; i < now.grids.size() && i < gpu_scene_.grids.size(); ++i)
     now.grids[i].blackbody_lut = gpu_scene_.grids[i].blackbody_lut;
   gpu::FrameConstants frame = build_frame_constants(scene, settings_, uint32_t(now.media.size()));
+  frame.lights.x = float(light_selection_.p_env);
   frame_buffer_.upload(ctx_, &frame, sizeof frame);
   if (!now.media.empty()) media_buffer_.upload(ctx_, now.media.data(), now.media.size() * sizeof(gpu::GpuMedium));
   if (!now.grids.empty()) grid_buffer_.upload(ctx_, now.grids.data(), now.grids.size() * sizeof(gpu::GpuGrid));

@@ -14,6 +14,8 @@
 #include "scene/Scene.h"
 #include "shared/gpu_types.h"
 #include "geometry/Surfaces.h"
+#include "light/EnvironmentMap.h"
+#include "light/LightSelection.h"
 #include "volume/StoredVolume.h"
 
 namespace pyrolume {
@@ -59,8 +61,20 @@ class RenderSession {
   void create_textures(const Scene& scene);
   void create_surfaces(const Scene& scene);
   void create_environment(const Scene& scene);
+  // The emission CDFs of the emissive grids and the light selection for
+  // next-event estimation (docs/mis.md), from the loaded volumes.
+  struct EmissionLights {
+    LightSelection selection;
+    std::vector<float> cdf, pmf;
+    std::vector<uint32_t> cells;
+    std::vector<gpu::GpuEmissionCdf> headers;  // per grid slot (MAX_GRIDS)
+  };
+  EmissionLights build_emission_lights(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes,
+                                       const GpuScene& gpu_scene) const;
+  void upload_emission_lights(const EmissionLights& lights);
   std::vector<std::pair<uint32_t, uint32_t>> spec_constants(const Scene& scene, const GpuScene& gpu_scene,
-                                                           const RenderSettings& settings) const;
+                                                           const RenderSettings& settings,
+                                                           const LightSelection& lights) const;
   void write_grid_descriptors();
 
   vk::Context& ctx_;
@@ -77,6 +91,10 @@ class RenderSession {
   std::vector<vk::Image2D> textures_2d_;  // [0] placeholder, then one per albedo texture
   // The environment map: texels, sampling CDF, header.
   vk::Buffer env_texels_, env_cdf_, env_header_;
+  std::optional<EnvironmentMap> environment_;
+  // The emissive grids as lights: CDF entries, their cells, per-cell pmf, headers.
+  vk::Buffer emission_cdf_, emission_cells_, emission_pmf_, emission_headers_;
+  LightSelection light_selection_;
   std::optional<vk::ComputePipeline> pipeline_;
   std::optional<vk::DescriptorSet> set_;
   std::vector<std::pair<uint32_t, uint32_t>> spec_;  // the variant pipeline_ was compiled for
