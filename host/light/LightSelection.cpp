@@ -44,7 +44,7 @@ LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, cons
 
 std::string light_strategy_warning(const Scene& scene) {
   const Integrator& in = scene.integrator;
-  if (!in.mis || in.emission_estimator == "collision" || !scene_scatters(scene)) return "";
+  if (!in.mis || !in.mis_in_file || in.emission_estimator == "collision" || !scene_scatters(scene)) return "";
   bool lights = scene.environment.has_value();
   for (const Medium& m : scene.media) lights = lights || (m.type == Medium::Type::Vdb && m.emission.emits());
   if (!lights) return "";

@@ -42,7 +42,8 @@ struct LightSelection {
 // absorption estimator does not have), max_depth ≥ 1 and at least one light.
 LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs);
 
-// One line for stderr when the scene asks for MIS but cannot get it (empty: none).
+// One line for stderr when the scene file asks for MIS ("mis": true written
+// out) but cannot get it with the absorption estimator (empty: none).
 std::string light_strategy_warning(const Scene& scene);
 
 // Power heuristic, β = 2 (Veach 1997, eq. 9.13), for the strategy with pdf

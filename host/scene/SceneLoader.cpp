@@ -362,6 +362,7 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
   if (r.has("integrator")) {
     Reader i = r.child("integrator");
     s.integrator.max_depth = i.integer("max_depth", s.integrator.max_depth, 0, 100000);
+    s.integrator.mis_in_file = i.has("mis");
     s.integrator.mis = i.boolean("mis", s.integrator.mis);
     s.integrator.light_only = i.boolean("light_only", s.integrator.light_only);
     s.integrator.emission_estimator = i.choice("emission_estimator", "absorption", {"absorption", "collision"});

@@ -10,6 +10,9 @@
 
 #include <gtest/gtest.h>
 
+#include "light/EmissionCdf.h"
+#include "light/EnvironmentMap.h"
+#include "light/LightSelection.h"
 #include "render/cpu/CpuRenderer.h"
 #include "support/MisScenes.h"
 #include "support/Stats.h"
@@ -123,6 +126,48 @@ TEST(CpuMis, ScatteringFurnaceIsOneWithSkyAsLight) {
   RenderResult r = render(s);
   ZTestReport z = test::ztest_against_exact(r, [](int, int) { return glm::dvec3(1.0); }, pooled(0.01));
   EXPECT_TRUE(z.ok) << z.summary();
+}
+
+// Light choice and strategy rules (host/light/LightSelection.h).
+TEST(LightSelection, ProbabilitiesAndStrategies) {
+  const auto dir = test::temp_dir("cpu_mis_select");
+  Scene s = test::fire_over_plane_scene(dir, Strategy::Mis, true, true);
+  const EnvironmentMap env = EnvironmentMap::load(s.environment->file);
+  const StoredVolume vol = load_stored_volume(s.media[0]);
+  const EmissionCdf cdf = EmissionCdf::build(s.media[0], vol);
+  ASSERT_FALSE(cdf.empty());
+  // Two emissive grids of equal power share the media's half equally.
+  LightSelection l = select_lights(s, &env, {&cdf, &cdf});
+  EXPECT_EQ(l.strategy, LightStrategy::Mis);
+  EXPECT_DOUBLE_EQ(l.p_env, 0.5);
+  EXPECT_DOUBLE_EQ(l.p_medium[0], 0.25);
+  EXPECT_DOUBLE_EQ(l.p_medium[1], 0.25);
+  // No environment: the media take everything; no media: the environment does.
+  l = select_lights(s, nullptr, {&cdf, nullptr});
+  EXPECT_DOUBLE_EQ(l.p_env, 0.0);
+  EXPECT_DOUBLE_EQ(l.p_medium[0], 1.0);
+  l = select_lights(s, &env, {nullptr});
+  EXPECT_DOUBLE_EQ(l.p_env, 1.0);
+  // Nothing to sample, mis off, the absorption estimator or max_depth 0: BSDF only.
+  EXPECT_EQ(select_lights(s, nullptr, {nullptr}).strategy, LightStrategy::Bsdf);
+  Scene off = s;
+  off.integrator.mis = false;
+  EXPECT_EQ(select_lights(off, &env, {&cdf}).strategy, LightStrategy::Bsdf);
+  Scene absorption = s;
+  absorption.integrator.emission_estimator = "absorption";
+  EXPECT_EQ(select_lights(absorption, &env, {&cdf}).strategy, LightStrategy::Bsdf);
+  Scene depth0 = s;
+  depth0.integrator.max_depth = 0;
+  EXPECT_EQ(select_lights(depth0, &env, {&cdf}).strategy, LightStrategy::Bsdf);
+  Scene light_only = s;
+  light_only.integrator.light_only = true;
+  EXPECT_EQ(select_lights(light_only, &env, {&cdf}).strategy, LightStrategy::LightOnly);
+  // The warning is for a file that asked for MIS with the absorption estimator.
+  EXPECT_EQ(light_strategy_warning(absorption), "");
+  absorption.integrator.mis_in_file = true;
+  EXPECT_NE(light_strategy_warning(absorption).find("collision"), std::string::npos);
+  s.integrator.mis_in_file = true;
+  EXPECT_EQ(light_strategy_warning(s), "");
 }
 
 }  // namespace
