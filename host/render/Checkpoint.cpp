@@ -91,7 +91,7 @@ Checkpoint read_checkpoint(const fs::path& file) {
   if (!in) throw input_error(name, "", std::string("cannot open checkpoint: ") + std::strerror(errno));
   std::string magic, header;
   if (!std::getline(in, magic) || magic != kMagic) throw input_error(name, "", "not a pyrolume checkpoint (version 1)");
-  if (!std::getline(in, header)) throw input_error(name, "", "truncated checkpoint (no header)");
+  if (!std::getline(in, header) || in.eof()) throw input_error(name, "", "truncated checkpoint (no complete header)");
   Checkpoint c;
   uint64_t bytes = 0;
   try {
