@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "render/Backend.h"
 #include "support/AccumulationScenes.h"
@@ -100,6 +101,97 @@ inline void expect_resume_exact(Backend& backend, const Scene& s) {
   RenderControl from_checkpoint;
   from_checkpoint.resume = &saved[saved.size() / 2];
   expect_same_sums(backend.render(s, rs, from_checkpoint), whole);
+}
+
+
+// ------------------------------------------------------------- the CLI ----
+
+inline std::string q(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+
+inline void expect_same_image(const Image& a, const Image& b) {
+  ASSERT_EQ(a.width, b.width);
+  ASSERT_EQ(a.height, b.height);
+  size_t differ = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) differ += a.rgb[i] != b.rgb[i];
+  EXPECT_EQ(differ, 0u) << "of " << a.rgb.size() << " values differ";
+  ASSERT_EQ(a.variance.size(), b.variance.size());
+  differ = 0;
+  for (size_t i = 0; i < a.variance.size(); ++i) differ += a.variance[i] != b.variance[i];
+  EXPECT_EQ(differ, 0u) << "of " << a.variance.size() << " variance values differ";
+}
+
+// A real SIGINT in the middle of a 10 000 spp render (sent once the first
+// checkpoint exists): exit 130, the image so far with its spp in the EXR
+// header and in the message, the checkpoint beside it; `--resume` then
+// completes it to 10 000 spp, identical to an uninterrupted render, and
+// removes the checkpoint.
+inline void expect_cli_interrupt_then_resume(const std::string& backend) {
+  auto dir = temp_dir("cli-resume-" + backend);
+  write_file(dir / "s.json", kSlowBallJson);
+  const auto out = dir / "o.exr", ckpt = dir / "o.exr.checkpoint";
+  CliProcess p = start_cli({"render", (dir / "s.json").string(), "-o", out.string(), "--backend", backend,
+                            "--checkpoint", "0.02", "--variance", "--stats", (dir / "st.json").string()},
+                           dir);
+  ASSERT_TRUE(wait_for_file(p, ckpt)) << "the render ended before its first checkpoint: " << read_file(p.err);
+  kill(p.pid, SIGINT);
+  ASSERT_EQ(wait_exit(p), 130) << read_file(p.err);
+  const std::string err = read_file(p.err);
+
+  Image part = read_image(out);
+  EXPECT_GT(part.spp, 0);
+  EXPECT_LT(part.spp, 10000);
+  EXPECT_EQ(part.spp_target, 10000);
+  ASSERT_TRUE(part.has_variance());
+  const std::string said = "interrupted after " + std::to_string(part.spp) + " of 10000 spp";
+  EXPECT_NE(err.find(said), std::string::npos) << err;
+  EXPECT_NE(err.find(out.string()), std::string::npos) << err;
+  EXPECT_NE(err.find("--resume"), std::string::npos) << err;
+  auto stats = nlohmann::json::parse(read_file(dir / "st.json"));
+  EXPECT_EQ(stats["spp"], part.spp);
+  EXPECT_EQ(stats["cancelled"], true);
+  ASSERT_TRUE(std::filesystem::exists(ckpt));
+
+  CliResult resumed = run_cli("render " + q(dir / "s.json") + " -o " + q(out) + " --backend " + backend +
+                              " --resume --variance --stats " + q(dir / "st2.json"));
+  ASSERT_EQ(resumed.status, 0) << resumed.err;
+  EXPECT_EQ(resumed.err.find("validation"), std::string::npos) << resumed.err;
+  EXPECT_EQ(err.find("validation"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(ckpt)) << "a finished render leaves no checkpoint";
+  auto stats2 = nlohmann::json::parse(read_file(dir / "st2.json"));
+  EXPECT_EQ(stats2["spp"], 10000);
+  EXPECT_EQ(stats2["resumed_spp"], part.spp);
+
+  CliResult whole = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "u.exr") + " --backend " + backend +
+                            " --variance");
+  ASSERT_EQ(whole.status, 0) << whole.err;
+  Image a = read_image(out), b = read_image(dir / "u.exr");
+  EXPECT_EQ(a.spp, 10000);
+  EXPECT_EQ(a.spp_target, 10000);
+  expect_same_image(a, b);
+  std::filesystem::remove_all(dir);
+}
+
+// SIGTERM: the same save, exit 143.
+inline void expect_cli_sigterm_saves(const std::string& backend) {
+  auto dir = temp_dir("cli-term-" + backend);
+  write_file(dir / "s.json", kSlowBallJson);
+  const auto out = dir / "o.exr", ckpt = dir / "o.exr.checkpoint";
+  CliProcess p = start_cli(
+      {"render", (dir / "s.json").string(), "-o", out.string(), "--backend", backend, "--checkpoint", "0.02"}, dir);
+  ASSERT_TRUE(wait_for_file(p, ckpt)) << read_file(p.err);
+  kill(p.pid, SIGTERM);
+  ASSERT_EQ(wait_exit(p), 143) << read_file(p.err);
+  Image part = read_image(out);
+  EXPECT_GT(part.spp, 0);
+  EXPECT_LT(part.spp, 10000);
+  EXPECT_NE(read_file(p.err).find("interrupted after " + std::to_string(part.spp)), std::string::npos);
+  // The partial image is exactly a render of that many spp (sample-indexed
+  // streams; on the GPU the same passes of 64).
+  CliResult same = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "again.exr") + " --backend " + backend +
+                           " --spp " + std::to_string(part.spp));
+  ASSERT_EQ(same.status, 0) << same.err;
+  expect_same_image(part, read_image(dir / "again.exr"));
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace pyrolume::test

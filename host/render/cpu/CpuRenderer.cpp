@@ -17,6 +17,7 @@
 #include "geometry/SceneSurfaces.h"
 #include "geometry/Surfaces.h"
 #include "light/EnvironmentMap.h"
+#include "render/Limits.h"
 #include "render/cpu/Media.h"
 #include "render/cpu/Rng.h"
 #include "render/cpu/Sampling.h"
@@ -266,6 +267,9 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
     if (!(glm::length(glm::cross(f, scene.camera.up)) > 0.0))
       throw std::invalid_argument("cpu reference: camera up is parallel to the view direction");
   }
+  // Σ L and Σ L² in double, and one copy of them for a checkpoint.
+  check_accumulation_size(scene.file.string(), settings.width, settings.height, 2 * 6 * sizeof(double),
+                          physical_memory_bytes(), "this machine's memory");
   const std::string& estimator = scene.integrator.emission_estimator;
   if (estimator != "absorption" && estimator != "collision")
     throw std::invalid_argument("cpu reference: unknown emission_estimator \"" + estimator + "\"");

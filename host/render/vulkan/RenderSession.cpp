@@ -6,6 +6,7 @@
 
 #include "geometry/SceneSurfaces.h"
 #include "light/EnvironmentMap.h"
+#include "render/Limits.h"
 #include "render/vulkan/Spirv.h"
 #include "util/Error.h"
 
@@ -30,6 +31,17 @@ std::string mib(double bytes) { return std::to_string(int(bytes / (1024.0 * 1024
 
 RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderSettings& settings)
     : ctx_(ctx), settings_(settings) {
+  // The accumulation buffer is one storage buffer: check it fits the device
+  // (lavapipe allows 128 MiB, about 1448² pixels) and its host readback
+  // (texels plus double sums) fits the machine, before loading anything.
+  const VkDeviceSize range = ctx.properties().limits.maxStorageBufferRange;
+  const bool range_binds = range <= ctx.max_allocation_size();
+  check_accumulation_size(scene.file.string(), settings.width, settings.height, sizeof(gpu::AccumTexel),
+                          range_binds ? range : ctx.max_allocation_size(),
+                          range_binds ? "this device's maxStorageBufferRange" : "this device's maxMemoryAllocationSize");
+  check_accumulation_size(scene.file.string(), settings.width, settings.height,
+                          sizeof(gpu::AccumTexel) + 6 * sizeof(double), physical_memory_bytes(),
+                          "this machine's memory");
   // Load only what the scene uses: the grids of its vdb media.
   volumes_.resize(scene.media.size());
   for (size_t i = 0; i < scene.media.size(); ++i) {
