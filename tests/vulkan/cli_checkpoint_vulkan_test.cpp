@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "support/AccumulationChecks.h"
+#include "support/VdbScenes.h"
 
 namespace pyrolume {
 namespace {
@@ -89,6 +90,29 @@ TEST(CliLimitsVulkan, AccumulationLargerThanTheDeviceAllowsIsBadInput) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_NE(r.err.find("film.width x film.height (or --width/--height): 16384x16384"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("this device's"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "o.exr"));
+  std::filesystem::remove_all(dir);
+}
+
+// A grid wider than the device's maxImageDimension3D: refused by the loader
+// before its dense array exists, naming the grid and the downsample that fits.
+TEST(CliLimitsVulkan, GridPastTheDevicesTextureLimitIsBadInput) {
+  auto dir = temp_dir("cli-wide");
+  ensure_openvdb();
+  auto g = openvdb::FloatGrid::create(0.0f);
+  g->setName("density");
+  g->tree().setValueOn(openvdb::Coord(0, 0, 0), 1.0f);
+  g->tree().setValueOn(openvdb::Coord(20000, 1, 1), 1.0f);  // past any GPU's 3D limit (16384 at most today)
+  write_vdb(dir / "wide.vdb", {g});
+  write_file(dir / "s.json", R"({"film": {"width": 4, "height": 4, "spp": 1},
+    "media": [{"name": "wide", "type": "vdb", "file": "wide.vdb", "sigma_a": [1, 1, 1], "sigma_s": [0, 0, 0]}]})");
+  CliResult r = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "o.exr"));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("wide.vdb: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("20003x4x4 texels (with downsample 1) exceed this device's 3D texture limit"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("add \"downsample\": "), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "o.exr"));
   std::filesystem::remove_all(dir);
 }

@@ -42,11 +42,12 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   check_accumulation_size(scene.file.string(), settings.width, settings.height,
                           sizeof(gpu::AccumTexel) + 6 * sizeof(double), physical_memory_bytes(),
                           "this machine's memory");
-  // Load only what the scene uses: the grids of its vdb media.
+  // Load only what the scene uses: the grids of its vdb media, each checked
+  // against the device's texture limits before its dense array is allocated.
   volumes_.resize(scene.media.size());
   for (size_t i = 0; i < scene.media.size(); ++i) {
     if (scene.media[i].type != Medium::Type::Vdb) continue;
-    volumes_[i] = load_stored_volume(scene.media[i]);
+    volumes_[i] = load_stored_volume(scene.media[i], dense_limits());
     for (const auto& w : volumes_[i]->warnings) warnings_.push_back(w);
   }
   gpu_scene_ = build_gpu_scene(scene, volumes_);
@@ -113,6 +114,10 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   });
 }
 
+DenseLimits RenderSession::dense_limits() const {
+  return DenseLimits{ctx_.properties().limits.maxImageDimension3D, uint64_t(ctx_.max_allocation_size())};
+}
+
 // The shader variant: code for grids, scattering and emission only when used.
 std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const Scene& scene, const GpuScene& g,
                                                                         const RenderSettings& settings) const {
@@ -151,7 +156,7 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
   // session as it was.
   std::vector<std::optional<StoredVolume>> volumes(scene.media.size());
   for (size_t i = 0; i < scene.media.size(); ++i)
-    if (scene.media[i].type == Medium::Type::Vdb) volumes[i] = load_stored_volume(scene.media[i]);
+    if (scene.media[i].type == Medium::Type::Vdb) volumes[i] = load_stored_volume(scene.media[i], dense_limits());
   // The blackbody LUTs depend only on the emission's mode, observer and
   // adaptation: bake them once per sequence and reuse them frame after frame.
   GpuScene gpu_scene = build_gpu_scene(scene, volumes, /*with_luts=*/false);
@@ -412,8 +417,6 @@ void RenderSession::result_from_state(const AccumulationState& state, RenderResu
   const size_t pixels = size_t(state.width) * size_t(state.height);
   if (state.data.size() != pixels * sizeof(gpu::AccumTexel))
     throw std::logic_error("RenderSession::result_from_state: state size does not match its image");
-  std::vector<gpu::AccumTexel> texels(pixels);
-  std::memcpy(texels.data(), state.data.data(), state.data.size());
   result.width = state.width;
   result.height = state.height;
   result.spp = state.spp;
@@ -422,7 +425,8 @@ void RenderSession::result_from_state(const AccumulationState& state, RenderResu
   result.events = result.density_lookups = 0.0;
   result.nonfinite_samples = 0;
   for (size_t i = 0; i < pixels; ++i) {
-    const gpu::AccumTexel& t = texels[i];
+    gpu::AccumTexel t;
+    std::memcpy(&t, state.data.data() + i * sizeof t, sizeof t);
     for (int c = 0; c < 3; ++c) {
       // Kahan: the running sum minus its pending compensation.
       result.sum[i * 3 + c] = double(t.sum[c]) - double(t.sum_c[c]);

@@ -63,6 +63,7 @@ class RenderSession {
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
+  DenseLimits dense_limits() const;  // this device's 3D texture limits, for the grid loader
   void upload_constants(const Scene& scene);
   void create_textures(const Scene& scene);
   void create_surfaces(const Scene& scene);

@@ -102,15 +102,16 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
       }
       if (settings.time_limit > 0 && since(render_start) >= settings.time_limit) break;
     }
+    saved = {};  // (memory: the final readback replaces it)
     AccumulationState final_state = session.save_state();
     RenderSession::result_from_state(final_state, result);
     if (result.spp < settings.spp) result.state = std::move(final_state);
   } catch (const vk::VulkanError& e) {
-    const bool lost = e.result == VK_ERROR_DEVICE_LOST;
-    if (!lost && e.result != VK_ERROR_OUT_OF_DEVICE_MEMORY && e.result != VK_ERROR_OUT_OF_HOST_MEMORY) throw;
+    const bool out_of_memory = e.result == VK_ERROR_OUT_OF_DEVICE_MEMORY || e.result == VK_ERROR_OUT_OF_HOST_MEMORY;
     // Out of memory leaves the device usable: read what the passes before the
-    // failed one accumulated. A lost device has nothing left to read.
-    if (!lost) {
+    // failed one accumulated. A lost device has nothing left to read, and
+    // after any other failure the device is not trusted: the host copy it is.
+    if (out_of_memory) {
       try {
         saved = session.save_state();
       } catch (const vk::VulkanError&) {
@@ -124,10 +125,11 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
     RenderSession::result_from_state(saved, partial);
     partial.seconds = since(render_start);
     partial.state = saved;
-    const std::string what = lost ? "the device was lost (VK_ERROR_DEVICE_LOST: a driver reset, hang or removal)"
-                             : e.result == VK_ERROR_OUT_OF_DEVICE_MEMORY
-                                 ? "the device ran out of memory (VK_ERROR_OUT_OF_DEVICE_MEMORY)"
-                                 : "the host ran out of memory (VK_ERROR_OUT_OF_HOST_MEMORY)";
+    const std::string what =
+        e.result == VK_ERROR_DEVICE_LOST ? "the device was lost (VK_ERROR_DEVICE_LOST: a driver reset, hang or removal)"
+        : e.result == VK_ERROR_OUT_OF_DEVICE_MEMORY ? "the device ran out of memory (VK_ERROR_OUT_OF_DEVICE_MEMORY)"
+        : e.result == VK_ERROR_OUT_OF_HOST_MEMORY   ? "the host ran out of memory (VK_ERROR_OUT_OF_HOST_MEMORY)"
+                                                    : std::string("the device failed: ") + e.what();
     throw RenderFailed(what, std::move(partial));
   }
   result.seconds = since(render_start);
