@@ -71,6 +71,13 @@ TEST(CliDeviceFailure, DeviceLostSavesTheLastHostCopyAndExits1) {
   ASSERT_EQ(fresh.status, 0) << fresh.err;
   expect_same_image(part, read_image(dir / "f.exr"));
 
+  // Lost in the first pass of the resumed render: what it resumed from is
+  // still there to save.
+  CliResult again = run_with_fault("VK_ERROR_DEVICE_LOST:1", render + " --spp 1000 --resume -o " + q(dir / "o.exr"));
+  EXPECT_EQ(again.status, 1) << again.err;
+  EXPECT_EQ(read_image(dir / "o.exr").spp, part.spp);
+  EXPECT_TRUE(std::filesystem::exists(dir / "o.exr.checkpoint"));
+
   // Lost in the first pass: nothing was accumulated, nothing is written.
   CliResult first = run_with_fault("VK_ERROR_DEVICE_LOST:1", render + " --spp 1000 -o " + q(dir / "n.exr"));
   EXPECT_EQ(first.status, 1) << first.err;

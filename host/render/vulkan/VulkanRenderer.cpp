@@ -77,6 +77,7 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
   auto render_start = Clock::now();
   const int per_pass = spp_per_pass(settings.width, settings.height, settings.spp);
   AccumulationState saved;
+  if (control.resume) saved = *control.resume;  // a failure in the first pass still has the resumed samples
   double save_interval = 0.0;
   auto last_save = render_start, last_checkpoint = render_start;
   try {
