@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <iostream>
 
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 
 #include "cli/Commands.h"
@@ -17,9 +19,16 @@
 namespace {
 std::atomic<bool> g_cancel{false};
 std::atomic<int> g_signal{0};
+// The first SIGINT/SIGTERM asks the render to stop after its pass and save;
+// a second one (the pass itself is stuck, or the user will not wait) exits at
+// once with the same status, saving nothing more.
 extern "C" void on_signal(int sig) {
+  if (g_cancel.exchange(true)) {
+    static const char msg[] = "pyrolume: second signal: exiting without saving\n";
+    [[maybe_unused]] ssize_t n = write(2, msg, sizeof msg - 1);
+    _exit(128 + sig);
+  }
   g_signal = sig;
-  g_cancel = true;
 }
 }  // namespace
 
