@@ -78,6 +78,13 @@ TEST(CliDeviceFailure, DeviceLostSavesTheLastHostCopyAndExits1) {
   EXPECT_EQ(read_image(dir / "o.exr").spp, part.spp);
   EXPECT_TRUE(std::filesystem::exists(dir / "o.exr.checkpoint"));
 
+  // Any other failure of a pass is handled the same way, with its own message.
+  CliResult other = run_with_fault("VK_ERROR_UNKNOWN:2", render + " --spp 1000 -o " + q(dir / "x.exr"));
+  EXPECT_EQ(other.status, 1) << other.err;
+  EXPECT_NE(other.err.find("the device failed: vkQueueSubmit"), std::string::npos) << other.err;
+  EXPECT_NE(other.err.find("VK_ERROR_UNKNOWN"), std::string::npos) << other.err;
+  EXPECT_EQ(read_image(dir / "x.exr").spp, 64);  // the host copy after pass 1
+
   // Lost in the first pass: nothing was accumulated, nothing is written.
   CliResult first = run_with_fault("VK_ERROR_DEVICE_LOST:1", render + " --spp 1000 -o " + q(dir / "n.exr"));
   EXPECT_EQ(first.status, 1) << first.err;

@@ -352,9 +352,10 @@ void RenderSession::record_pass(VkCommandBuffer cmd, int spp) {
 
 namespace {
 // Test hook (no CLI flag): PYROLUME_TEST_FAIL_PASS=VK_ERROR_DEVICE_LOST:N (or
-// VK_ERROR_OUT_OF_DEVICE_MEMORY:N) makes the N-th render pass of this process
-// (1-based) fail as if vkQueueSubmit had returned that result. A device cannot
-// be lost on lavapipe; this is how tests reach the recovery path.
+// VK_ERROR_OUT_OF_DEVICE_MEMORY:N; any other name means VK_ERROR_UNKNOWN)
+// makes the N-th render pass of this process (1-based) fail as if
+// vkQueueSubmit had returned that result. A device cannot be lost on
+// lavapipe; this is how tests reach the recovery path.
 VkResult injected_failure() {
   static const std::pair<VkResult, long> fault = [] {
     const char* v = std::getenv("PYROLUME_TEST_FAIL_PASS");
