@@ -16,6 +16,7 @@
 #include "image/ImageIo.h"
 #include "image/RenderImage.h"
 #include "render/Backend.h"
+#include "render/Checkpoint.h"
 #include "render/vulkan/Devices.h"
 #include "render/vulkan/VulkanRenderer.h"
 #include "scene/Scene.h"
@@ -56,7 +57,9 @@ void check_folder(const std::filesystem::path& file, const std::string& what) {
 // The stats JSON of one render (DESIGN.md "--stats").
 void write_stats(const std::filesystem::path& file, const RenderArgs& args, const std::filesystem::path& output,
                  const RenderResult& result, std::optional<int> frame) {
-  const double samples = double(result.width) * result.height * result.spp;
+  const double samples = double(total_samples(result.width, result.height, result.spp));
+  // Rates count this run's samples only (a resumed render's earlier ones took no time here).
+  const double new_samples = double(total_samples(result.width, result.height, result.spp - result.resumed_spp));
   nlohmann::ordered_json j;
   j["backend"] = result.backend;
   j["device"] = result.device;
@@ -66,12 +69,16 @@ void write_stats(const std::filesystem::path& file, const RenderArgs& args, cons
   j["width"] = result.width;
   j["height"] = result.height;
   j["spp"] = result.spp;
+  j["spp_target"] = result.spp_target;
+  j["resumed_spp"] = result.resumed_spp;
+  j["total_samples"] = total_samples(result.width, result.height, result.spp);
   j["seconds"] = result.seconds;
   j["load_seconds"] = result.load_seconds;
-  j["samples_per_second"] = result.seconds > 0 ? samples / result.seconds : 0.0;
+  j["samples_per_second"] = result.seconds > 0 ? new_samples / result.seconds : 0.0;
   j["peak_rss_mb"] = peak_rss_mb();
-  j["density_lookups_per_ray"] = samples > 0 ? result.density_lookups / samples : 0.0;
-  j["lookups_per_second"] = result.seconds > 0 ? result.density_lookups / result.seconds : 0.0;
+  const double lookups_per_ray = samples > 0 ? result.density_lookups / samples : 0.0;
+  j["density_lookups_per_ray"] = lookups_per_ray;
+  j["lookups_per_second"] = result.seconds > 0 ? lookups_per_ray * new_samples / result.seconds : 0.0;
   j["events_per_path"] = samples > 0 ? result.events / samples : 0.0;
   j["nonfinite_samples"] = result.nonfinite_samples;
   j["cancelled"] = result.cancelled;
@@ -80,7 +87,7 @@ void write_stats(const std::filesystem::path& file, const RenderArgs& args, cons
 
 // "OUT: WxH, N spp, S s, M Msamples/s, DEVICE (BACKEND)" on stdout.
 void print_summary(const std::filesystem::path& output, const RenderResult& result) {
-  const double samples = double(result.width) * result.height * result.spp;
+  const double samples = double(total_samples(result.width, result.height, result.spp - result.resumed_spp));
   char line[512];
   std::snprintf(line, sizeof line, "%s: %dx%d, %d spp, %s s, %.2f Msamples/s, %s (%s)", output.string().c_str(),
                 result.width, result.height, result.spp, format_seconds(result.seconds).c_str(),
@@ -124,6 +131,9 @@ std::vector<std::string> missing_inputs(const Scene& pattern_scene, const Scene&
 // `--frames N-N` would render it alone.
 int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesystem::path& output,
                  const std::atomic<bool>& cancel) {
+  if (args.checkpoint > 0.0 || args.resume)
+    throw input_error(args.checkpoint > 0.0 ? "--checkpoint" : "--resume", "",
+                      "is for single renders; a sequence resumes by frames with --skip-existing");
   const FrameRange range = parse_frame_range(args.frames);
   if (!has_frame_pattern(output.string()))
     throw input_error(output.string(), "",
@@ -235,22 +245,95 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   RenderSettings settings = settings_from(args, scene);
   settings.frame = 0;
 
+  // Checkpoints: OUT.checkpoint carries the accumulation and what it belongs to.
+  const std::filesystem::path checkpoint_file = checkpoint_path(output);
+  CheckpointIdentity identity{args.backend, args.scene,     scene_fingerprint(args.scene), settings.width,
+                              settings.height, settings.seed, settings.frame,                 ""};
+  std::optional<Checkpoint> resumed;
+  if (args.resume) {
+    std::error_code ec;
+    if (std::filesystem::exists(checkpoint_file, ec)) {
+      resumed = read_checkpoint(checkpoint_file);
+      check_resumable(checkpoint_file, *resumed, identity, settings.spp);
+    } else {
+      std::cerr << "pyrolume: warning: --resume: there is no " << checkpoint_file.string()
+                << "; rendering from 0 spp\n";
+    }
+  }
+
   BackendOptions options;
   options.device_index = args.device;
   auto backend = make_backend(args.backend, options);
+  identity.device = backend->device_name();
+
+  // A checkpoint that cannot be written must not end the render: warn once.
+  bool checkpoint_warned = false;
+  auto save_checkpoint = [&](const AccumulationState& state) {
+    try {
+      write_checkpoint(checkpoint_file, identity, settings.spp, state);
+      return true;
+    } catch (const InputError& e) {
+      if (!checkpoint_warned) std::cerr << "pyrolume: warning: checkpoint not saved: " << e.what() << "\n";
+      checkpoint_warned = true;
+      return false;
+    }
+  };
 
   ProgressBar bar("rendering");
   RenderControl control;
   control.progress = [&](int done, int target) { bar.update(done, target); };
   control.cancel = &cancel;
-  RenderResult result = backend->render(scene, settings, control);
+  if (resumed) control.resume = &resumed->state;
+  if (args.checkpoint > 0.0) {
+    control.checkpoint_seconds = args.checkpoint;
+    control.checkpoint = [&](const AccumulationState& state) { save_checkpoint(state); };
+  }
+
+  // The image and (short of the target) the checkpoint of what was rendered.
+  auto save = [&](const RenderResult& result, bool keep_checkpoint) {
+    Image image = image_from_render(result, args.variance);
+    write_image(output, image, scene.film.exposure);
+    if (!args.stats.empty()) write_stats(args.stats, args, output, result, std::nullopt);
+    bool checkpointed = false;
+    if (result.spp < settings.spp && keep_checkpoint && !result.state.data.empty())
+      checkpointed = save_checkpoint(result.state);
+    if (result.spp >= settings.spp) {
+      std::error_code ec;
+      std::filesystem::remove(checkpoint_file, ec);  // complete: nothing left to resume
+    }
+    return checkpointed;
+  };
+  auto resume_hint = [&](bool checkpointed) {
+    return checkpointed ? "; continue with --resume (" + checkpoint_file.string() + ")" : std::string();
+  };
+
+  RenderResult result;
+  try {
+    result = backend->render(scene, settings, control);
+  } catch (const RenderFailed& e) {
+    bar.finish();
+    const RenderResult& partial = e.partial;
+    if (partial.spp <= 0) {
+      std::cerr << "pyrolume: error: " << e.what() << " before any samples were saved; nothing is written\n";
+      return 1;
+    }
+    const bool checkpointed = save(partial, true);
+    std::cerr << "pyrolume: error: " << e.what() << "; the image so far (" << partial.spp << " of "
+              << settings.spp << " spp) is saved to " << output.string() << resume_hint(checkpointed) << "\n";
+    return 1;
+  }
   bar.finish();
 
-  Image image = image_from_render(result, args.variance);
-  write_image(output, image, scene.film.exposure);
-  if (!args.stats.empty()) write_stats(args.stats, args, output, result, std::nullopt);
+  const bool short_of_target = result.spp < settings.spp;
+  const bool checkpointed = save(result, result.cancelled || args.checkpoint > 0.0);
   print_warnings(result, "");
-  if (result.cancelled) std::cerr << "pyrolume: interrupted after " << result.spp << " spp; the image so far is saved\n";
+  if (result.cancelled)
+    std::cerr << "pyrolume: interrupted after " << result.spp << " of " << settings.spp
+              << " spp; the image so far is saved to " << output.string() << " (spp " << result.spp << ")"
+              << resume_hint(checkpointed) << "\n";
+  else if (short_of_target && checkpointed)
+    std::cerr << "pyrolume: stopped at " << result.spp << " of " << settings.spp << " spp (--time-limit)"
+              << resume_hint(checkpointed) << "\n";
   print_summary(output, result);
   return 0;
 }

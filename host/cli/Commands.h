@@ -18,6 +18,10 @@ struct RenderArgs {
   std::string frames;
   bool skip_existing = false;  // skip frames whose output exists (resume)
   bool strict = false;         // stop with exit 2 at the first missing input frame
+  // Checkpoints (render/Checkpoint.h): save OUT.checkpoint every `checkpoint`
+  // seconds (0 = only when interrupted); continue from it with `resume`.
+  double checkpoint = 0.0;
+  bool resume = false;
 };
 int run_render(const RenderArgs& args, const std::atomic<bool>& cancel);
 

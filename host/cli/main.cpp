@@ -6,19 +6,29 @@
 #include <cstdio>
 #include <iostream>
 
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 
 #include "cli/Commands.h"
 #include "preview/Preview.h"
+#include "render/Render.h"
 #include "render/vulkan/Devices.h"
 #include "util/Error.h"
 
 namespace {
 std::atomic<bool> g_cancel{false};
 std::atomic<int> g_signal{0};
+// The first SIGINT/SIGTERM asks the render to stop after its pass and save;
+// a second one (the pass itself is stuck, or the user will not wait) exits at
+// once with the same status, saving nothing more.
 extern "C" void on_signal(int sig) {
+  if (g_cancel.exchange(true)) {
+    static const char msg[] = "pyrolume: second signal: exiting without saving\n";
+    [[maybe_unused]] ssize_t n = write(2, msg, sizeof msg - 1);
+    _exit(128 + sig);
+  }
   g_signal = sig;
-  g_cancel = true;
 }
 }  // namespace
 
@@ -33,7 +43,8 @@ int main(int argc, char** argv) {
   render->add_option("scene", render_args.scene, "Scene JSON file")->required();
   render->add_option("-o,--output", render_args.output, "Output image (.exr linear float, .png sRGB)");
   render->add_option("--backend", render_args.backend, "vulkan (default) or cpu")->check(CLI::IsMember({"vulkan", "cpu"}));
-  render->add_option("--spp", render_args.spp, "Samples per pixel (overrides film.spp)")->check(CLI::PositiveNumber);
+  render->add_option("--spp", render_args.spp, "Samples per pixel (overrides film.spp), at most 2^24")
+      ->check(CLI::Range(1, pyrolume::kMaxSpp));
   render->add_option("--width", render_args.width, "Image width (overrides film.width)")->check(CLI::Range(1, 16384));
   render->add_option("--height", render_args.height, "Image height (overrides film.height)")->check(CLI::Range(1, 16384));
   render->add_option("--seed", render_args.seed, "Random seed (overrides film.seed)");
@@ -46,6 +57,12 @@ int main(int argc, char** argv) {
                      "Render frames A-B[:step] (or one frame A); -o and --stats are then patterns: out_####.exr");
   render->add_flag("--skip-existing", render_args.skip_existing, "With --frames: skip frames whose output exists");
   render->add_flag("--strict", render_args.strict, "With --frames: stop (exit 2) at the first missing input frame");
+  render->add_option("--checkpoint", render_args.checkpoint,
+                     "Every SEC seconds save the accumulation to OUT.checkpoint (e.g. out.exr.checkpoint; an "
+                     "interrupted render always saves it; a finished one removes it)")
+      ->check(CLI::PositiveNumber);
+  render->add_flag("--resume", render_args.resume,
+                   "Continue from OUT.checkpoint (same scene, backend, size, seed; refused otherwise) up to --spp");
 
   PreviewArgs pv;
   auto* preview = app.add_subcommand("preview", "Open a window that shows the render converging");

@@ -13,6 +13,10 @@ struct Image {
   // Empty, or interleaved RGB variance of the per-pixel MEAN (sample variance / spp),
   // same layout as rgb. Written to EXR as variance.R, variance.G, variance.B.
   std::vector<float> variance;
+  // Samples per pixel behind the means, and the number the render was asked
+  // for (less when it was interrupted). EXR attributes "spp" and "spp_target";
+  // 0 = unknown (not a render, or a format without metadata).
+  int spp = 0, spp_target = 0;
 
   size_t pixel_count() const { return size_t(width) * size_t(height); }
   size_t index(int x, int y, int c) const { return (size_t(y) * size_t(width) + size_t(x)) * 3 + size_t(c); }

@@ -4,6 +4,7 @@
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfIO.h>
+#include <ImfIntAttribute.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <stb_image.h>
@@ -82,6 +83,8 @@ class StdOStreamAdaptor : public Imf::OStream {
 void write_exr(std::ostream& os, const Image& img) {
   Imf::Header header(img.width, img.height);
   header.compression() = Imf::ZIP_COMPRESSION;  // lossless: compare must see the exact floats
+  if (img.spp > 0) header.insert("spp", Imf::IntAttribute(img.spp));
+  if (img.spp_target > 0) header.insert("spp_target", Imf::IntAttribute(img.spp_target));
   const char* names[3] = {"R", "G", "B"};
   const char* var_names[3] = {"variance.R", "variance.G", "variance.B"};
   for (const char* n : names) header.channels().insert(n, Imf::Channel(Imf::FLOAT));
@@ -142,6 +145,8 @@ Image read_exr(const fs::path& file) {
   in.readPixels(dw.min.y, dw.max.y);
   if (gray)
     for (size_t i = 0; i < img.rgb.size(); i += 3) img.rgb[i + 1] = img.rgb[i + 2] = img.rgb[i];
+  if (auto* a = in.header().findTypedAttribute<Imf::IntAttribute>("spp")) img.spp = a->value();
+  if (auto* a = in.header().findTypedAttribute<Imf::IntAttribute>("spp_target")) img.spp_target = a->value();
   return img;
 }
 

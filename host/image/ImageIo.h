@@ -19,6 +19,7 @@ unsigned char srgb_encode_u8(float linear, double exposure_stops = 0.0);
 
 // Chooses the format by extension (case-insensitive):
 //   .exr  float32, ZIP, channels R, G, B (+ variance.R/G/B when img has variance);
+//         int header attributes "spp" / "spp_target" when img.spp / spp_target > 0;
 //         linear, exposure NOT applied.
 //   .png  8-bit sRGB RGB, exposure applied, variance dropped.
 // Atomic (see AtomicFile.h): a failure leaves no file at `file`.
@@ -27,7 +28,8 @@ void write_image(const std::filesystem::path& file, const Image& img, double exp
 
 // Reads by content, not by extension:
 //   EXR: data window; R, G, B (missing ones read as 0); a Y-only file gives
-//        R = G = B = Y; A is ignored; variance.R/G/B loaded when all three exist.
+//        R = G = B = Y; A is ignored; variance.R/G/B loaded when all three exist;
+//        the "spp" / "spp_target" attributes when present.
 //        Half and uint channels are converted to float.
 //   PNG/JPG/BMP/TGA (via stb_image): sRGB decoded to linear (8- and 16-bit).
 //   Radiance .hdr (via stb_image): already linear.

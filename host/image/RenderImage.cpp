@@ -8,6 +8,8 @@ namespace pyrolume {
 
 Image image_from_render(const RenderResult& result, bool with_variance) {
   Image img = make_image(result.width, result.height, with_variance);
+  img.spp = result.spp;
+  img.spp_target = result.spp_target;
   const size_t count = img.rgb.size();
   if (result.sum.size() != count || (with_variance && result.sum_sq.size() != count))
     throw std::logic_error("image_from_render: sums do not match width*height*3");

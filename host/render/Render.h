@@ -4,12 +4,36 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace pyrolume {
 
 struct Scene;
+
+// Samples per pixel are at most 2^24 (16 777 216) everywhere (CLI, scene key,
+// both backends): per-pixel counts and the GPU's uint sample indices then stay
+// exact, float-accumulated per-pixel counters too, and image totals
+// (pixels × spp, up to 2^28 · 2^24) need 64-bit arithmetic: total_samples().
+inline constexpr int kMaxSpp = 1 << 24;
+
+// Camera samples of a width×height render at spp samples per pixel, in 64-bit
+// (int products overflow at 2^31: 4096² pixels × 128 spp already does).
+inline uint64_t total_samples(int width, int height, int spp) {
+  return uint64_t(uint32_t(width)) * uint64_t(uint32_t(height)) * uint64_t(uint32_t(spp));
+}
+
+// A backend's accumulation in its own layout and precision (the CPU's double
+// sums and integer counters, the GPU's Kahan-compensated float texels), opaque
+// to everyone else: a checkpoint stores it byte for byte and a resumed render
+// continues from it exactly where it stopped (render/Checkpoint.h).
+struct AccumulationState {
+  std::string backend;  // whose layout `data` is in: "cpu" | "vulkan"
+  int width = 0, height = 0;
+  int spp = 0;  // samples per pixel accumulated in `data`
+  std::vector<uint8_t> data;
+};
 
 struct RenderSettings {
   int width = 0, height = 0;  // already resolved (CLI overrides scene film)
@@ -28,11 +52,21 @@ using ProgressFn = std::function<void(int spp_done, int spp_target)>;
 struct RenderControl {
   ProgressFn progress;
   const std::atomic<bool>* cancel = nullptr;  // set by SIGINT/SIGTERM: stop after the current pass
+  // Continue from this state (same backend and image size, checked by the
+  // caller's checkpoint) instead of from 0 spp: the passes go on with sample
+  // index `resume->spp`, so the result equals an uninterrupted render's.
+  const AccumulationState* resume = nullptr;
+  // Called with the accumulation after the first pass that ends at least
+  // checkpoint_seconds after the previous call (or the start); 0 = never.
+  double checkpoint_seconds = 0.0;
+  std::function<void(const AccumulationState&)> checkpoint;
 };
 
 struct RenderResult {
   int width = 0, height = 0;
-  int spp = 0;  // samples per pixel actually taken
+  int spp = 0;  // samples per pixel actually taken (including resumed ones)
+  int spp_target = 0;   // samples per pixel asked for (RenderSettings::spp)
+  int resumed_spp = 0;  // of `spp`, those that came from RenderControl::resume
   // Interleaved RGB, width*height*3, row 0 = top.
   std::vector<double> sum, sum_sq;
   std::string backend, device;
@@ -44,6 +78,18 @@ struct RenderResult {
   uint64_t nonfinite_samples = 0;
   bool cancelled = false;
   std::vector<std::string> warnings;  // one line each (e.g. NaN voxels), printed by the CLI
+  // When the render ended short of spp_target (cancelled, time limit): the
+  // accumulation, so the caller can checkpoint it. Empty otherwise.
+  AccumulationState state;
+};
+
+// The device failed mid-render (VK_ERROR_DEVICE_LOST, out of device memory):
+// what() says which; `partial` holds the accumulation saved before the failure
+// (its spp may be 0), state included, so the caller can still write it.
+struct RenderFailed : std::runtime_error {
+  RenderFailed(const std::string& what, RenderResult partial)
+      : std::runtime_error(what), partial(std::move(partial)) {}
+  RenderResult partial;
 };
 
 }  // namespace pyrolume

@@ -4,6 +4,7 @@
 // value sits at the integer index point ijk (cell-centred data, the convention of
 // openvdb::tools::BoxSampler), so a texel centre is an integer index coordinate.
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -42,6 +43,15 @@ struct VolumeGrids {
   std::optional<DenseGrid> temperature;
   std::vector<std::string> warnings;  // one line each, for stderr
   size_t tree_mem_bytes = 0;          // memUsage() of the sparse trees read (freed before return)
+};
+
+// What the device that will sample a dense grid allows (0 = no limit): the
+// loader checks a grid's dimensions against it before allocating the dense
+// array, so an oversized grid is one clear error instead of gigabytes of
+// host memory followed by the same error.
+struct DenseLimits {
+  uint32_t max_dim = 0;     // maxImageDimension3D
+  uint64_t max_bytes = 0;   // maxMemoryAllocationSize (checked at 2 B per texel, R16F's size)
 };
 
 // Bytes the dense texture takes on the device: 2 per texel as R16F, 4 as R32F.

@@ -38,8 +38,8 @@ StoredGrid store(DenseGrid grid, TextureFormat wanted) {
 }
 }  // namespace
 
-StoredVolume load_stored_volume(const Medium& m) {
-  VolumeGrids grids = load_volume(m, needs_temperature_grid(m));
+StoredVolume load_stored_volume(const Medium& m, const DenseLimits& limits) {
+  VolumeGrids grids = load_volume(m, needs_temperature_grid(m), limits);
   TextureFormat wanted = m.texture_format == "r32f" ? TextureFormat::R32F : TextureFormat::R16F;
   StoredVolume v;
   v.density = store(std::move(grids.density), wanted);

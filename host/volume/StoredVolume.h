@@ -33,7 +33,7 @@ bool needs_temperature_grid(const Medium& m);
 // Loads the medium's grids (VdbLoader) and rounds them to their texture format:
 // the medium's `texture_format` ("r16f" default, "r32f"), promoted to R32F when a
 // stored value exceeds what R16F holds (|v| > 6e4).
-StoredVolume load_stored_volume(const Medium& m);
+StoredVolume load_stored_volume(const Medium& m, const DenseLimits& limits = {});
 
 // Rounds every value to the nearest half and fills half_bits.
 void round_to_format(StoredGrid& g);

@@ -132,15 +132,40 @@ int64_t floor_div(int64_t a, int64_t k) { return a >= 0 ? a / k : -((-a + k - 1)
 class DenseBuilder {
  public:
   DenseBuilder(DenseGrid& out, const glm::i64vec3& bmin, const glm::i64vec3& bmax, int k, bool clamp_negative,
-               const std::string& file, Role role)
+               const std::string& file, Role role, const DenseLimits& limits)
       : out_(out), k_(k), clamp_negative_(clamp_negative) {
-    glm::i64vec3 cmin, cmax;
-    for (int a = 0; a < 3; ++a) {
-      cmin[a] = floor_div(bmin[a], k);
-      cmax[a] = floor_div(bmax[a], k);
-    }
-    const glm::i64vec3 dims = cmax - cmin + int64_t(3);  // + one padding texel each side
+    auto dims_at = [&](int64_t kk, glm::i64vec3* lo) {
+      glm::i64vec3 cmin, cmax;
+      for (int a = 0; a < 3; ++a) {
+        cmin[a] = floor_div(bmin[a], kk);
+        cmax[a] = floor_div(bmax[a], kk);
+      }
+      if (lo) *lo = cmin;
+      return glm::i64vec3(cmax - cmin + int64_t(3));  // + one padding texel each side
+    };
+    glm::i64vec3 cmin;
+    const glm::i64vec3 dims = dims_at(k, &cmin);
     const uint64_t texels = uint64_t(dims.x) * uint64_t(dims.y) * uint64_t(dims.z);
+    // The device's limits, before anything is allocated; the suggestion is
+    // the smallest downsample that fits them.
+    auto fits = [&](const glm::i64vec3& d) {
+      const uint64_t n = uint64_t(d.x) * uint64_t(d.y) * uint64_t(d.z);
+      return (limits.max_dim == 0 || std::max({d.x, d.y, d.z}) <= int64_t(limits.max_dim)) &&
+             (limits.max_bytes == 0 || 2 * n <= limits.max_bytes);
+    };
+    if (!fits(dims)) {
+      int64_t suggest = k;
+      while (suggest <= 64 && !fits(dims_at(suggest, nullptr))) ++suggest;  // 64: the key's maximum
+      std::ostringstream s;
+      s << dims.x << "x" << dims.y << "x" << dims.z << " texels (with downsample " << k << ") exceed ";
+      if (limits.max_dim != 0 && std::max({dims.x, dims.y, dims.z}) > int64_t(limits.max_dim))
+        s << "this device's 3D texture limit of " << limits.max_dim << " per axis";
+      else
+        s << "what this device allows in one allocation (" << (limits.max_bytes >> 20) << " MiB at 2 B per texel)";
+      if (suggest <= 64) s << "; add \"downsample\": " << suggest << " to the medium";
+      else s << "; even \"downsample\": 64 does not fit: crop the grid";
+      throw input_error(file, role_key(role, out.name), s.str());
+    }
     // 2^32 texels is 16 GiB as float: past what any host or device here holds,
     // and texel offsets would overflow 32-bit shader arithmetic.
     if (dims.x > (1 << 30) || dims.y > (1 << 30) || dims.z > (1 << 30) || texels > (uint64_t(1) << 32)) {
@@ -222,7 +247,7 @@ void warn_empty(const std::string& file, Role role, const std::string& grid, std
 
 template <class GridT>
 DenseGrid dense_from_openvdb(const GridT& grid, const Medium& m, Role role, const std::string& file,
-                             std::vector<std::string>& warnings) {
+                             std::vector<std::string>& warnings, const DenseLimits& limits) {
   DenseGrid out;
   out.name = grid.getName();
   const glm::dmat4 grid_to_world = openvdb_index_to_world(grid.transform(), file, out.name);
@@ -236,7 +261,7 @@ DenseGrid dense_from_openvdb(const GridT& grid, const Medium& m, Role role, cons
   const auto& lo = bbox.min();
   const auto& hi = bbox.max();
   DenseBuilder b(out, {lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}, m.downsample, role == Role::Density, file,
-                 role);
+                 role, limits);
   // ValueOnCIter visits each active voxel once and each active tile once (as a box).
   for (auto it = grid.tree().cbeginValueOn(); it; ++it) {
     if (it.isVoxelValue()) {
@@ -277,7 +302,7 @@ std::vector<GridEntry> openvdb_grid_entries(openvdb::io::File& f) {
   return entries;
 }
 
-VolumeGrids load_openvdb(const Medium& m, bool need_temperature) {
+VolumeGrids load_openvdb(const Medium& m, bool need_temperature, const DenseLimits& limits) {
   ensure_openvdb_initialized();
   const std::string file = m.file.string();
   VolumeGrids out;
@@ -291,9 +316,9 @@ VolumeGrids load_openvdb(const Medium& m, bool need_temperature) {
       openvdb::GridBase::Ptr g = f.readGrid(e.name);  // only this grid's tree is read
       out.tree_mem_bytes += g->baseTree().memUsage();
       if (auto fg = openvdb::gridConstPtrCast<openvdb::FloatGrid>(g))
-        return dense_from_openvdb(*fg, m, role, file, out.warnings);
+        return dense_from_openvdb(*fg, m, role, file, out.warnings, limits);
       if (auto dg = openvdb::gridConstPtrCast<openvdb::DoubleGrid>(g))
-        return dense_from_openvdb(*dg, m, role, file, out.warnings);
+        return dense_from_openvdb(*dg, m, role, file, out.warnings, limits);
       throw input_error(file, role_key(role, e.name), "is a " + g->valueType() + " grid; expected float or double");
     };  // the sparse tree is freed here, before the next grid is read
     out.density = load(c.density, Role::Density);
@@ -309,7 +334,7 @@ VolumeGrids load_openvdb(const Medium& m, bool need_temperature) {
 
 template <class BuildT>
 DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Medium& m, Role role,
-                             const std::string& file, std::vector<std::string>& warnings) {
+                             const std::string& file, std::vector<std::string>& warnings, const DenseLimits& limits) {
   DenseGrid out;
   out.name = grid.gridName();
   const glm::dmat4 grid_to_world = nanovdb_index_to_world(grid);
@@ -321,7 +346,7 @@ DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Medium
     return out;
   }
   DenseBuilder b(out, {bbox.min()[0], bbox.min()[1], bbox.min()[2]}, {bbox.max()[0], bbox.max()[1], bbox.max()[2]},
-                 m.downsample, role == Role::Density, file, role);
+                 m.downsample, role == Role::Density, file, role, limits);
   auto acc = grid.getAccessor();
   for (int k = bbox.min()[2]; k <= bbox.max()[2]; ++k)
     for (int j = bbox.min()[1]; j <= bbox.max()[1]; ++j)
@@ -336,7 +361,7 @@ DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Medium
   return out;
 }
 
-VolumeGrids load_nanovdb(const Medium& m, bool need_temperature) {
+VolumeGrids load_nanovdb(const Medium& m, bool need_temperature, const DenseLimits& limits) {
   const std::string file = m.file.string();
   VolumeGrids out;
   std::vector<nanovdb::io::GridMetaData> metas;
@@ -359,12 +384,12 @@ VolumeGrids load_nanovdb(const Medium& m, bool need_temperature) {
     }
     if (!h) throw input_error(file, role_key(role, e.name), "cannot read NanoVDB grid");
     out.tree_mem_bytes += h.size();
-    if (auto* g = h.grid<float>()) return dense_from_nanovdb(*g, m, role, file, out.warnings);
-    if (auto* g = h.grid<double>()) return dense_from_nanovdb(*g, m, role, file, out.warnings);
-    if (auto* g = h.grid<nanovdb::Fp16>()) return dense_from_nanovdb(*g, m, role, file, out.warnings);
-    if (auto* g = h.grid<nanovdb::Fp8>()) return dense_from_nanovdb(*g, m, role, file, out.warnings);
-    if (auto* g = h.grid<nanovdb::Fp4>()) return dense_from_nanovdb(*g, m, role, file, out.warnings);
-    if (auto* g = h.grid<nanovdb::FpN>()) return dense_from_nanovdb(*g, m, role, file, out.warnings);
+    if (auto* g = h.grid<float>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
+    if (auto* g = h.grid<double>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
+    if (auto* g = h.grid<nanovdb::Fp16>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
+    if (auto* g = h.grid<nanovdb::Fp8>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
+    if (auto* g = h.grid<nanovdb::Fp4>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
+    if (auto* g = h.grid<nanovdb::FpN>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
     throw input_error(file, role_key(role, e.name), "NanoVDB grid type " + e.type + " is not supported");
   };
   out.density = load(c.density, Role::Density);
@@ -374,11 +399,11 @@ VolumeGrids load_nanovdb(const Medium& m, bool need_temperature) {
 
 }  // namespace
 
-VolumeGrids load_volume(const Medium& m, bool need_temperature) {
+VolumeGrids load_volume(const Medium& m, bool need_temperature, const DenseLimits& limits) {
   const std::string file = m.file.string();
   if (m.downsample < 1) throw input_error(file, "downsample", "must be >= 1");
-  return detect_volume_format(m.file) == VolumeFormat::NanoVdb ? load_nanovdb(m, need_temperature)
-                                                               : load_openvdb(m, need_temperature);
+  return detect_volume_format(m.file) == VolumeFormat::NanoVdb ? load_nanovdb(m, need_temperature, limits)
+                                                               : load_openvdb(m, need_temperature, limits);
 }
 
 }  // namespace pyrolume

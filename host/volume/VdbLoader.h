@@ -18,8 +18,9 @@ inline constexpr const char* kDefaultDensityGrid = "density";
 // Throws InputError (file, grid, reason) for a missing/unreadable file, a
 // missing grid (the message lists the grids present) or a non-scalar grid.
 // Recoverable oddities (empty grid, NaN/Inf, negative density) come back as
-// VolumeGrids::warnings.
-VolumeGrids load_volume(const Medium& m, bool need_temperature);
+// VolumeGrids::warnings. A grid past `limits` throws InputError (file, grid,
+// the limit, the "downsample" that would fit) before its dense array exists.
+VolumeGrids load_volume(const Medium& m, bool need_temperature, const DenseLimits& limits = {});
 
 // The medium's `transform` as a matrix: T * Rz * Ry * Rx * S, i.e. scale first,
 // then rotate about X, Y, Z (degrees, right-handed), then translate.

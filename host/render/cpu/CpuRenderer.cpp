@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -18,6 +19,7 @@
 #include "light/EmissionCdf.h"
 #include "light/EnvironmentMap.h"
 #include "light/LightSelection.h"
+#include "render/Limits.h"
 #include "render/cpu/Media.h"
 #include "render/cpu/Rng.h"
 #include "render/cpu/Sampling.h"
@@ -355,6 +357,42 @@ glm::dvec3 camera_ray_direction(const Camera& camera, int width, int height, dou
 
 }  // namespace cpu
 
+namespace {
+
+// The CPU's AccumulationState layout (host byte order): Σ L and Σ L² as
+// doubles (width·height·3 each), then the counters collisions, density
+// lookups and non-finite samples as uint64.
+struct CpuCounters {
+  uint64_t collisions = 0, density_lookups = 0, nonfinite = 0;
+};
+
+AccumulationState save_state(const RenderResult& res, const CpuCounters& c) {
+  AccumulationState st;
+  st.backend = "cpu";
+  st.width = res.width;
+  st.height = res.height;
+  st.spp = res.spp;
+  const size_t n = res.sum.size() * sizeof(double);
+  st.data.resize(2 * n + sizeof c);
+  std::memcpy(st.data.data(), res.sum.data(), n);
+  std::memcpy(st.data.data() + n, res.sum_sq.data(), n);
+  std::memcpy(st.data.data() + 2 * n, &c, sizeof c);
+  return st;
+}
+
+void load_state(const AccumulationState& st, RenderResult& res, CpuCounters& c) {
+  const size_t n = res.sum.size() * sizeof(double);
+  if (st.backend != "cpu" || st.width != res.width || st.height != res.height || st.data.size() != 2 * n + sizeof c)
+    throw std::invalid_argument("cpu reference: the resumed accumulation is not a " + std::to_string(res.width) + "x" +
+                                std::to_string(res.height) + " cpu one");
+  std::memcpy(res.sum.data(), st.data.data(), n);
+  std::memcpy(res.sum_sq.data(), st.data.data() + n, n);
+  std::memcpy(&c, st.data.data() + 2 * n, sizeof c);
+  res.spp = res.resumed_spp = st.spp;
+}
+
+}  // namespace
+
 CpuRenderer::CpuRenderer(int threads) {
   if (threads <= 0) threads = int(std::thread::hardware_concurrency());
   threads_ = std::max(1, threads);
@@ -367,13 +405,16 @@ std::string CpuRenderer::device_name() const {
 RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& settings, const RenderControl& control) {
   using namespace cpu;
   auto load_start = Clock::now();
-  if (settings.width <= 0 || settings.height <= 0 || settings.spp <= 0)
-    throw std::invalid_argument("cpu reference: width, height and spp must be positive");
+  if (settings.width <= 0 || settings.height <= 0 || settings.spp <= 0 || settings.spp > kMaxSpp)
+    throw std::invalid_argument("cpu reference: width, height and spp must be positive (spp at most 2^24)");
   {
     glm::dvec3 f = scene.camera.look_at - scene.camera.position;
     if (!(glm::length(glm::cross(f, scene.camera.up)) > 0.0))
       throw std::invalid_argument("cpu reference: camera up is parallel to the view direction");
   }
+  // Σ L and Σ L² in double, and one copy of them for a checkpoint.
+  check_accumulation_size(scene.file.string(), settings.width, settings.height, 2 * 6 * sizeof(double),
+                          physical_memory_bytes(), "this machine's memory");
   const std::string& estimator = scene.integrator.emission_estimator;
   if (estimator != "absorption" && estimator != "collision")
     throw std::invalid_argument("cpu reference: unknown emission_estimator \"" + estimator + "\"");
@@ -407,8 +448,13 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   res.height = H;
   res.backend = name();
   res.device = device_name();
+  res.spp_target = settings.spp;
   res.sum.assign(size_t(W) * H * 3, 0.0);
   res.sum_sq.assign(size_t(W) * H * 3, 0.0);
+  // Resumed: the sums continue in sample order, so the result is bit-identical
+  // to an uninterrupted render's (per-pixel sums never depend on passes).
+  CpuCounters totals;
+  if (control.resume) load_state(*control.resume, res, totals);
 
   constexpr int kTile = 16;
   const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
@@ -417,8 +463,9 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   auto render_start = Clock::now();
   res.load_seconds = std::chrono::duration<double>(render_start - load_start).count();
 
-  uint64_t total_collisions = 0, total_nonfinite = 0, total_lookups = 0, total_violations = 0;
-  int spp_done = 0;
+  uint64_t total_violations = 0;
+  auto last_checkpoint = render_start;
+  int spp_done = res.spp;
   while (spp_done < settings.spp) {
     const int s_begin = spp_done, s_end = std::min(settings.spp, spp_done + kPassSpp);
     std::atomic<int> next_tile{0};
@@ -456,9 +503,9 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
     worker(0);
     for (auto& th : pool) th.join();
     for (const auto& cnt : counters) {
-      total_collisions += cnt.collisions;
-      total_nonfinite += cnt.nonfinite;
-      total_lookups += cnt.density_lookups;
+      totals.collisions += cnt.collisions;
+      totals.nonfinite += cnt.nonfinite;
+      totals.density_lookups += cnt.density_lookups;
       total_violations += cnt.majorant_violations;
     }
 
@@ -466,6 +513,11 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
     res.spp = spp_done;
     if (control.progress) control.progress(spp_done, settings.spp);
     if (spp_done >= settings.spp) break;
+    if (control.checkpoint && control.checkpoint_seconds > 0.0 &&
+        std::chrono::duration<double>(Clock::now() - last_checkpoint).count() >= control.checkpoint_seconds) {
+      control.checkpoint(save_state(res, totals));
+      last_checkpoint = Clock::now();
+    }
     if (control.cancel && control.cancel->load()) {
       res.cancelled = true;
       break;
@@ -483,13 +535,14 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   //    present at each tentative collision (real or null); homogeneous media
   //    read no texture. (Shadow rays, when MIS lands, add their ratio-tracking
   //    lookups the same way.) Temperature lookups are not counted.
-  res.events = double(total_collisions) / 3.0;
-  res.density_lookups = double(total_lookups) / 3.0;
+  res.events = double(totals.collisions) / 3.0;
+  res.density_lookups = double(totals.density_lookups) / 3.0;
   majorant_violations_ = total_violations;
   if (total_violations)
     std::fprintf(stderr, "warning: cpu reference: %llu tentative collisions had sigma_t above the majorant\n",
                  (unsigned long long)total_violations);
-  res.nonfinite_samples = total_nonfinite;
+  res.nonfinite_samples = totals.nonfinite;
+  if (res.spp < settings.spp) res.state = save_state(res, totals);
   return res;
 }
 

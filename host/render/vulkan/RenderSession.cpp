@@ -1,10 +1,13 @@
 #include "render/vulkan/RenderSession.h"
 
 #include <algorithm>
+#include <cstdlib>
+#include <cstring>
 
 #include "geometry/SceneSurfaces.h"
 #include "light/EmissionCdf.h"
 #include "light/EnvironmentMap.h"
+#include "render/Limits.h"
 #include "render/vulkan/Spirv.h"
 #include "util/Error.h"
 
@@ -29,11 +32,23 @@ std::string mib(double bytes) { return std::to_string(int(bytes / (1024.0 * 1024
 
 RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderSettings& settings)
     : ctx_(ctx), settings_(settings) {
-  // Load only what the scene uses: the grids of its vdb media.
+  // The accumulation buffer is one storage buffer: check it fits the device
+  // (lavapipe allows 128 MiB, about 1448² pixels) and its host readback
+  // (texels plus double sums) fits the machine, before loading anything.
+  const VkDeviceSize range = ctx.properties().limits.maxStorageBufferRange;
+  const bool range_binds = range <= ctx.max_allocation_size();
+  check_accumulation_size(scene.file.string(), settings.width, settings.height, sizeof(gpu::AccumTexel),
+                          range_binds ? range : ctx.max_allocation_size(),
+                          range_binds ? "this device's maxStorageBufferRange" : "this device's maxMemoryAllocationSize");
+  check_accumulation_size(scene.file.string(), settings.width, settings.height,
+                          sizeof(gpu::AccumTexel) + 6 * sizeof(double), physical_memory_bytes(),
+                          "this machine's memory");
+  // Load only what the scene uses: the grids of its vdb media, each checked
+  // against the device's texture limits before its dense array is allocated.
   volumes_.resize(scene.media.size());
   for (size_t i = 0; i < scene.media.size(); ++i) {
     if (scene.media[i].type != Medium::Type::Vdb) continue;
-    volumes_[i] = load_stored_volume(scene.media[i]);
+    volumes_[i] = load_stored_volume(scene.media[i], dense_limits());
     for (const auto& w : volumes_[i]->warnings) warnings_.push_back(w);
   }
   gpu_scene_ = build_gpu_scene(scene, volumes_);
@@ -107,6 +122,10 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   });
 }
 
+DenseLimits RenderSession::dense_limits() const {
+  return DenseLimits{ctx_.properties().limits.maxImageDimension3D, uint64_t(ctx_.max_allocation_size())};
+}
+
 // The shader variant: code for grids, scattering and emission only when used.
 std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const Scene& scene, const GpuScene& g,
                                                                         const RenderSettings& settings,
@@ -153,7 +172,7 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
   // session as it was.
   std::vector<std::optional<StoredVolume>> volumes(scene.media.size());
   for (size_t i = 0; i < scene.media.size(); ++i)
-    if (scene.media[i].type == Medium::Type::Vdb) volumes[i] = load_stored_volume(scene.media[i]);
+    if (scene.media[i].type == Medium::Type::Vdb) volumes[i] = load_stored_volume(scene.media[i], dense_limits());
   // The blackbody LUTs depend only on the emission's mode, observer and
   // adaptation: bake them once per sequence and reuse them frame after frame.
   GpuScene gpu_scene = build_gpu_scene(scene, volumes, /*with_luts=*/false);
@@ -393,23 +412,84 @@ void RenderSession::record_pass(VkCommandBuffer cmd, int spp) {
   spp_done_ += spp;
 }
 
+namespace {
+// Test hook (no CLI flag): PYROLUME_TEST_FAIL_PASS=VK_ERROR_DEVICE_LOST:N (or
+// VK_ERROR_OUT_OF_DEVICE_MEMORY:N; any other name means VK_ERROR_UNKNOWN)
+// makes the N-th render pass of this process (1-based) fail as if
+// vkQueueSubmit had returned that result. A device cannot be lost on
+// lavapipe; this is how tests reach the recovery path.
+VkResult injected_failure() {
+  static const std::pair<VkResult, long> fault = [] {
+    const char* v = std::getenv("PYROLUME_TEST_FAIL_PASS");
+    if (!v) return std::pair<VkResult, long>{VK_SUCCESS, 0};
+    const std::string s = v;
+    const size_t colon = s.find(':');
+    const std::string name = s.substr(0, colon);
+    const long n = colon == std::string::npos ? 1 : std::atol(s.c_str() + colon + 1);
+    VkResult r = name == "VK_ERROR_DEVICE_LOST"            ? VK_ERROR_DEVICE_LOST
+                 : name == "VK_ERROR_OUT_OF_DEVICE_MEMORY" ? VK_ERROR_OUT_OF_DEVICE_MEMORY
+                                                            : VK_ERROR_UNKNOWN;
+    return std::pair<VkResult, long>{r, n};
+  }();
+  static long passes = 0;
+  if (fault.first == VK_SUCCESS) return VK_SUCCESS;
+  return ++passes == fault.second ? fault.first : VK_SUCCESS;
+}
+}  // namespace
+
 void RenderSession::run_pass(int spp) {
-  ctx_.submit_and_wait([&](VkCommandBuffer cmd) { record_pass(cmd, spp); });
+  const int spp_before = spp_done_;
+  const bool clear_before = needs_clear_;
+  try {
+    if (VkResult r = injected_failure(); r != VK_SUCCESS)
+      vk::throw_vk_error("vkQueueSubmit (PYROLUME_TEST_FAIL_PASS)", r, __FILE__, __LINE__);
+    ctx_.submit_and_wait([&](VkCommandBuffer cmd) { record_pass(cmd, spp); });
+  } catch (const vk::VulkanError&) {
+    spp_done_ = spp_before;
+    needs_clear_ = clear_before;
+    throw;
+  }
 }
 
-void RenderSession::read(RenderResult& result) {
+AccumulationState RenderSession::save_state() {
   const size_t pixels = size_t(settings_.width) * size_t(settings_.height);
-  std::vector<gpu::AccumTexel> texels(pixels);
-  if (spp_done_ > 0 && !needs_clear_) accum_.download(ctx_, texels.data(), pixels * sizeof(gpu::AccumTexel));
-  result.width = settings_.width;
-  result.height = settings_.height;
-  result.spp = spp_done_;
+  AccumulationState st;
+  st.backend = "vulkan";
+  st.width = settings_.width;
+  st.height = settings_.height;
+  st.spp = spp_done_;
+  st.data.assign(pixels * sizeof(gpu::AccumTexel), 0);
+  if (spp_done_ > 0 && !needs_clear_) accum_.download(ctx_, st.data.data(), st.data.size());
+  return st;
+}
+
+void RenderSession::load_state(const AccumulationState& st) {
+  const size_t bytes = size_t(settings_.width) * size_t(settings_.height) * sizeof(gpu::AccumTexel);
+  if (st.backend != "vulkan" || st.width != settings_.width || st.height != settings_.height ||
+      st.data.size() != bytes || st.spp < 0)
+    throw std::invalid_argument("vulkan: the resumed accumulation is not a " + std::to_string(settings_.width) + "x" +
+                                std::to_string(settings_.height) + " vulkan one");
+  accum_.upload(ctx_, st.data.data(), bytes);
+  spp_done_ = st.spp;
+  needs_clear_ = st.spp == 0;
+}
+
+void RenderSession::read(RenderResult& result) { result_from_state(save_state(), result); }
+
+void RenderSession::result_from_state(const AccumulationState& state, RenderResult& result) {
+  const size_t pixels = size_t(state.width) * size_t(state.height);
+  if (state.data.size() != pixels * sizeof(gpu::AccumTexel))
+    throw std::logic_error("RenderSession::result_from_state: state size does not match its image");
+  result.width = state.width;
+  result.height = state.height;
+  result.spp = state.spp;
   result.sum.assign(pixels * 3, 0.0);
   result.sum_sq.assign(pixels * 3, 0.0);
   result.events = result.density_lookups = 0.0;
   result.nonfinite_samples = 0;
   for (size_t i = 0; i < pixels; ++i) {
-    const gpu::AccumTexel& t = texels[i];
+    gpu::AccumTexel t;
+    std::memcpy(&t, state.data.data() + i * sizeof t, sizeof t);
     for (int c = 0; c < 3; ++c) {
       // Kahan: the running sum minus its pending compensation.
       result.sum[i * 3 + c] = double(t.sum[c]) - double(t.sum_c[c]);

@@ -43,7 +43,8 @@ class RenderSession {
   // Record one pass of `spp` samples per pixel into cmd (the caller submits).
   // Passes must be submitted in the order they were recorded.
   void record_pass(VkCommandBuffer cmd, int spp);
-  // Record, submit and wait.
+  // Record, submit and wait. If the submission fails (VulkanError), spp_done()
+  // stays as it was: the accumulation holds the passes before this one.
   void run_pass(int spp);
 
   int spp_done() const { return spp_done_; }
@@ -53,10 +54,18 @@ class RenderSession {
   const vk::Buffer& accumulation() const { return accum_; }
   // Read the sums and counters back into result (sum, sum_sq, spp, counters).
   void read(RenderResult& result);
+  // The accumulation as it is on the device (raw AccumTexels, backend "vulkan"),
+  // for checkpoints; and back: the next pass continues at state.spp with the
+  // same Kahan sums and compensations, so it equals an uninterrupted render.
+  AccumulationState save_state();
+  void load_state(const AccumulationState& state);
+  // A saved state's sums and counters, as read() would give them.
+  static void result_from_state(const AccumulationState& state, RenderResult& result);
   // Warnings from loading the grids (one line each).
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
+  DenseLimits dense_limits() const;  // this device's 3D texture limits, for the grid loader
   void upload_constants(const Scene& scene);
   void create_textures(const Scene& scene);
   void create_surfaces(const Scene& scene);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 #include "render/vulkan/Context.h"
 #include "render/vulkan/RenderSession.h"
@@ -61,19 +62,77 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
   result.load_seconds = since(load_start) + context_seconds_;
   context_seconds_ = 0.0;
 
-  // Progressive passes of a fixed size (see spp_per_pass).
+  if (settings.spp <= 0 || settings.spp > kMaxSpp)
+    throw std::invalid_argument("vulkan: spp must be in 1..2^24, not " + std::to_string(settings.spp));
+  result.spp_target = settings.spp;
+  if (control.resume) {
+    session.load_state(*control.resume);
+    result.resumed_spp = control.resume->spp;
+  }
+
+  // Progressive passes of a fixed size (see spp_per_pass). A host copy of the
+  // accumulation (`saved`) is refreshed after the first pass, at every
+  // checkpoint and otherwise at most every max(1 s, 20 readbacks' time), so
+  // the readbacks cost under 5 %: it is what a lost device still lets us save.
   auto render_start = Clock::now();
   const int per_pass = spp_per_pass(settings.width, settings.height, settings.spp);
-  while (session.spp_done() < settings.spp) {
-    session.run_pass(std::min(per_pass, settings.spp - session.spp_done()));
-    if (control.progress) control.progress(session.spp_done(), settings.spp);
-    if (control.cancel && control.cancel->load()) {
-      result.cancelled = true;
-      break;
+  AccumulationState saved;
+  if (control.resume) saved = *control.resume;  // a failure in the first pass still has the resumed samples
+  double save_interval = 0.0;
+  auto last_save = render_start, last_checkpoint = render_start;
+  try {
+    while (session.spp_done() < settings.spp) {
+      session.run_pass(std::min(per_pass, settings.spp - session.spp_done()));
+      if (control.progress) control.progress(session.spp_done(), settings.spp);
+      if (session.spp_done() >= settings.spp) break;
+      const bool checkpoint_due = control.checkpoint && control.checkpoint_seconds > 0.0 &&
+                                  since(last_checkpoint) >= control.checkpoint_seconds;
+      if (checkpoint_due || since(last_save) >= save_interval) {
+        const auto t0 = Clock::now();
+        saved = session.save_state();
+        save_interval = std::max(1.0, 20.0 * since(t0));
+        last_save = Clock::now();
+        if (checkpoint_due) {
+          control.checkpoint(saved);
+          last_checkpoint = Clock::now();
+        }
+      }
+      if (control.cancel && control.cancel->load()) {
+        result.cancelled = true;
+        break;
+      }
+      if (settings.time_limit > 0 && since(render_start) >= settings.time_limit) break;
     }
-    if (settings.time_limit > 0 && since(render_start) >= settings.time_limit) break;
+    saved = {};  // (memory: the final readback replaces it)
+    AccumulationState final_state = session.save_state();
+    RenderSession::result_from_state(final_state, result);
+    if (result.spp < settings.spp) result.state = std::move(final_state);
+  } catch (const vk::VulkanError& e) {
+    const bool out_of_memory = e.result == VK_ERROR_OUT_OF_DEVICE_MEMORY || e.result == VK_ERROR_OUT_OF_HOST_MEMORY;
+    // Out of memory leaves the device usable: read what the passes before the
+    // failed one accumulated. A lost device has nothing left to read, and
+    // after any other failure the device is not trusted: the host copy it is.
+    if (out_of_memory) {
+      try {
+        saved = session.save_state();
+      } catch (const vk::VulkanError&) {
+      }
+    }
+    if (saved.data.empty()) {  // failed before anything was saved: 0 spp
+      saved = AccumulationState{"vulkan", settings.width, settings.height, 0, {}};
+      saved.data.assign(size_t(settings.width) * size_t(settings.height) * sizeof(gpu::AccumTexel), 0);
+    }
+    RenderResult partial = result;
+    RenderSession::result_from_state(saved, partial);
+    partial.seconds = since(render_start);
+    partial.state = saved;
+    const std::string what =
+        e.result == VK_ERROR_DEVICE_LOST ? "the device was lost (VK_ERROR_DEVICE_LOST: a driver reset, hang or removal)"
+        : e.result == VK_ERROR_OUT_OF_DEVICE_MEMORY ? "the device ran out of memory (VK_ERROR_OUT_OF_DEVICE_MEMORY)"
+        : e.result == VK_ERROR_OUT_OF_HOST_MEMORY   ? "the host ran out of memory (VK_ERROR_OUT_OF_HOST_MEMORY)"
+                                                    : std::string("the device failed: ") + e.what();
+    throw RenderFailed(what, std::move(partial));
   }
-  session.read(result);
   result.seconds = since(render_start);
   return result;
 }

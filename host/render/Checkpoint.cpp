@@ -1,0 +1,163 @@
+#include "render/Checkpoint.h"
+
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+#include <fstream>
+#include <iterator>
+
+#include <nlohmann/json.hpp>
+
+#include "image/AtomicFile.h"
+#include "shared/gpu_types.h"
+#include "util/Error.h"
+
+namespace pyrolume {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kMagic = "pyrolume-checkpoint 1";
+
+uint64_t fnv1a(const void* data, size_t n, uint64_t h = 0xcbf29ce484222325ull) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (size_t i = 0; i < n; ++i) {
+    h ^= p[i];
+    h *= 0x100000001b3ull;
+  }
+  return h;
+}
+
+// The payload size each backend's layout has (render/cpu/CpuRenderer.cpp
+// save_state, render/vulkan/RenderSession::save_state): a checkpoint whose
+// size disagrees is refused here, with its file name, not deep in a backend.
+uint64_t payload_bytes(const std::string& backend, int width, int height) {
+  const uint64_t pixels = uint64_t(width) * uint64_t(height);
+  if (backend == "cpu") return pixels * 6 * sizeof(double) + 3 * sizeof(uint64_t);
+  if (backend == "vulkan") return pixels * sizeof(gpu::AccumTexel);
+  return 0;
+}
+
+}  // namespace
+
+fs::path checkpoint_path(const fs::path& output) {
+  fs::path p = output;
+  p += ".checkpoint";
+  return p;
+}
+
+uint64_t scene_fingerprint(const fs::path& scene_file) {
+  std::ifstream in(scene_file, std::ios::binary);
+  if (!in) throw input_error(scene_file.string(), "", "cannot open");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string canonical = text;
+  try {
+    canonical = nlohmann::json::parse(text, nullptr, true, /*ignore_comments=*/true).dump();
+  } catch (const nlohmann::json::exception&) {
+  }
+  return fnv1a(canonical.data(), canonical.size());
+}
+
+void write_checkpoint(const fs::path& file, const CheckpointIdentity& id, int spp_target,
+                      const AccumulationState& state) {
+  nlohmann::ordered_json j;
+  j["backend"] = id.backend;
+  j["device"] = id.device;
+  j["scene"] = id.scene;
+  j["scene_hash"] = id.scene_hash;
+  j["width"] = id.width;
+  j["height"] = id.height;
+  j["seed"] = id.seed;
+  j["frame"] = id.frame;
+  j["spp"] = state.spp;
+  j["spp_target"] = spp_target;
+  j["payload_bytes"] = state.data.size();
+  const std::string header = std::string(kMagic) + "\n" + j.dump() + "\n";
+  if (state.backend != id.backend || state.width != id.width || state.height != id.height)
+    throw std::logic_error("write_checkpoint: the state does not match the identity");
+  const uint64_t sum = fnv1a(state.data.data(), state.data.size());
+  unsigned char trailer[8];
+  for (int i = 0; i < 8; ++i) trailer[i] = static_cast<unsigned char>(sum >> (8 * i));
+  write_file_atomic(file, [&](std::ostream& os) {
+    os.write(header.data(), std::streamsize(header.size()));
+    os.write(reinterpret_cast<const char*>(state.data.data()), std::streamsize(state.data.size()));
+    os.write(reinterpret_cast<const char*>(trailer), 8);
+  });
+}
+
+Checkpoint read_checkpoint(const fs::path& file) {
+  const std::string name = file.string();
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw input_error(name, "", std::string("cannot open checkpoint: ") + std::strerror(errno));
+  std::string magic, header;
+  if (!std::getline(in, magic) || magic != kMagic) throw input_error(name, "", "not a pyrolume checkpoint (version 1)");
+  if (!std::getline(in, header) || in.eof()) throw input_error(name, "", "truncated checkpoint (no complete header)");
+  Checkpoint c;
+  uint64_t bytes = 0;
+  try {
+    const auto j = nlohmann::json::parse(header);
+    CheckpointIdentity& id = c.identity;
+    id.backend = j.at("backend").get<std::string>();
+    id.device = j.at("device").get<std::string>();
+    id.scene = j.at("scene").get<std::string>();
+    id.scene_hash = j.at("scene_hash").get<uint64_t>();
+    id.width = j.at("width").get<int>();
+    id.height = j.at("height").get<int>();
+    id.seed = j.at("seed").get<uint32_t>();
+    id.frame = j.at("frame").get<uint32_t>();
+    c.state.spp = j.at("spp").get<int>();
+    c.spp_target = j.at("spp_target").get<int>();
+    bytes = j.at("payload_bytes").get<uint64_t>();
+  } catch (const nlohmann::json::exception& e) {
+    throw input_error(name, "", std::string("corrupt checkpoint header: ") + e.what());
+  }
+  const CheckpointIdentity& id = c.identity;
+  if (id.width < 1 || id.height < 1 || id.width > 16384 || id.height > 16384 || c.state.spp < 0 ||
+      c.state.spp > kMaxSpp)
+    throw input_error(name, "", "corrupt checkpoint header: impossible width, height or spp");
+  if (payload_bytes(id.backend, id.width, id.height) == 0)
+    throw input_error(name, "backend", "unknown backend \"" + id.backend + "\"");
+  if (bytes != payload_bytes(id.backend, id.width, id.height))
+    throw input_error(name, "", "corrupt checkpoint: " + std::to_string(bytes) + " payload bytes for a " +
+                                    std::to_string(id.width) + "x" + std::to_string(id.height) + " " + id.backend +
+                                    " render");
+  c.state.backend = id.backend;
+  c.state.width = id.width;
+  c.state.height = id.height;
+  c.state.data.resize(bytes);
+  unsigned char trailer[8];
+  in.read(reinterpret_cast<char*>(c.state.data.data()), std::streamsize(bytes));
+  in.read(reinterpret_cast<char*>(trailer), 8);
+  if (!in) throw input_error(name, "", "truncated checkpoint");
+  if (in.peek() != std::char_traits<char>::eof()) throw input_error(name, "", "corrupt checkpoint: trailing bytes");
+  uint64_t sum = 0;
+  for (int i = 0; i < 8; ++i) sum |= uint64_t(trailer[i]) << (8 * i);
+  if (sum != fnv1a(c.state.data.data(), c.state.data.size()))
+    throw input_error(name, "", "corrupt checkpoint: checksum mismatch");
+  return c;
+}
+
+void check_resumable(const fs::path& file, const Checkpoint& saved, const CheckpointIdentity& now, int spp_target) {
+  const std::string name = file.string();
+  const CheckpointIdentity& was = saved.identity;
+  auto refuse = [&](const std::string& key, const std::string& then, const std::string& today) {
+    throw input_error(name, key,
+                      "the checkpoint was made with " + key + " " + then + ", this render has " + today +
+                          " (delete the checkpoint or render without --resume)");
+  };
+  if (was.scene_hash != now.scene_hash)
+    throw input_error(name, "scene",
+                      "the checkpoint was made from a different scene (" + was.scene + " as it was then); " + now.scene +
+                          " has changed or is another file (delete the checkpoint or render without --resume)");
+  if (was.backend != now.backend) refuse("backend", was.backend, now.backend);
+  if (was.width != now.width) refuse("width", std::to_string(was.width), std::to_string(now.width));
+  if (was.height != now.height) refuse("height", std::to_string(was.height), std::to_string(now.height));
+  if (was.seed != now.seed) refuse("seed", std::to_string(was.seed), std::to_string(now.seed));
+  if (was.frame != now.frame) refuse("frame", std::to_string(was.frame), std::to_string(now.frame));
+  if (saved.state.spp > spp_target)
+    throw input_error(name, "spp",
+                      "the checkpoint already has " + std::to_string(saved.state.spp) + " spp, more than the " +
+                          std::to_string(spp_target) + " asked for");
+}
+
+}  // namespace pyrolume

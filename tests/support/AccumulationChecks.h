@@ -1,0 +1,197 @@
+#pragma once
+// Backend-independent accumulation checks (issue 10), run by
+// tests/unit/cpu_accumulation_test.cpp and tests/vulkan/vulkan_accumulation_test.cpp
+// on their backend.
+#include <atomic>
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "render/Backend.h"
+#include "support/AccumulationScenes.h"
+
+namespace pyrolume::test {
+
+// A constant-radiance 4×4 render at 65 536 spp: the mean and Σ L²/n of every
+// pixel are exact to rel_tol (naive float accumulation over 1024 passes is
+// off by ~1e-5; Kahan sums and double sums are not).
+inline void expect_constant_radiance_exact(Backend& backend, const Scene& s, glm::dvec3 L, double rel_tol) {
+  RenderResult r = backend.render(s, settings_for(s), {});
+  ASSERT_EQ(r.spp, 65536);
+  EXPECT_EQ(r.nonfinite_samples, 0u);
+  const double n = r.spp;
+  double worst = 0.0, worst_sq = 0.0;
+  for (size_t p = 0; p < size_t(r.width) * r.height; ++p)
+    for (int c = 0; c < 3; ++c) {
+      worst = std::max(worst, std::abs(r.sum[p * 3 + c] / n - L[c]) / L[c]);
+      worst_sq = std::max(worst_sq, std::abs(r.sum_sq[p * 3 + c] / n - L[c] * L[c]) / (L[c] * L[c]));
+    }
+  EXPECT_LE(worst, rel_tol) << "mean";
+  EXPECT_LE(worst_sq, rel_tol) << "sum of squares";
+  std::printf("65536 spp: worst relative error of the mean %.3g, of sum L^2 / n %.3g\n", worst, worst_sq);
+}
+
+// Non-finite samples are recorded as 0 and counted, exactly.
+inline void expect_nonfinite_samples_counted(Backend& backend, const std::filesystem::path& dir) {
+  const int W = 8, H = 4, spp = 64;
+  Scene s = inf_texture_scene(dir, W, H, spp);
+  RenderResult r = backend.render(s, settings_for(s), {});
+  EXPECT_EQ(r.nonfinite_samples, uint64_t(W / 2) * H * spp);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const double sum = r.sum[(size_t(y) * W + x) * 3 + c], sq = r.sum_sq[(size_t(y) * W + x) * 3 + c];
+        ASSERT_TRUE(std::isfinite(sum) && std::isfinite(sq)) << x << "," << y;
+        const double expected = x < W / 2 ? 0.0 : s.background[c];  // non-finite samples count as 0
+        EXPECT_NEAR(sum / spp, expected, 1e-6) << x << "," << y << " channel " << c;
+      }
+}
+
+inline void expect_same_sums(const RenderResult& a, const RenderResult& b) {
+  EXPECT_EQ(a.spp, b.spp);
+  ASSERT_EQ(a.sum.size(), b.sum.size());
+  size_t differ = 0;
+  for (size_t i = 0; i < a.sum.size(); ++i) differ += a.sum[i] != b.sum[i] || a.sum_sq[i] != b.sum_sq[i];
+  EXPECT_EQ(differ, 0u) << "of " << a.sum.size() << " channel sums differ";
+  EXPECT_EQ(a.events, b.events);
+  EXPECT_EQ(a.density_lookups, b.density_lookups);
+  EXPECT_EQ(a.nonfinite_samples, b.nonfinite_samples);
+}
+
+// Interrupted after 3 passes and resumed from the state it returned, or from
+// the last periodic checkpoint, the render is bit-identical to an
+// uninterrupted one: sample streams are indexed by sample number and the
+// state is the backend's own accumulation.
+inline void expect_resume_exact(Backend& backend, const Scene& s) {
+  const RenderSettings rs = settings_for(s);
+  RenderResult whole = backend.render(s, rs, {});
+  ASSERT_EQ(whole.spp, rs.spp);
+  EXPECT_TRUE(whole.state.data.empty()) << "a finished render has nothing to checkpoint";
+
+  std::atomic<bool> cancel{false};
+  int passes = 0;
+  RenderControl stop;
+  stop.cancel = &cancel;
+  stop.progress = [&](int, int) {
+    if (++passes == 3) cancel = true;
+  };
+  RenderResult part = backend.render(s, rs, stop);
+  ASSERT_TRUE(part.cancelled);
+  ASSERT_GT(part.spp, 0);
+  ASSERT_LT(part.spp, rs.spp);
+  ASSERT_EQ(part.state.spp, part.spp);
+  ASSERT_EQ(part.state.backend, backend.name());
+
+  RenderControl resume;
+  resume.resume = &part.state;
+  RenderResult rest = backend.render(s, rs, resume);
+  EXPECT_EQ(rest.resumed_spp, part.spp);
+  expect_same_sums(rest, whole);
+
+  // Periodic checkpoints (every pass here), resumed from the last one taken.
+  std::vector<AccumulationState> saved;
+  RenderControl periodic;
+  periodic.checkpoint_seconds = 1e-9;
+  periodic.checkpoint = [&](const AccumulationState& st) { saved.push_back(st); };
+  RenderResult again = backend.render(s, rs, periodic);
+  expect_same_sums(again, whole);  // checkpoints do not disturb the accumulation
+  ASSERT_GE(saved.size(), 2u);
+  for (size_t i = 1; i < saved.size(); ++i) EXPECT_GT(saved[i].spp, saved[i - 1].spp);
+  RenderControl from_checkpoint;
+  from_checkpoint.resume = &saved[saved.size() / 2];
+  expect_same_sums(backend.render(s, rs, from_checkpoint), whole);
+}
+
+
+// ------------------------------------------------------------- the CLI ----
+
+inline std::string q(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+
+inline void expect_same_image(const Image& a, const Image& b) {
+  ASSERT_EQ(a.width, b.width);
+  ASSERT_EQ(a.height, b.height);
+  size_t differ = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) differ += a.rgb[i] != b.rgb[i];
+  EXPECT_EQ(differ, 0u) << "of " << a.rgb.size() << " values differ";
+  ASSERT_EQ(a.variance.size(), b.variance.size());
+  differ = 0;
+  for (size_t i = 0; i < a.variance.size(); ++i) differ += a.variance[i] != b.variance[i];
+  EXPECT_EQ(differ, 0u) << "of " << a.variance.size() << " variance values differ";
+}
+
+// A real SIGINT in the middle of a 10 000 spp render (sent once the first
+// checkpoint exists): exit 130, the image so far with its spp in the EXR
+// header and in the message, the checkpoint beside it; `--resume` then
+// completes it to 10 000 spp, identical to an uninterrupted render, and
+// removes the checkpoint.
+inline void expect_cli_interrupt_then_resume(const std::string& backend) {
+  auto dir = temp_dir("cli-resume-" + backend);
+  write_file(dir / "s.json", kSlowBallJson);
+  const auto out = dir / "o.exr", ckpt = dir / "o.exr.checkpoint";
+  CliProcess p = start_cli({"render", (dir / "s.json").string(), "-o", out.string(), "--backend", backend,
+                            "--checkpoint", "0.02", "--variance", "--stats", (dir / "st.json").string()},
+                           dir);
+  ASSERT_TRUE(wait_for_file(p, ckpt)) << "the render ended before its first checkpoint: " << read_file(p.err);
+  kill(p.pid, SIGINT);
+  ASSERT_EQ(wait_exit(p), 130) << read_file(p.err);
+  const std::string err = read_file(p.err);
+
+  Image part = read_image(out);
+  EXPECT_GT(part.spp, 0);
+  EXPECT_LT(part.spp, 10000);
+  EXPECT_EQ(part.spp_target, 10000);
+  ASSERT_TRUE(part.has_variance());
+  const std::string said = "interrupted after " + std::to_string(part.spp) + " of 10000 spp";
+  EXPECT_NE(err.find(said), std::string::npos) << err;
+  EXPECT_NE(err.find(out.string()), std::string::npos) << err;
+  EXPECT_NE(err.find("--resume"), std::string::npos) << err;
+  auto stats = nlohmann::json::parse(read_file(dir / "st.json"));
+  EXPECT_EQ(stats["spp"], part.spp);
+  EXPECT_EQ(stats["cancelled"], true);
+  ASSERT_TRUE(std::filesystem::exists(ckpt));
+
+  CliResult resumed = run_cli("render " + q(dir / "s.json") + " -o " + q(out) + " --backend " + backend +
+                              " --resume --variance --stats " + q(dir / "st2.json"));
+  ASSERT_EQ(resumed.status, 0) << resumed.err;
+  EXPECT_EQ(resumed.err.find("validation"), std::string::npos) << resumed.err;
+  EXPECT_EQ(err.find("validation"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(ckpt)) << "a finished render leaves no checkpoint";
+  auto stats2 = nlohmann::json::parse(read_file(dir / "st2.json"));
+  EXPECT_EQ(stats2["spp"], 10000);
+  EXPECT_EQ(stats2["resumed_spp"], part.spp);
+
+  CliResult whole = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "u.exr") + " --backend " + backend +
+                            " --variance");
+  ASSERT_EQ(whole.status, 0) << whole.err;
+  Image a = read_image(out), b = read_image(dir / "u.exr");
+  EXPECT_EQ(a.spp, 10000);
+  EXPECT_EQ(a.spp_target, 10000);
+  expect_same_image(a, b);
+  std::filesystem::remove_all(dir);
+}
+
+// SIGTERM: the same save, exit 143.
+inline void expect_cli_sigterm_saves(const std::string& backend) {
+  auto dir = temp_dir("cli-term-" + backend);
+  write_file(dir / "s.json", kSlowBallJson);
+  const auto out = dir / "o.exr", ckpt = dir / "o.exr.checkpoint";
+  CliProcess p = start_cli(
+      {"render", (dir / "s.json").string(), "-o", out.string(), "--backend", backend, "--checkpoint", "0.02"}, dir);
+  ASSERT_TRUE(wait_for_file(p, ckpt)) << read_file(p.err);
+  kill(p.pid, SIGTERM);
+  ASSERT_EQ(wait_exit(p), 143) << read_file(p.err);
+  Image part = read_image(out);
+  EXPECT_GT(part.spp, 0);
+  EXPECT_LT(part.spp, 10000);
+  EXPECT_NE(read_file(p.err).find("interrupted after " + std::to_string(part.spp)), std::string::npos);
+  // The partial image is exactly a render of that many spp (sample-indexed
+  // streams; on the GPU the same passes of 64).
+  CliResult same = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "again.exr") + " --backend " + backend +
+                           " --spp " + std::to_string(part.spp));
+  ASSERT_EQ(same.status, 0) << same.err;
+  expect_same_image(part, read_image(dir / "again.exr"));
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace pyrolume::test

@@ -1,0 +1,68 @@
+// The grid loader checks a grid against the device's 3D texture limits before
+// it allocates the dense array (issue 10 "limits"), naming the file and grid
+// and the downsample that would fit.
+#include <gtest/gtest.h>
+
+#include "support/VdbScenes.h"
+#include "util/Error.h"
+#include "volume/VdbLoader.h"
+
+namespace pyrolume {
+namespace {
+
+// Two active voxels, at the origin and at `far`: a tiny sparse grid whose
+// dense box spans far + 1 voxels per axis (+ 2 padding texels).
+std::filesystem::path write_two_voxels(const std::filesystem::path& file, openvdb::Coord far) {
+  test::ensure_openvdb();
+  auto g = openvdb::FloatGrid::create(0.0f);
+  g->setName("density");
+  g->tree().setValueOn(openvdb::Coord(0, 0, 0), 1.0f);
+  g->tree().setValueOn(far, 1.0f);
+  return test::write_vdb(file, {g});
+}
+
+std::string load_error(const Medium& m, const DenseLimits& limits) {
+  try {
+    load_volume(m, false, limits);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(VolumeLimits, GridPastTheDeviceDimensionIsRefusedBeforeAllocating) {
+  auto dir = test::temp_dir("vol-limits");
+  // 4503 × 5 × 5 texels: past 4096 along x.
+  const auto file = write_two_voxels(dir / "wide.vdb", openvdb::Coord(4500, 2, 2));
+  Medium m = test::vdb_medium("wide", file, {1, 1, 1}, {0, 0, 0});
+  const std::string err = load_error(m, DenseLimits{4096, 0});
+  EXPECT_NE(err.find(file.string() + ": "), std::string::npos) << err;
+  EXPECT_NE(err.find("density"), std::string::npos) << err;
+  EXPECT_NE(err.find("4503x5x5 texels (with downsample 1) exceed this device's 3D texture limit of 4096 per axis"),
+            std::string::npos)
+      << err;
+  EXPECT_NE(err.find("add \"downsample\": 2"), std::string::npos) << err;
+  // The suggestion fits: with downsample 2 the grid loads (2253 × 4 × 4).
+  m.downsample = 2;
+  VolumeGrids v = load_volume(m, false, DenseLimits{4096, 0});
+  EXPECT_EQ(v.density.dims, glm::ivec3(2253, 4, 4));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(VolumeLimits, GridPastTheAllocationLimitIsRefused) {
+  auto dir = test::temp_dir("vol-bytes");
+  const auto file = write_two_voxels(dir / "cube.vdb", openvdb::Coord(199, 199, 199));  // 202³ texels
+  Medium m = test::vdb_medium("cube", file, {1, 1, 1}, {0, 0, 0});
+  const std::string err = load_error(m, DenseLimits{0, uint64_t(1) << 20});  // 1 MiB
+  EXPECT_NE(err.find("202x202x202 texels (with downsample 1) exceed what this device allows in one allocation (1 MiB"),
+            std::string::npos)
+      << err;
+  // (199/3 + 3)³ · 2 B = 69³ · 2 B fits in 1 MiB; (199/2 + 3)³ · 2 B = 102³ · 2 B does not.
+  EXPECT_NE(err.find("add \"downsample\": 3"), std::string::npos) << err;
+  // No limits: it loads.
+  EXPECT_EQ(load_volume(m, false).density.dims, glm::ivec3(202, 202, 202));
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace pyrolume

@@ -1,0 +1,148 @@
+// `pyrolume render` on the Vulkan backend interrupted, checkpointed and
+// resumed as a user runs it (real signals, real files), and the device-failure
+// path: a lost device or exhausted device memory mid-render (injected with
+// PYROLUME_TEST_FAIL_PASS, since lavapipe cannot lose a device) saves the
+// accumulation so far, says which failure it was and exits 1.
+#include <cstdlib>
+
+#include <gtest/gtest.h>
+
+#include "support/AccumulationChecks.h"
+#include "support/VdbScenes.h"
+
+namespace pyrolume {
+namespace {
+using namespace pyrolume::test;
+
+TEST(CliCheckpointVulkan, SigintSavesThenResumeCompletesIdentically) { expect_cli_interrupt_then_resume("vulkan"); }
+
+TEST(CliCheckpointVulkan, SigtermSavesAndExits143) { expect_cli_sigterm_saves("vulkan"); }
+
+// Runs the CLI with PYROLUME_TEST_FAIL_PASS=fault set.
+CliResult run_with_fault(const std::string& fault, const std::string& args) {
+  setenv("PYROLUME_TEST_FAIL_PASS", fault.c_str(), 1);
+  CliResult r = run_cli(args);
+  unsetenv("PYROLUME_TEST_FAIL_PASS");
+  return r;
+}
+
+TEST(CliDeviceFailure, OutOfDeviceMemorySavesThePassesBeforeAndExits1) {
+  auto dir = temp_dir("cli-oom");
+  write_file(dir / "s.json", kSlowBallJson);
+  const std::string render = "render " + q(dir / "s.json") + " --variance --spp 1000";
+  // Pass 3 fails: the two passes of 64 spp before it are read back and saved.
+  CliResult r = run_with_fault("VK_ERROR_OUT_OF_DEVICE_MEMORY:3", render + " -o " + q(dir / "o.exr"));
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("VK_ERROR_OUT_OF_DEVICE_MEMORY"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("128 of 1000 spp"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  Image part = read_image(dir / "o.exr");
+  EXPECT_EQ(part.spp, 128);
+  ASSERT_TRUE(std::filesystem::exists(dir / "o.exr.checkpoint"));
+  // What was saved is exactly a 128 spp render ...
+  CliResult fresh = run_cli(render.substr(0, render.find(" --spp")) + " --spp 128 -o " + q(dir / "f.exr"));
+  ASSERT_EQ(fresh.status, 0) << fresh.err;
+  expect_same_image(part, read_image(dir / "f.exr"));
+  // ... and resumes to the full one.
+  CliResult resumed = run_cli(render + " -o " + q(dir / "o.exr") + " --resume");
+  ASSERT_EQ(resumed.status, 0) << resumed.err;
+  EXPECT_EQ(resumed.err.find("validation"), std::string::npos) << resumed.err;
+  CliResult whole = run_cli(render + " -o " + q(dir / "u.exr"));
+  ASSERT_EQ(whole.status, 0) << whole.err;
+  expect_same_image(read_image(dir / "o.exr"), read_image(dir / "u.exr"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CliDeviceFailure, DeviceLostSavesTheLastHostCopyAndExits1) {
+  auto dir = temp_dir("cli-lost");
+  write_file(dir / "s.json", kSlowBallJson);
+  const std::string render = "render " + q(dir / "s.json") + " --variance";
+  // A lost device cannot be read: what is saved is the host copy taken after
+  // pass 1 (or pass 2, if a second copy was due by then).
+  CliResult r = run_with_fault("VK_ERROR_DEVICE_LOST:3", render + " --spp 1000 -o " + q(dir / "o.exr"));
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("VK_ERROR_DEVICE_LOST"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  Image part = read_image(dir / "o.exr");
+  EXPECT_TRUE(part.spp == 64 || part.spp == 128) << part.spp;
+  EXPECT_NE(r.err.find(std::to_string(part.spp) + " of 1000 spp"), std::string::npos) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(dir / "o.exr.checkpoint"));
+  CliResult fresh = run_cli(render + " --spp " + std::to_string(part.spp) + " -o " + q(dir / "f.exr"));
+  ASSERT_EQ(fresh.status, 0) << fresh.err;
+  expect_same_image(part, read_image(dir / "f.exr"));
+
+  // Lost in the first pass of the resumed render: what it resumed from is
+  // still there to save.
+  CliResult again = run_with_fault("VK_ERROR_DEVICE_LOST:1", render + " --spp 1000 --resume -o " + q(dir / "o.exr"));
+  EXPECT_EQ(again.status, 1) << again.err;
+  EXPECT_EQ(read_image(dir / "o.exr").spp, part.spp);
+  EXPECT_TRUE(std::filesystem::exists(dir / "o.exr.checkpoint"));
+
+  // Any other failure of a pass is handled the same way, with its own message.
+  CliResult other = run_with_fault("VK_ERROR_UNKNOWN:2", render + " --spp 1000 -o " + q(dir / "x.exr"));
+  EXPECT_EQ(other.status, 1) << other.err;
+  EXPECT_NE(other.err.find("the device failed: vkQueueSubmit"), std::string::npos) << other.err;
+  EXPECT_NE(other.err.find("VK_ERROR_UNKNOWN"), std::string::npos) << other.err;
+  EXPECT_EQ(read_image(dir / "x.exr").spp, 64);  // the host copy after pass 1
+
+  // Lost in the first pass: nothing was accumulated, nothing is written.
+  CliResult first = run_with_fault("VK_ERROR_DEVICE_LOST:1", render + " --spp 1000 -o " + q(dir / "n.exr"));
+  EXPECT_EQ(first.status, 1) << first.err;
+  EXPECT_NE(first.err.find("VK_ERROR_DEVICE_LOST"), std::string::npos) << first.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "n.exr"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "n.exr.checkpoint"));
+  std::filesystem::remove_all(dir);
+}
+
+// An accumulation buffer no device allows (16384² × 64 B = 16 GiB > any
+// maxStorageBufferRange, a uint32): one line naming the keys, exit 2.
+TEST(CliLimitsVulkan, AccumulationLargerThanTheDeviceAllowsIsBadInput) {
+  auto dir = temp_dir("cli-big");
+  write_file(dir / "s.json", kSlowBallJson);
+  CliResult r = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --width 16384 --height 16384");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("film.width x film.height (or --width/--height): 16384x16384"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("this device's"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "o.exr"));
+  std::filesystem::remove_all(dir);
+}
+
+// A grid wider than the device's maxImageDimension3D: refused by the loader
+// before its dense array exists, naming the grid and the downsample that fits.
+TEST(CliLimitsVulkan, GridPastTheDevicesTextureLimitIsBadInput) {
+  auto dir = temp_dir("cli-wide");
+  ensure_openvdb();
+  auto g = openvdb::FloatGrid::create(0.0f);
+  g->setName("density");
+  g->tree().setValueOn(openvdb::Coord(0, 0, 0), 1.0f);
+  g->tree().setValueOn(openvdb::Coord(20000, 1, 1), 1.0f);  // past any GPU's 3D limit (16384 at most today)
+  write_vdb(dir / "wide.vdb", {g});
+  write_file(dir / "s.json", R"({"film": {"width": 4, "height": 4, "spp": 1},
+    "media": [{"name": "wide", "type": "vdb", "file": "wide.vdb", "sigma_a": [1, 1, 1], "sigma_s": [0, 0, 0]}]})");
+  CliResult r = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "o.exr"));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("wide.vdb: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("20003x4x4 texels (with downsample 1) exceed this device's 3D texture limit"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("add \"downsample\": "), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "o.exr"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CliCheckpointVulkan, NonFiniteSamplesAreReportedInStats) {
+  auto dir = temp_dir("cli-inf-gpu");
+  inf_texture_scene(dir, 8, 4, 16);  // writes inf.exr
+  write_file(dir / "s.json", inf_texture_scene_json(8, 4, 16));
+  CliResult r = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --stats " + q(dir / "st.json"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto stats = nlohmann::json::parse(read_file(dir / "st.json"));
+  EXPECT_EQ(stats["nonfinite_samples"], 4 * 4 * 16);
+  Image img = read_image(dir / "o.exr");
+  for (float v : img.rgb) EXPECT_TRUE(std::isfinite(v));
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace pyrolume
