@@ -6,7 +6,13 @@
 #include <filesystem>
 #include <string>
 
+#include <cstdio>
+
+#include <gtest/gtest.h>
+
 #include "image/ImageIo.h"
+#include "render/Render.h"
+#include "support/Stats.h"
 #include "support/AnalyticScenes.h"
 #include "support/SurfaceScenes.h"
 #include "support/VdbScenes.h"
@@ -70,6 +76,36 @@ inline Scene scattering_fire_scene(const std::filesystem::path& dir, Strategy k,
   s.media.back().temperature.cutoff_k = 500.0;
   set_strategy(s, k);
   return s;
+}
+
+// --------------------------------------------------------------- checks ----
+
+inline ZTestOptions mis_pooled(double tolerance) {
+  ZTestOptions o;
+  o.pool3x3 = true;
+  o.bias_tolerance = tolerance;
+  return o;
+}
+
+// Two renders of the same scene converge to the same image (pooled z-test,
+// DESIGN.md bias formula); prints the report.
+inline void expect_same_image(const RenderResult& a, const RenderResult& b, double tolerance, const char* what) {
+  ZTestReport z = ztest_images(a, b, mis_pooled(tolerance));
+  EXPECT_TRUE(z.ok) << what << ": " << z.summary();
+  std::printf("%s: %s\n", what, z.summary().c_str());
+}
+
+// Σ over the pixel-channels of the rows from `first_row` down of the
+// per-sample variance: the plane in front of the fire in fire_over_plane_scene.
+inline double lower_rows_variance(const RenderResult& r, int first_row) {
+  double v = 0.0;
+  for (int y = first_row; y < r.height; ++y)
+    for (int x = 0; x < r.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const size_t i = (size_t(y) * r.width + x) * 3 + c;
+        v += sample_variance(r.sum[i], r.sum_sq[i], r.spp);
+      }
+  return v;
 }
 
 }  // namespace pyrolume::test

@@ -32,50 +32,28 @@ RenderResult render(const Scene& s) {
   return res;
 }
 
-ZTestOptions pooled(double tolerance) {
-  ZTestOptions o;
-  o.pool3x3 = true;
-  o.bias_tolerance = tolerance;
-  return o;
-}
-
-// Mean per-pixel variance of the mean over the pixels selected, luminance-free:
-// the sum over channels.
-double mean_variance(const RenderResult& r, const std::vector<size_t>& pixels) {
-  double v = 0.0;
-  for (size_t p : pixels)
-    for (int c = 0; c < 3; ++c) v += test::sample_variance(r.sum[p * 3 + c], r.sum_sq[p * 3 + c], r.spp) / r.spp;
-  return v / double(pixels.size());
-}
-
-void expect_same(const RenderResult& a, const RenderResult& b, double tolerance, const char* what) {
-  ZTestReport z = test::ztest_images(a, b, pooled(tolerance));
-  EXPECT_TRUE(z.ok) << what << ": " << z.summary();
-  std::printf("%s: %s\n", what, z.summary().c_str());
-}
-
 // Terrain-like: an absorbing fire over a plane under a sky. All three
 // strategies have finite variance here.
 TEST(CpuMis, FireOverPlaneWithSkyStrategiesAgree) {
   const auto dir = test::temp_dir("cpu_mis_plane");
   auto scene = [&](Strategy k, int spp) { return test::fire_over_plane_scene(dir, k, true, false, 24, 18, spp); };
   RenderResult bsdf = render(scene(Strategy::Bsdf, 1024));
-  expect_same(render(scene(Strategy::Mis, 256)), bsdf, 0.02, "MIS vs BSDF only");
-  expect_same(render(scene(Strategy::LightOnly, 256)), bsdf, 0.02, "light only vs BSDF only");
+  test::expect_same_image(render(scene(Strategy::Mis, 256)), bsdf, 0.02, "MIS vs BSDF only");
+  test::expect_same_image(render(scene(Strategy::LightOnly, 256)), bsdf, 0.02, "light only vs BSDF only");
 }
 
 // The fire scatters too: MIS at medium vertices inside the emitter.
 TEST(CpuMis, ScatteringFireOverPlaneMisAgrees) {
   const auto dir = test::temp_dir("cpu_mis_plane");
   auto scene = [&](Strategy k, int spp) { return test::fire_over_plane_scene(dir, k, true, true, 24, 18, spp); };
-  expect_same(render(scene(Strategy::Mis, 256)), render(scene(Strategy::Bsdf, 1024)), 0.02, "MIS vs BSDF only");
+  test::expect_same_image(render(scene(Strategy::Mis, 256)), render(scene(Strategy::Bsdf, 1024)), 0.02, "MIS vs BSDF only");
 }
 
 TEST(CpuMis, ScatteringEmissiveMediumMisAgrees) {
   const auto dir = test::temp_dir("cpu_mis_scattering");
   RenderResult bsdf = render(test::scattering_fire_scene(dir, Strategy::Bsdf, 12, 12, 8192));
   RenderResult mis = render(test::scattering_fire_scene(dir, Strategy::Mis, 12, 12, 4096));
-  expect_same(mis, bsdf, 0.02, "MIS vs phase only");
+  test::expect_same_image(mis, bsdf, 0.02, "MIS vs phase only");
 }
 
 // The fire lights the plane: at equal spp, MIS has far less variance on plane
@@ -86,12 +64,9 @@ TEST(CpuMis, MisLowersVarianceOnLitPlane) {
   Scene s_bsdf = test::fire_over_plane_scene(dir, Strategy::Bsdf, false, false, 24, 18, 64);
   RenderResult bsdf = render(s_bsdf);
   RenderResult mis = render(test::fire_over_plane_scene(dir, Strategy::Mis, false, false, 24, 18, 64));
-  // Plane pixels whose camera ray misses the medium: no events on a camera ray
-  // through nothing would be ambiguous, so select by geometry: rows below the box.
-  std::vector<size_t> plane;
-  for (int y = s_bsdf.film.height * 3 / 4; y < s_bsdf.film.height; ++y)
-    for (int x = 0; x < s_bsdf.film.width; ++x) plane.push_back(size_t(y) * s_bsdf.film.width + x);
-  const double v_bsdf = mean_variance(bsdf, plane), v_mis = mean_variance(mis, plane);
+  // The bottom quarter: plane in front of the box, camera rays through no medium.
+  const int first = s_bsdf.film.height * 3 / 4;
+  const double v_bsdf = test::lower_rows_variance(bsdf, first), v_mis = test::lower_rows_variance(mis, first);
   std::printf("plane variance: BSDF %.4g, MIS %.4g, ratio %.1f\n", v_bsdf, v_mis, v_bsdf / v_mis);
   EXPECT_GT(v_bsdf, 4.0 * v_mis);
 }
@@ -107,7 +82,7 @@ TEST(CpuMis, FurnaceSphereIsOneWithSkyAsLight) {
     s.environment = Environment{test::write_uniform_sky(dir, glm::vec3(1.0f)), 1.0, 0.0};
     test::set_strategy(s, k);
     RenderResult r = render(s);
-    ZTestReport z = test::ztest_against_exact(r, [](int, int) { return glm::dvec3(1.0); }, pooled(0.01));
+    ZTestReport z = test::ztest_against_exact(r, [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
     EXPECT_TRUE(z.ok) << z.summary();
     std::printf("furnace: %s\n", z.summary().c_str());
   }
@@ -124,7 +99,7 @@ TEST(CpuMis, ScatteringFurnaceIsOneWithSkyAsLight) {
   s.environment = Environment{test::write_uniform_sky(dir, glm::vec3(1.0f)), 1.0, 0.0};
   test::set_strategy(s, Strategy::Mis);
   RenderResult r = render(s);
-  ZTestReport z = test::ztest_against_exact(r, [](int, int) { return glm::dvec3(1.0); }, pooled(0.01));
+  ZTestReport z = test::ztest_against_exact(r, [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
   EXPECT_TRUE(z.ok) << z.summary();
 }
 

@@ -21,13 +21,6 @@ using test::Strategy;
 using test::ZTestOptions;
 using test::ZTestReport;
 
-ZTestOptions pooled(double tolerance) {
-  ZTestOptions o;
-  o.pool3x3 = true;
-  o.bias_tolerance = tolerance;
-  return o;
-}
-
 class VulkanMis : public test::VulkanFixture {
  protected:
   RenderResult gpu(const Scene& s) {
@@ -43,17 +36,12 @@ class VulkanMis : public test::VulkanFixture {
     EXPECT_EQ(renderer.majorant_violations(), 0u);
     return r;
   }
-  void expect_same(const RenderResult& a, const RenderResult& b, double tolerance, const char* what) {
-    ZTestReport z = test::ztest_images(a, b, pooled(tolerance));
-    EXPECT_TRUE(z.ok) << what << ": " << z.summary();
-    std::printf("%s: %s\n", what, z.summary().c_str());
-  }
 };
 
 TEST_F(VulkanMis, ScatteringFireOverPlaneMatchesCpu) {
   const auto dir = test::temp_dir("vk_mis_plane");
   Scene s = test::fire_over_plane_scene(dir, Strategy::Mis, true, true, 24, 18, 512);
-  expect_same(gpu(s), cpu(s, 512), 0.02, "GPU vs CPU, MIS");
+  test::expect_same_image(gpu(s), cpu(s, 512), 0.02, "GPU vs CPU, MIS");
 }
 
 TEST_F(VulkanMis, ChromaticFireOverPlaneMatchesCpu) {
@@ -61,21 +49,21 @@ TEST_F(VulkanMis, ChromaticFireOverPlaneMatchesCpu) {
   Scene s = test::fire_over_plane_scene(dir, Strategy::Mis, true, true, 24, 18, 512);
   s.media[0].sigma_a = {1.0, 2.0, 3.5};
   s.media[0].sigma_s = {2.5, 1.5, 0.5};
-  expect_same(gpu(s), cpu(s, 512), 0.02, "GPU vs CPU, MIS, chromatic sigma");
+  test::expect_same_image(gpu(s), cpu(s, 512), 0.02, "GPU vs CPU, MIS, chromatic sigma");
 }
 
 TEST_F(VulkanMis, EmissiveScatteringGridMatchesCpu) {
   const auto dir = test::temp_dir("vk_mis_scattering");
   Scene s = test::scattering_fire_scene(dir, Strategy::Mis, 12, 12, 4096);
-  expect_same(gpu(s), cpu(s, 4096), 0.02, "GPU vs CPU, MIS, scattering emitter");
+  test::expect_same_image(gpu(s), cpu(s, 4096), 0.02, "GPU vs CPU, MIS, scattering emitter");
 }
 
 TEST_F(VulkanMis, StrategiesAgreeOnGpu) {
   const auto dir = test::temp_dir("vk_mis_plane");
   auto scene = [&](Strategy k, int spp) { return test::fire_over_plane_scene(dir, k, true, false, 24, 18, spp); };
   RenderResult bsdf = gpu(scene(Strategy::Bsdf, 2048));
-  expect_same(gpu(scene(Strategy::Mis, 256)), bsdf, 0.02, "GPU MIS vs BSDF only");
-  expect_same(gpu(scene(Strategy::LightOnly, 256)), bsdf, 0.02, "GPU light only vs BSDF only");
+  test::expect_same_image(gpu(scene(Strategy::Mis, 256)), bsdf, 0.02, "GPU MIS vs BSDF only");
+  test::expect_same_image(gpu(scene(Strategy::LightOnly, 256)), bsdf, 0.02, "GPU light only vs BSDF only");
 }
 
 TEST_F(VulkanMis, FurnaceSphereIsOneWithSkyAsLight) {
@@ -85,7 +73,7 @@ TEST_F(VulkanMis, FurnaceSphereIsOneWithSkyAsLight) {
   s.shapes.push_back(test::sphere_shape({0, 0, 0}, 1.0, glm::dvec3(1.0)));
   s.environment = Environment{test::write_uniform_sky(dir, glm::vec3(1.0f)), 1.0, 0.0};
   test::set_strategy(s, Strategy::Mis);
-  ZTestReport z = test::ztest_against_exact(gpu(s), [](int, int) { return glm::dvec3(1.0); }, pooled(0.01));
+  ZTestReport z = test::ztest_against_exact(gpu(s), [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
   EXPECT_TRUE(z.ok) << z.summary();
   std::printf("GPU furnace: %s\n", z.summary().c_str());
 }
@@ -95,14 +83,8 @@ TEST_F(VulkanMis, MisLowersVarianceOnLitPlane) {
   Scene sb = test::fire_over_plane_scene(dir, Strategy::Bsdf, false, false, 24, 18, 64);
   RenderResult bsdf = gpu(sb);
   RenderResult mis = gpu(test::fire_over_plane_scene(dir, Strategy::Mis, false, false, 24, 18, 64));
-  double vb = 0.0, vm = 0.0;
-  for (int y = sb.film.height * 3 / 4; y < sb.film.height; ++y)
-    for (int x = 0; x < sb.film.width; ++x)
-      for (int c = 0; c < 3; ++c) {
-        const size_t i = (size_t(y) * sb.film.width + x) * 3 + c;
-        vb += test::sample_variance(bsdf.sum[i], bsdf.sum_sq[i], bsdf.spp);
-        vm += test::sample_variance(mis.sum[i], mis.sum_sq[i], mis.spp);
-      }
+  const int first = sb.film.height * 3 / 4;
+  const double vb = test::lower_rows_variance(bsdf, first), vm = test::lower_rows_variance(mis, first);
   std::printf("GPU plane variance: BSDF %.4g, MIS %.4g, ratio %.1f\n", vb, vm, vb / vm);
   EXPECT_GT(vb, 4.0 * vm);
 }
