@@ -142,6 +142,14 @@ class HardCase : public B, protected test::ConstantBoxSetup {
     return r;
   }
 
+  // The check can fail: the same render against a deliberately wrong closed
+  // form is rejected.
+  static void expect_rejected(const RenderResult& r, const std::function<glm::dvec3(int, int)>& wrong,
+                              const char* what, const test::ZTestOptions& o = pooled()) {
+    const test::ZTestReport rep = test::ztest_against_exact(r, wrong, o);
+    EXPECT_FALSE(rep.ok) << "deliberately wrong (" << what << ") was accepted: " << rep.summary();
+  }
+
   // Every pixel of every sample equals `value` (up to float accumulation).
   static void expect_every_pixel(const RenderResult& r, const glm::dvec3& value, const char* what) {
     size_t off = 0;

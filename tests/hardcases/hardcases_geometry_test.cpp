@@ -62,7 +62,10 @@ TYPED_TEST(HardGeometry, OneVoxelGrid) {
   s.background = {0.05, 0.1, 0.2};
   s.media.push_back(test::vdb_medium("voxel", this->dir / "one.vdb", {0.4, 0.8, 1.6}, {0, 0, 0}, 0.0,
                                      glm::dvec3(1.0, 0.6, 0.3), 1.5));
-  this->expect_closed_form(s, grid_exact(s, test::TrilinearVoxelField(lat, one, value)), "one voxel", tail_pooled());
+  const RenderResult r =
+      this->expect_closed_form(s, grid_exact(s, test::TrilinearVoxelField(lat, one, value)), "one voxel", tail_pooled());
+  this->expect_rejected(r, grid_exact(s, test::TrilinearVoxelField(lat, one, [](int, int, int) { return 2.2f; })),
+                        "10 % denser", tail_pooled());
 }
 
 // A 1×1×32 grid (a rod of one voxel's width with a density ramp along it):
@@ -132,7 +135,8 @@ TYPED_TEST(HardGeometry, ExtremeTransforms) {
     s.camera.position = glm::dvec3(M * glm::dvec4(s.camera.position, 1.0));
     s.camera.look_at = glm::dvec3(M * glm::dvec4(s.camera.look_at, 1.0));
     s.camera.up = glm::normalize(glm::dvec3(M * glm::dvec4(s.camera.up, 0.0)));
-    this->expect_closed_form(s, grid_exact(s, this->field(), M), c.what, pooled(0.01));
+    const RenderResult r = this->expect_closed_form(s, grid_exact(s, this->field(), M), c.what, pooled(0.01));
+    this->expect_rejected(r, grid_exact(s, this->field()), "transform ignored", pooled(0.01));
   }
 }
 

@@ -172,6 +172,9 @@ TYPED_TEST(HardMedia, Albedo0999WithMaxDepth1000) {
   const double alpha = 9.99 / 10.0;
   const glm::dvec3 L = glm::dvec3(2.0, 0.0, 0.0) * (1.0 - std::pow(alpha, 1001.0));
   const RenderResult r = this->expect_closed_form(s, [L](int, int) { return L; }, "albedo 0.999", pooled(0.02));
+  const glm::dvec3 untruncated(2.0, 0.0, 0.0), capped = glm::dvec3(2.0, 0.0, 0.0) * (1.0 - std::pow(alpha, 601.0));
+  this->expect_rejected(r, [&](int, int) { return untruncated; }, "no depth limit", pooled(0.02));
+  this->expect_rejected(r, [&](int, int) { return capped; }, "max_depth 600", pooled(0.02));
   std::printf("events per sample %.1f (expected %.1f)\n", r.events / (double(r.width) * r.height * r.spp),
               (1.0 - std::pow(alpha, 1001.0)) / (1.0 - alpha));
 }
@@ -186,6 +189,7 @@ TYPED_TEST(HardMedia, Albedo0999WithMaxDepth1000) {
 //  - Rays that stay at x index in [4, 14] see 1e6 K wherever ρ > 0:
 //    L = Le(1e6 K)·(1 − e^{−σa τ}) (closed form on those pixels).
 //  - Vulkan: the whole image (including the 0 → 1e6 K ramp) against the CPU reference.
+// In seed mode (both estimators) and physical mode (radiance ~1e10).
 TYPED_TEST(HardMedia, TemperaturesZeroTinyHugeAndNaN) {
   const test::Lattice lat{0.1, {0.0, 0.0, 0.0}};
   const test::VoxelBox dbox{{-8, -4, -4}, {12, 4, 4}}, tbox{{-9, -6, -6}, {14, 6, 6}};
@@ -200,7 +204,6 @@ TYPED_TEST(HardMedia, TemperaturesZeroTinyHugeAndNaN) {
   s.camera.look_at = {0.2, 0.05, 0.0};
   s.camera.fov_deg = 2.0 * std::atan(0.4 / 40.0) * 180.0 / 3.14159265358979;  // 2.4 × 0.8 units at z = 0
   s.media.push_back(test::vdb_medium("slabs", file, glm::dvec3(1.5), {0, 0, 0}, 0.0, std::nullopt, 2.0, true));
-  s.media[0].emission.blackbody = BlackbodyMode::Seed;
 
   // Each pixel column's x-index range over the density support (z index −5..5).
   auto column_range = [&](int px) {
@@ -223,39 +226,57 @@ TYPED_TEST(HardMedia, TemperaturesZeroTinyHugeAndNaN) {
     }
   }
   ASSERT_GE(hot1 - hot0, 6) << "the camera should see at least 7 hot columns";
-  const glm::dvec3 Le = 2.0 * color::blackbody_rgb(1e6, BlackbodyMode::Seed);
   const test::ConstantBoxField f{lat, dbox, 1.0};
-  auto exact = test::exact_image(s, [&](const glm::dvec3& o, const glm::dvec3& d, int* sig) {
-    if (sig) *sig = f.signature(o, d);
-    return Le * (1.0 - std::exp(-1.5 * f.optical_depth(o, d)));
-  });
-  RenderResult r[2];
-  for (int e = 0; e < 2; ++e) {
-    s.integrator.emission_estimator = hard::kEstimators[e];
-    r[e] = this->render(s, hard::kEstimators[e]);
+  // Seed mode with both estimators, and physical mode (absolute Planck
+  // radiance: ~1e10 at 1e6 K) with the absorption estimator.
+  struct Config {
+    const char* estimator;
+    BlackbodyMode mode;
+    const char* what;
+  };
+  const Config configs[] = {{"absorption", BlackbodyMode::Seed, "seed, absorption"},
+                            {"collision", BlackbodyMode::Seed, "seed, collision"},
+                            {"absorption", BlackbodyMode::Physical, "physical, absorption"}};
+  RenderResult r[3];
+  for (int e = 0; e < 3; ++e) {
+    const Config& cf = configs[e];
+    s.integrator.emission_estimator = cf.estimator;
+    s.media[0].emission.blackbody = cf.mode;
+    r[e] = this->render(s, cf.what);
     ASSERT_FALSE(this->kVulkan && r[e].warnings.empty()) << "no warning about the NaN temperature voxels";
     // Cold columns: exactly 0.
     for (int px = 0; px < W; ++px) {
       if (column_range(px).second > 3.0) continue;
       ++cold;
       for (int py = 0; py < H; ++py)
-        EXPECT_EQ(hard::pixel_mean(r[e], px, py), glm::dvec3(0.0)) << hard::kEstimators[e] << " cold pixel " << px;
+        EXPECT_EQ(hard::pixel_mean(r[e], px, py), glm::dvec3(0.0)) << cf.what << " cold pixel " << px;
     }
-    // Hot columns: the closed form.
+    // Hot columns: the closed form (and not the one of 5000 K).
     const int w = hot1 - hot0 + 1;
-    const test::ZTestReport rep = test::ztest_against_exact(
-        hard::crop(r[e], hot0, 0, w, H), [&](int x, int y) { return exact(x + hot0, y); }, pooled(0.01));
-    EXPECT_TRUE(rep.ok) << "1e6 K columns [" << hard::kEstimators[e] << "] " << rep.summary();
-    std::printf("1e6 K columns %d..%d [%s]: %s\n", hot0, hot1, hard::kEstimators[e], rep.summary().c_str());
+    const RenderResult hot = hard::crop(r[e], hot0, 0, w, H);
+    auto exact_at = [&](double T) {
+      const glm::dvec3 Le = 2.0 * color::blackbody_rgb(T, cf.mode);
+      return test::exact_image(s, [&, Le](const glm::dvec3& o, const glm::dvec3& d, int* sig) {
+        if (sig) *sig = f.signature(o, d);
+        return Le * (1.0 - std::exp(-1.5 * f.optical_depth(o, d)));
+      });
+    };
+    const auto exact = exact_at(1e6), wrong = exact_at(5000.0);
+    const test::ZTestReport rep =
+        test::ztest_against_exact(hot, [&](int x, int y) { return exact(x + hot0, y); }, pooled(0.01));
+    EXPECT_TRUE(rep.ok) << "1e6 K columns [" << cf.what << "] " << rep.summary();
+    std::printf("1e6 K columns %d..%d [%s]: %s\n", hot0, hot1, cf.what, rep.summary().c_str());
+    this->expect_rejected(hot, [&](int x, int y) { return wrong(x + hot0, y); }, "5000 K", pooled(0.01));
   }
-  EXPECT_GE(cold, 2 * 8) << "the camera should see at least 8 cold columns";
+  EXPECT_GE(cold, 3 * 8) << "the camera should see at least 8 cold columns";
   if constexpr (TestFixture::kVulkan) {
-    for (int e = 0; e < 2; ++e) {
-      s.integrator.emission_estimator = hard::kEstimators[e];
+    for (int e = 0; e < 3; ++e) {
+      s.integrator.emission_estimator = configs[e].estimator;
+      s.media[0].emission.blackbody = configs[e].mode;
       const RenderResult ref = this->cpu_reference(s, 512, 99 + e);
       const test::ZTestReport rep = test::ztest_images(r[e], ref, pooled(0.01));
-      EXPECT_TRUE(rep.ok) << "vs CPU [" << hard::kEstimators[e] << "] " << rep.summary();
-      std::printf("vs CPU [%s]: %s\n", hard::kEstimators[e], rep.summary().c_str());
+      EXPECT_TRUE(rep.ok) << "vs CPU [" << configs[e].what << "] " << rep.summary();
+      std::printf("vs CPU [%s]: %s\n", configs[e].what, rep.summary().c_str());
     }
   }
 }
