@@ -13,6 +13,7 @@
 
 #include "color/Blackbody.h"
 #include "hardcases/HardCaseFixture.h"
+#include "volume/VdbLoader.h"
 
 namespace pyrolume {
 namespace {
@@ -48,15 +49,16 @@ TYPED_TEST(HardMedia, DensityZeroEverywhere) {
 }
 
 // A density of 1e-6 (a half subnormal as stored) with a 50 000 K temperature
-// grid covering the whole density texture. With density_scale 1.5e6 the medium
-// is optically visible and L = Le(50 000 K)·(1 − e^{−σ τ}) with the STORED
-// density (closed form, both estimators). Unscaled (σ̄ ~ 1e-6 per unit: free
-// flights of ~1e6 units) with Le ~ 1e6 nothing is informative at affordable
-// spp, so the limit is asserted: finite, non-negative and, with the
-// absorption estimator, no sample above Le (each sample is Le or 0).
+// grid covering the whole density texture, L = Le(50 000 K)·(1 − e^{−σ τ}) with
+// the STORED density, both estimators:
+//  - with density_scale 1.5e6 (optically thick, 1 %);
+//  - unscaled (σ̄ ≈ 1e-6 per unit: free flights of ~1e6 units), the grid
+//    scaled up 2e4× by its transform so that a ray's τ is ~0.03 and the
+//    medium can be seen at all; the camera ~1e5 units away (2 %).
 TYPED_TEST(HardMedia, TinyDensityHighTemperature) {
   const float rho = glm::unpackHalf1x16(glm::packHalf1x16(1e-6f));
   ASSERT_GT(rho, 0.0f);
+  ASSERT_NE(rho, 1e-6f) << "1e-6 should not be exact in half";
   const double T = 50000.0;
   const test::TemperatureBox tb{{0.15, {0.01, 0.02, -0.03}}, {{-8, -6, -7}, {8, 6, 7}}, float(T)};
   Scene s = test::vdb_base_scene(16, 16, 256);
@@ -67,26 +69,38 @@ TYPED_TEST(HardMedia, TinyDensityHighTemperature) {
   s.media[0].density_scale = 1.5e6;
   const glm::dvec3 Le = 3.0 * color::blackbody_rgb(T, BlackbodyMode::Seed);
   const test::ConstantBoxField f{this->lat, this->box, double(rho)};
-  auto exact = test::exact_image(s, [&](const glm::dvec3& o, const glm::dvec3& d, int* sig) {
-    const double tau = 1.5e6 * f.optical_depth(o, d);
-    if (sig) *sig = f.signature(o, d);
-    return Le * (1.0 - std::exp(-tau));
-  });
-  this->expect_closed_form(s, exact, "tiny density, scaled", pooled(0.01));
+  auto exact_for = [&](const Scene& sc, const glm::dmat4& M) {
+    const glm::dmat4 Mi = glm::inverse(M);
+    const double scale = sc.media[0].density_scale;
+    return test::exact_image(sc, [&, Mi, scale](const glm::dvec3& o, const glm::dvec3& d, int* sig) {
+      const glm::dvec3 ol(Mi * glm::dvec4(o, 1.0)), dl(Mi * glm::dvec4(d, 0.0));
+      if (sig) *sig = f.signature(ol, dl);
+      return Le * (1.0 - std::exp(-scale * f.optical_depth(ol, dl)));
+    });
+  };
+  this->expect_closed_form(s, exact_for(s, glm::dmat4(1.0)), "tiny density, density_scale 1.5e6", pooled(0.01));
 
-  s.media[0].density_scale = 1.0;
-  s.media[0].emission.scale = 1e6;
-  s.film.width = s.film.height = 8;
-  s.film.spp = 64;
-  const glm::dvec3 Le_big = 1e6 * color::blackbody_rgb(T, BlackbodyMode::Seed);
-  for (const char* est : hard::kEstimators) {
-    s.integrator.emission_estimator = est;
-    const RenderResult r = this->render(s, est);
-    for (size_t i = 0; i < r.sum.size(); ++i) {
-      ASSERT_GE(r.sum[i], 0.0) << est;
-      if (std::string(est) == "absorption") ASSERT_LE(r.sum_sq[i], Le_big[i % 3] * r.sum[i] * (1.0 + 1e-4)) << est;
-    }
-  }
+  Scene u = s;
+  u.film.width = u.film.height = 32;
+  // The GPU's channels share one path (grey σ here: equal relative errors),
+  // which the bias formula's independent-channel SE understates by up to
+  // sqrt(3): 4× the samples there.
+  u.film.spp = this->kVulkan ? 4096 : 1024;
+  u.media[0].density_scale = 1.0;
+  u.media[0].transform.scale = glm::dvec3(2e4);
+  const glm::dmat4 M = medium_transform_matrix(u.media[0].transform);
+  u.camera.position = glm::dvec3(M * glm::dvec4(u.camera.position, 1.0));
+  u.camera.look_at = glm::dvec3(M * glm::dvec4(u.camera.look_at, 1.0));
+  // Most samples are 0, an absorption gives Le (allow_unseen_rare_events; 2·Le
+  // also covers the collision estimator's rare double collision).
+  const RenderResult r =
+      this->expect_closed_form(u, exact_for(u, M), "tiny density, unscaled, 2e4 units", pooled(0.02), 2.0 * Le);
+  // The check can fail: the unrounded 1e-6 differs by 1.3 %, too little to
+  // resolve here, but a medium twice as dense is rejected.
+  Scene twice = u;
+  twice.media[0].density_scale = 2.0;
+  this->expect_rejected(r, hard::allow_unseen_rare_events(r, exact_for(twice, M), 2.0 * Le), "twice the density",
+                        pooled(0.02));
 }
 
 // Optical depth 1e4 per voxel (grid) and σa = 1e5 per unit (homogeneous
