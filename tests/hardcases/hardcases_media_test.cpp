@@ -259,6 +259,36 @@ TYPED_TEST(HardMedia, Albedo0999WithMaxDepth1000) {
               (1.0 - std::pow(alpha, 1001.0)) / (1.0 - alpha));
 }
 
+// Long paths: albedo 0.9995 with max_depth 5000, as above (L = Le·(1 − α^5001)
+// = 0.918·Le); each path makes ~1840 collisions, so a 64-spp pass asks ~1.2e5
+// tracking steps of every lane, and the events per sample must be the
+// truncated geometric mean Σ_{k<=5000} α^k = 1836.
+TYPED_TEST(HardMedia, LongPathsAlbedo09995WithMaxDepth5000) {
+  if constexpr (TestFixture::kVulkan)
+    GTEST_SKIP() << "render.comp drops samples silently on lavapipe when a pass needs more than 65535 tracking steps "
+                    "per SIMD group (llvmpipe's loop limiter apparently counts all loops of an invocation together, so "
+                    "the nested lane loops in main() do not reset it): here events per sample stop at 65536/64 = 1024 "
+                    "instead of 1836, and L reads ~55 % of the closed form (docs/robustness.md)";
+  Scene s = test::analytic_base_scene(4, 4, 64);
+  s.camera.position = {0.3, -0.2, 0.1};
+  s.camera.look_at = {1.0, 0.5, 2.0};
+  s.integrator.max_depth = 5000;
+  s.media.push_back(test::homogeneous_sphere("deep", {0, 0, 0}, 50.0, glm::dvec3(0.005), glm::dvec3(9.995), 0.3,
+                                             glm::dvec3(1.0, 0.0, 0.0), 1.0));
+  const double alpha = 9.995 / 10.0, events = (1.0 - std::pow(alpha, 5001.0)) / (1.0 - alpha);
+  const glm::dvec3 L = glm::dvec3(1.0, 0.0, 0.0) * (1.0 - std::pow(alpha, 5001.0));
+  Scene one = s;
+  one.integrator.emission_estimator = "absorption";
+  const RenderResult r = this->render(one, "long paths");
+  const test::ZTestReport rep = test::ztest_against_exact(r, [L](int, int) { return L; }, pooled(0.02));
+  EXPECT_TRUE(rep.ok) << rep.summary();
+  // Collisions per path: a truncated geometric count, SD < 1/(1 − α) = 2000
+  // per walk (three walks per sample on the CPU, one path on the GPU).
+  const double n = double(r.width) * r.height * r.spp, per_sample = r.events / n;
+  EXPECT_NEAR(per_sample, events, 5.0 * 2000.0 / std::sqrt(n)) << "events per sample";
+  std::printf("long paths: %s; events per sample %.1f (expected %.1f)\n", rep.summary().c_str(), per_sample, events);
+}
+
 // Temperatures 0, 1e-3, NaN and 1e6 K in one grid, in x-slabs of a temperature
 // grid on the density's lattice that extends beyond the density (so within a
 // slab T is constant wherever ρ > 0): index x <= −5: 0 K, −4..−1: 1e-3 K,
