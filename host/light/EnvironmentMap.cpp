@@ -119,12 +119,12 @@ glm::dvec2 EnvironmentMap::direction_to_uv(const glm::dvec3& dir) const {
   // Into the map's frame: Rz(−rotation)·dir.
   const double x = cos_rot_ * dir.x + sin_rot_ * dir.y;
   const double y = -sin_rot_ * dir.x + cos_rot_ * dir.y;
-  const double len = glm::length(dir);
-  const double cos_theta = std::clamp(dir.z / len, -1.0, 1.0);
   double u = 0.5 - std::atan2(y, x) / (2.0 * kPi);
   if (u >= 1.0) u -= 1.0;
   if (u < 0.0) u += 1.0;
-  return {u, std::acos(cos_theta) / kPi};
+  // θ from atan2, not acos(z/|dir|): acos loses all precision near the poles
+  // (1 − cos θ ≈ θ²/2 falls below double epsilon), and pdf() divides by sin θ.
+  return {u, std::atan2(std::hypot(x, y), dir.z) / kPi};
 }
 
 glm::dvec3 EnvironmentMap::uv_to_direction(const glm::dvec2& uv) const {
