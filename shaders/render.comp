@@ -47,6 +47,7 @@ layout(set = 0, binding = BINDING_DENSITY) uniform sampler3D density_tex[MAX_GRI
 layout(set = 0, binding = BINDING_TEMPERATURE) uniform sampler3D temperature_tex[MAX_GRIDS];
 layout(set = 0, binding = BINDING_BLACKBODY) uniform sampler1D blackbody_tex[MAX_GRIDS];
 layout(push_constant) uniform PassBlock { PassConstants pass_constants; };
+layout(std430, set = 0, binding = BINDING_PASS_STATUS) buffer PassStatusBlock { PassStatus pass_status; };
 // Surfaces (shaders/bvh.glsl's contract).
 layout(std430, set = 0, binding = BINDING_BVH_NODES) readonly buffer BvhNodes { GpuBvhNode bvh_nodes[]; };
 layout(std430, set = 0, binding = BINDING_BVH_TRIANGLES) readonly buffer BvhTriangles { GpuTriangle bvh_triangles[]; };
@@ -372,11 +373,15 @@ vec3 shadow_transmittance(vec3 o, vec3 d, float t_max, vec3 w, inout uint rng, i
   if (!any_hit) return vec3(1.0);
   vec3 T = vec3(1.0);
   float t = 0.0;
-  for (uint n = 0u; n < 65535u; ++n) {
+  // Two nested loops: llvmpipe ends any single loop after 65535 iterations
+  // (see main); 2^24 steps without the roulette ending the ray count as opaque.
+  bool done = false;
+  for (uint m = 0u; m < 1024u && !done; ++m) {
+   for (uint n = 0u; n < 16384u; ++n) {
     float t_next;
     bool any_ahead;
     float sigma_bar = majorant_at(o, d, t, span, t_next, any_ahead);
-    if (!any_ahead || t >= t_max) break;
+    if (!any_ahead || t >= t_max) { done = true; break; }
     if (sigma_bar <= 0.0) { t = t_next; continue; }
     float dt = sample_free_flight(sigma_bar, rng_next(rng));
     if (t + dt >= min(t_next, t_max)) { t = min(t_next, t_max); continue; }
@@ -394,7 +399,9 @@ vec3 shadow_transmittance(vec3 o, vec3 d, float t_max, vec3 w, inout uint rng, i
       if (rng_next(rng) >= q) return vec3(0.0);
       T /= q;
     }
+   }
   }
+  if (!done) return vec3(0.0);
   if (!isinf(t_max)) {
     float t_next;
     bool any_ahead;
@@ -720,8 +727,9 @@ void main() {
   PathStats stats = PathStats(0.0, 0.0);
   float nonfinite = 0.0;
   const uint first = pass_constants.sample_offset, last = first + pass_constants.spp;
+  uint k = first;  // the next sample: k < last after the loops means llvmpipe's loop budget ran out
   if (DEBUG_MODE != DEBUG_NONE) {
-    for (uint k = first; k < last; ++k) {
+    for (; k < last; ++k) {
       uint rng;
       PathState p = camera_path(pixel, k, rng);
       vec3 T = transmittance(p.o, p.d, DEBUG_MODE == DEBUG_RATIO_TRACKING, rng, stats);
@@ -735,10 +743,12 @@ void main() {
     // divergence halves throughput). Each sample keeps its own random stream, so
     // the result does not depend on the schedule.
     //
-    // Two nested loops, because llvmpipe ends any single loop after 65535
-    // iterations (per SIMD group): a dense pass would otherwise drop samples
-    // silently. The inner loop restarts its count at every entry.
-    uint k = first, rng;
+    // llvmpipe ends every loop of the invocation once all its loops together
+    // have run 65535 iterations (per SIMD group; PassStatus in gpu_types.h):
+    // unfinished samples are reported below and the host redoes the pass in
+    // smaller ones. (The nested loops are from when the limit was thought to
+    // be per loop; they cost nothing.)
+    uint rng;
     PathState p = camera_path(pixel, k, rng);
     vec2 span[MEDIA_N];
     while (k < last) {
@@ -754,6 +764,11 @@ void main() {
         if (++k < last) p = camera_path(pixel, k, rng);
       }
     }
+  }
+
+  if (k < last) {  // the pass ran out of loop budget: the host discards and redoes it
+    atomicAdd(pass_status.counts.x, last - k);
+    return;
   }
 
   // Kahan-compensated accumulation across passes.

@@ -81,6 +81,7 @@ void write_stats(const std::filesystem::path& file, const RenderArgs& args, cons
   j["lookups_per_second"] = result.seconds > 0 ? lookups_per_ray * new_samples / result.seconds : 0.0;
   j["events_per_path"] = samples > 0 ? result.events / samples : 0.0;
   j["nonfinite_samples"] = result.nonfinite_samples;
+  j["dropped_samples"] = result.dropped_samples;
   j["cancelled"] = result.cancelled;
   write_text_atomic(file, j.dump(2) + "\n");
 }

@@ -76,6 +76,9 @@ struct RenderResult {
   double density_lookups = 0.0;  // trilinear density samples
   double events = 0.0;           // real collisions (absorption + scattering)
   uint64_t nonfinite_samples = 0;
+  // Samples the device could not finish even one per pass (llvmpipe's loop
+  // budget, gpu_types.h PassStatus): counted in spp, contributing nothing.
+  uint64_t dropped_samples = 0;
   bool cancelled = false;
   std::vector<std::string> warnings;  // one line each (e.g. NaN voxels), printed by the CLI
   // When the render ended short of spp_target (cancelled, time limit): the

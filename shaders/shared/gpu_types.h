@@ -38,6 +38,7 @@ PYRO_CONST uint BINDING_EMISSION_CDF = 17;     // readonly buffer float[]: every
 PYRO_CONST uint BINDING_EMISSION_CELLS = 18;   // readonly buffer uint[]: the cells of its entries
 PYRO_CONST uint BINDING_EMISSION_PMF = 19;     // readonly buffer float[]: per-cell probabilities
 PYRO_CONST uint BINDING_EMISSION_HEADERS = 20; // uniform GpuEmissionCdf[MAX_GRIDS], by grid slot
+PYRO_CONST uint BINDING_PASS_STATUS = 21;      // buffer PassStatus: what the pass could not finish
 
 // Specialisation constants of render.comp: a scene pays only for what it uses.
 PYRO_CONST uint SPEC_HAS_GRIDS = 0;
@@ -118,6 +119,15 @@ struct PassConstants {
   uint pad1;
 };
 
+// What one pass reports back (zeroed before every pass). llvmpipe ends every
+// loop of an invocation once all loops together have run 65535 iterations
+// (Mesa gallivm: one "looplimiter" per function, lp_exec_endloop), so a pass
+// with too much work per SIMD group stops early; the host redoes it in
+// smaller passes (RenderSession::run_pass).
+struct PassStatus {
+  uvec4 counts;  // x: samples not finished (summed over pixels); yzw: 0
+};
+
 // Per-pixel accumulation, Kahan-compensated so float32 sums stay accurate over
 // thousands of passes (Kahan 1965; `precise` stops the compiler reassociating).
 struct AccumTexel {
@@ -134,6 +144,7 @@ static_assert(sizeof(FrameConstants) == 128);
 static_assert(offsetof(FrameConstants, image) == 80);
 static_assert(sizeof(PassConstants) == 16);
 static_assert(sizeof(AccumTexel) == 64);
+static_assert(sizeof(PassStatus) == 16);
 }  // namespace pyrolume::gpu
 #endif
 #endif

@@ -62,6 +62,10 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                           VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                       vk::MemoryKind::DeviceLocal, "accumulation");
+  accum_backup_ = vk::Buffer(ctx, accum_.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                             vk::MemoryKind::DeviceLocal, "accumulation before the pass");
+  pass_status_ = vk::Buffer(ctx, sizeof(gpu::PassStatus), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                            vk::MemoryKind::HostVisible, "pass status");
   create_textures(scene);
   create_surfaces(scene);
   create_environment(scene);
@@ -92,12 +96,14 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                         {gpu::BINDING_EMISSION_CDF, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_EMISSION_CELLS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_EMISSION_PMF, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                        {gpu::BINDING_EMISSION_HEADERS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}},
+                        {gpu::BINDING_EMISSION_HEADERS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+                        {gpu::BINDING_PASS_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
                     uint32_t(sizeof(gpu::PassConstants)), spec_, "render");
   set_.emplace(ctx, *pipeline_, "render set");
   set_->write_buffer(gpu::BINDING_FRAME, frame_buffer_);
   set_->write_buffer(gpu::BINDING_MEDIA, media_buffer_);
   set_->write_buffer(gpu::BINDING_ACCUM, accum_);
+  set_->write_buffer(gpu::BINDING_PASS_STATUS, pass_status_);
   set_->write_buffer(gpu::BINDING_GRIDS, grid_buffer_);
   write_grid_descriptors();
   set_->write_buffer(gpu::BINDING_BVH_NODES, bvh_nodes_);
@@ -393,6 +399,9 @@ void RenderSession::reset() {
 }
 
 void RenderSession::record_pass(VkCommandBuffer cmd, int spp) {
+  vkCmdFillBuffer(cmd, pass_status_.buffer(), 0, VK_WHOLE_SIZE, 0u);
+  vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                     VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   if (needs_clear_) {
     vkCmdFillBuffer(cmd, accum_.buffer(), 0, VK_WHOLE_SIZE, 0u);
     vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
@@ -438,15 +447,55 @@ VkResult injected_failure() {
 }  // namespace
 
 void RenderSession::run_pass(int spp) {
-  const int spp_before = spp_done_;
-  const bool clear_before = needs_clear_;
+  // What the accumulation holds after the last sub-pass that completed: a
+  // failure restores it, so the counters never claim samples it lacks.
+  int spp_ok = spp_done_;
+  bool clear_ok = needs_clear_;
   try {
     if (VkResult r = injected_failure(); r != VK_SUCCESS)
       vk::throw_vk_error("vkQueueSubmit (PYROLUME_TEST_FAIL_PASS)", r, __FILE__, __LINE__);
-    ctx_.submit_and_wait([&](VkCommandBuffer cmd) { record_pass(cmd, spp); });
+    // A pass the device cannot finish (llvmpipe's loop budget, PassStatus) is
+    // undone from the copy taken before it and redone in halves; the size that
+    // works is kept for the passes after it. Each sample keeps its index, so
+    // the result is the same as with passes that fit.
+    for (int remaining = spp; remaining > 0;) {
+      const int n = std::min(remaining, max_pass_spp_);
+      const bool clears = needs_clear_;
+      ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
+        if (!clears) {
+          const VkBufferCopy all{0, 0, accum_.size()};
+          vkCmdCopyBuffer(cmd, accum_.buffer(), accum_backup_.buffer(), 1, &all);
+          vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT,
+                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+        }
+        record_pass(cmd, n);
+      });
+      pass_status_.invalidate();
+      const uint32_t unfinished = pass_status_.data<gpu::PassStatus>()->counts.x;
+      if (unfinished == 0 || n == 1) {
+        dropped_samples_ += unfinished;  // at 1 spp per pass there is nothing left to split
+        remaining -= n;
+        spp_ok = spp_done_;
+        clear_ok = needs_clear_;
+        continue;
+      }
+      spp_done_ -= n;
+      if (clears) {
+        needs_clear_ = true;
+      } else {
+        ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
+          const VkBufferCopy all{0, 0, accum_.size()};
+          vkCmdCopyBuffer(cmd, accum_backup_.buffer(), accum_.buffer(), 1, &all);
+          vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                             VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT);
+        });
+      }
+      max_pass_spp_ = n / 2;
+    }
   } catch (const vk::VulkanError&) {
-    spp_done_ = spp_before;
-    needs_clear_ = clear_before;
+    spp_done_ = spp_ok;
+    needs_clear_ = clear_ok;
     throw;
   }
 }

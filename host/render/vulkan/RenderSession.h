@@ -48,6 +48,10 @@ class RenderSession {
   void run_pass(int spp);
 
   int spp_done() const { return spp_done_; }
+  // Passes are split when the device cannot finish them (PassStatus): the
+  // largest pass size that has worked, and the samples lost at 1 spp per pass.
+  int max_pass_spp() const { return max_pass_spp_; }
+  uint64_t dropped_samples() const { return dropped_samples_; }
   int width() const { return settings_.width; }
   int height() const { return settings_.height; }
   // AccumTexel per pixel (shaders/shared/gpu_types.h), row 0 = top.
@@ -107,6 +111,9 @@ class RenderSession {
   std::optional<vk::ComputePipeline> pipeline_;
   std::optional<vk::DescriptorSet> set_;
   std::vector<std::pair<uint32_t, uint32_t>> spec_;  // the variant pipeline_ was compiled for
+  vk::Buffer pass_status_, accum_backup_;  // PassStatus; the accumulation before the pass in flight
+  int max_pass_spp_ = 1 << 30;
+  uint64_t dropped_samples_ = 0;
   int spp_done_ = 0;
   bool needs_clear_ = true;
 };

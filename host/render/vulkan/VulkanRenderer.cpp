@@ -75,6 +75,7 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
   // checkpoint and otherwise at most every max(1 s, 20 readbacks' time), so
   // the readbacks cost under 5 %: it is what a lost device still lets us save.
   auto render_start = Clock::now();
+  const uint64_t dropped_before = session.dropped_samples();  // a kept session counts across frames
   const int per_pass = spp_per_pass(settings.width, settings.height, settings.spp);
   AccumulationState saved;
   if (control.resume) saved = *control.resume;  // a failure in the first pass still has the resumed samples
@@ -106,6 +107,12 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
     saved = {};  // (memory: the final readback replaces it)
     AccumulationState final_state = session.save_state();
     RenderSession::result_from_state(final_state, result);
+    result.dropped_samples = session.dropped_samples() - dropped_before;
+    if (result.dropped_samples > 0)
+      result.warnings.push_back(std::to_string(result.dropped_samples) +
+                                " samples did not finish even at 1 spp per pass (the driver's loop limit: llvmpipe runs "
+                                "at most 65535 loop iterations per dispatch); they count in spp and add nothing, so "
+                                "those pixels are darker than they should be. A real GPU has no such limit");
     if (result.spp < settings.spp) result.state = std::move(final_state);
   } catch (const vk::VulkanError& e) {
     const bool out_of_memory = e.result == VK_ERROR_OUT_OF_DEVICE_MEMORY || e.result == VK_ERROR_OUT_OF_HOST_MEMORY;
