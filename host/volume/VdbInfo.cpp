@@ -1,5 +1,6 @@
 #include "volume/VdbInfo.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -159,6 +160,10 @@ GridReport report_openvdb(const openvdb::GridBase& g, const std::string& file) {
 
 int info_openvdb(const std::string& file, bool values, std::ostream& out) {
   ensure_openvdb_initialized();
+  // OpenVDB trusts the lengths and offsets it reads: check them first, and
+  // with --values read only the trees the check walked.
+  const std::vector<std::string> walked =
+      validate_openvdb_file(file, [values](const std::string&) { return values; });
   try {
     openvdb::io::File f(file);
     f.open(/*delayLoad=*/false);
@@ -173,15 +178,17 @@ int info_openvdb(const std::string& file, bool values, std::ostream& out) {
     // Per grid, so that one unregistered grid type spoils only its own block.
     for (const std::string& name : names) {
       openvdb::GridBase::Ptr g;
+      const bool read_values = values && std::find(walked.begin(), walked.end(), name) != walked.end();
       try {
-        g = values ? f.readGrid(name) : f.readGridMetadata(name);
+        g = read_values ? f.readGrid(name) : f.readGridMetadata(name);
       } catch (const openvdb::Exception& e) {
         out << "grid \"" << name << "\"\n  unreadable: " << e.what() << "\n";
         continue;
       }
       GridReport r = report_openvdb(*g, file);
-      if (values) fill_from_values(*g, r);
+      if (read_values) fill_from_values(*g, r);
       else fill_from_metadata(*g, r);
+      if (values && !read_values) r.note = "values not read: " + r.type + " trees are not checked";
       print_report(r, out);
     }
   } catch (const openvdb::Exception& e) {
@@ -234,6 +241,7 @@ void nano_grid(const nanovdb::NanoGrid<BuildT>& grid, bool values, GridReport& r
 
 int info_nanovdb(const std::string& file, bool values, std::ostream& out) {
   std::vector<nanovdb::io::GridMetaData> metas;
+  validate_nanovdb_file(file);  // nanovdb::io allocates by the sizes it reads
   try {
     metas = nanovdb::io::readGridMetaData(file);
   } catch (const std::exception& e) {
@@ -260,6 +268,7 @@ int info_nanovdb(const std::string& file, bool values, std::ostream& out) {
     } catch (const std::exception& e) {
       r.note = std::string("grid unreadable: ") + e.what();
     }
+    if (h) validate_nanovdb_grid(h, file, r.name);  // before any accessor follows its offsets
     if (h) {
       if (auto* g = h.grid<float>()) nano_grid(*g, values, r);
       else if (auto* g = h.grid<double>()) nano_grid(*g, values, r);

@@ -280,6 +280,7 @@ std::vector<GridEntry> openvdb_grid_entries(openvdb::io::File& f) {
 VolumeGrids load_openvdb(const Medium& m, bool need_temperature) {
   ensure_openvdb_initialized();
   const std::string file = m.file.string();
+  validate_openvdb_file(m.file);  // OpenVDB trusts the lengths and offsets it reads
   VolumeGrids out;
   try {
     openvdb::io::File f(file);
@@ -287,6 +288,13 @@ VolumeGrids load_openvdb(const Medium& m, bool need_temperature) {
     // memory-mapped file would add its pages to the RSS we promise to bound.
     f.open(/*delayLoad=*/false);
     const GridChoice c = choose_grids(openvdb_grid_entries(f), m, need_temperature, file, out.warnings);
+    // The trees of the grids about to be read, before OpenVDB allocates by them.
+    const std::vector<std::string> walked = validate_openvdb_file(m.file, [&](const std::string& name) {
+      return name == c.density.name || (c.temperature && name == c.temperature->name);
+    });
+    for (const GridEntry* e : {&c.density, c.temperature ? &*c.temperature : nullptr})
+      if (e && std::find(walked.begin(), walked.end(), e->name) == walked.end())
+        throw input_error(file, "grid \"" + e->name + "\"", "its tree type cannot be checked, so it is not read");
     auto load = [&](const GridEntry& e, Role role) {
       openvdb::GridBase::Ptr g = f.readGrid(e.name);  // only this grid's tree is read
       out.tree_mem_bytes += g->baseTree().memUsage();
@@ -340,6 +348,7 @@ VolumeGrids load_nanovdb(const Medium& m, bool need_temperature) {
   const std::string file = m.file.string();
   VolumeGrids out;
   std::vector<nanovdb::io::GridMetaData> metas;
+  validate_nanovdb_file(m.file);  // nanovdb::io allocates by the sizes it reads
   try {
     metas = nanovdb::io::readGridMetaData(file);
   } catch (const std::exception& e) {
@@ -358,6 +367,7 @@ VolumeGrids load_nanovdb(const Medium& m, bool need_temperature) {
       throw input_error(file, role_key(role, e.name), std::string("cannot read NanoVDB grid: ") + ex.what());
     }
     if (!h) throw input_error(file, role_key(role, e.name), "cannot read NanoVDB grid");
+    validate_nanovdb_grid(h, file, e.name);  // before any accessor follows its offsets
     out.tree_mem_bytes += h.size();
     if (auto* g = h.grid<float>()) return dense_from_nanovdb(*g, m, role, file, out.warnings);
     if (auto* g = h.grid<double>()) return dense_from_nanovdb(*g, m, role, file, out.warnings);
