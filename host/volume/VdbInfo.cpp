@@ -217,11 +217,19 @@ void nano_grid(const nanovdb::NanoGrid<BuildT>& grid, bool values, GridReport& r
   const auto& b = grid.indexBBox();
   auto acc = grid.getAccessor();
   uint64_t n = 0;
+  // Visits every voxel of the box: refuse boxes too large to scan (a corrupt
+  // or huge bbox would run for hours). int64 counters: the box may end at INT32_MAX.
+  uint64_t box = 1;
+  for (int a = 0; a < 3; ++a) box *= uint64_t(std::max<int64_t>(0, int64_t(b.max()[a]) - b.min()[a] + 1));
+  if (box > (uint64_t(1) << 27)) {
+    r.note = "index bbox of " + std::to_string(box) + " voxels is too large to scan";
+    return;
+  }
   if (grid.activeVoxelCount() > 0)
-    for (int k = b.min()[2]; k <= b.max()[2]; ++k)
-      for (int j = b.min()[1]; j <= b.max()[1]; ++j)
-        for (int i = b.min()[0]; i <= b.max()[0]; ++i) {
-          const nanovdb::Coord ijk(i, j, k);
+    for (int64_t k = b.min()[2]; k <= b.max()[2]; ++k)
+      for (int64_t j = b.min()[1]; j <= b.max()[1]; ++j)
+        for (int64_t i = b.min()[0]; i <= b.max()[0]; ++i) {
+          const nanovdb::Coord ijk{int32_t(i), int32_t(j), int32_t(k)};
           if (!acc.isActive(ijk)) continue;
           ++n;
           const double v = double(acc.getValue(ijk));

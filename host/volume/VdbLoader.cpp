@@ -123,6 +123,8 @@ GridChoice choose_grids(const std::vector<GridEntry>& entries, const Medium& m, 
   return c;
 }
 
+uint64_t max_dense_texels = uint64_t(1) << 32;
+
 int64_t floor_div(int64_t a, int64_t k) { return a >= 0 ? a / k : -((-a + k - 1) / k); }
 
 // Fills a DenseGrid from active voxels. With downsample k, coarse voxel J
@@ -143,7 +145,7 @@ class DenseBuilder {
     const uint64_t texels = uint64_t(dims.x) * uint64_t(dims.y) * uint64_t(dims.z);
     // 2^32 texels is 16 GiB as float: past what any host or device here holds,
     // and texel offsets would overflow 32-bit shader arithmetic.
-    if (dims.x > (1 << 30) || dims.y > (1 << 30) || dims.z > (1 << 30) || texels > (uint64_t(1) << 32)) {
+    if (dims.x > (1 << 30) || dims.y > (1 << 30) || dims.z > (1 << 30) || texels > max_dense_texels) {
       std::ostringstream s;
       s << "active bounding box of " << dims.x - 2 << " x " << dims.y - 2 << " x " << dims.z - 2
         << " voxels is too large for a dense texture; use \"downsample\": k (box filter by k)";
@@ -331,10 +333,11 @@ DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Medium
   DenseBuilder b(out, {bbox.min()[0], bbox.min()[1], bbox.min()[2]}, {bbox.max()[0], bbox.max()[1], bbox.max()[2]},
                  m.downsample, role == Role::Density, file, role);
   auto acc = grid.getAccessor();
-  for (int k = bbox.min()[2]; k <= bbox.max()[2]; ++k)
-    for (int j = bbox.min()[1]; j <= bbox.max()[1]; ++j)
-      for (int i = bbox.min()[0]; i <= bbox.max()[0]; ++i) {
-        const nanovdb::Coord ijk(i, j, k);
+  // int64 counters: the box may end at INT32_MAX (DenseBuilder bounded its size).
+  for (int64_t k = bbox.min()[2]; k <= bbox.max()[2]; ++k)
+    for (int64_t j = bbox.min()[1]; j <= bbox.max()[1]; ++j)
+      for (int64_t i = bbox.min()[0]; i <= bbox.max()[0]; ++i) {
+        const nanovdb::Coord ijk{int32_t(i), int32_t(j), int32_t(k)};
         if (acc.isActive(ijk)) b.add(i, j, k, double(acc.getValue(ijk)));
       }
   b.finish();
@@ -383,6 +386,8 @@ VolumeGrids load_nanovdb(const Medium& m, bool need_temperature) {
 }
 
 }  // namespace
+
+void set_max_dense_texels(uint64_t texels) { max_dense_texels = std::min(texels, uint64_t(1) << 32); }
 
 VolumeGrids load_volume(const Medium& m, bool need_temperature) {
   const std::string file = m.file.string();

@@ -77,7 +77,12 @@ std::string outcome(const fs::path& p, F&& read) {
 // ---- VDB ----
 
 struct OpenVdbInit {
-  OpenVdbInit() { openvdb::initialize(); }
+  OpenVdbInit() {
+    openvdb::initialize();
+    // A damaged root origin can spread the few voxels over a legitimately
+    // huge box: refuse it (InputError) instead of filling gigabytes.
+    set_max_dense_texels(uint64_t(1) << 24);
+  }
 } const init_once;
 
 constexpr uint32_t kZipMask = openvdb::io::COMPRESS_ZIP | openvdb::io::COMPRESS_ACTIVE_MASK;
