@@ -307,6 +307,18 @@ Image read_stb(const fs::path& file, const std::vector<unsigned char>& bytes) {
     const char* why = stbi_failure_reason();
     return input_error(file.string(), "", std::string("cannot decode image: ") + (why ? why : "unknown format"));
   };
+  // stb_image decodes a truncated file as if the missing bytes were zero, so
+  // a 61-byte TGA header claiming 20000 x 20000 "decodes" to gigabytes (found
+  // by fuzz_image). Bound the size by the header first: no format stb reads
+  // packs more than ~1000 pixels into a byte (zlib's limit), so 4096 per byte
+  // of file leaves any real image through.
+  if (stbi_info_from_memory(data, len, &w, &h, &n)) {
+    const int64_t pixels = int64_t(w) * int64_t(h);
+    if (w < 1 || h < 1 || pixels > kExrMaxPixels || pixels > int64_t(bytes.size()) * 4096)
+      throw input_error(file.string(), "",
+                        "image header claims " + std::to_string(w) + " x " + std::to_string(h) + " pixels for a " +
+                            std::to_string(bytes.size()) + "-byte file (corrupt or truncated)");
+  }
   if (stbi_is_hdr_from_memory(data, len)) {
     float* px = stbi_loadf_from_memory(data, len, &w, &h, &n, 3);
     if (!px) throw fail();

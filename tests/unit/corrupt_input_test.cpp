@@ -249,6 +249,23 @@ TEST(CorruptExr, EveryTruncationAndDamagedByteIsReadOrRefused) {
   }
 }
 
+// Found by fuzz_image: stb_image "decodes" a truncated TGA as zeros, so a
+// 61-byte header claiming 20000 x 20000 pixels became 4.5 GB of floats.
+TEST(CorruptImage, TruncatedTgaWithHugeHeaderIsAnInputError) {
+  const auto dir = test::temp_dir("tga");
+  // Uncompressed true-colour TGA header: 18 bytes, width and height at 12 and 14.
+  Bytes b(61, 0);
+  b[2] = 2;
+  const uint16_t side = 20000;
+  std::memcpy(b.data() + 12, &side, 2);
+  std::memcpy(b.data() + 14, &side, 2);
+  b[16] = 24;
+  const fs::path p = dir / "huge.tga";
+  write_bytes(p, b, b.size());
+  const std::string msg = outcome(p, [&] { read_image(p); });
+  EXPECT_NE(msg.find("image header claims 20000 x 20000 pixels"), std::string::npos) << msg;
+}
+
 // ---- OBJ ----
 
 // load_obj ignores materials, so it must not open what a `mtllib` line names:
