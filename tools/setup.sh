@@ -5,7 +5,7 @@ set -euo pipefail
 PYROLUME_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 PYROLUME_BUILD="${PYROLUME_BUILD:-$PYROLUME_ROOT/build}"
 
-# Build tools, Vulkan (loader, headers, lavapipe, validation layers, glslang),
+# Build tools (clang + compiler-rt: the sanitizer and libFuzzer build), Vulkan (loader, headers, lavapipe, validation layers, glslang),
 # and the libraries the host uses.
 PYROLUME_PACKAGES=(
   build-essential cmake ninja-build pkg-config
@@ -13,6 +13,7 @@ PYROLUME_PACKAGES=(
   libopenvdb-dev libboost-iostreams-dev libnanovdb-dev libtbb-dev
   libglfw3-dev xvfb xauth python3 python3-matplotlib libtinyobjloader-dev
   libopenexr-dev libglm-dev nlohmann-json3-dev libcli11-dev libstb-dev libgtest-dev
+  clang libclang-rt-14-dev
 )
 
 pyrolume_install_packages() {
@@ -39,4 +40,16 @@ pyrolume_build() {
   jobs="$(nproc 2>/dev/null || echo 2)"
   cmake -S "$PYROLUME_ROOT" -B "$PYROLUME_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release >&2
   cmake --build "$PYROLUME_BUILD" -j "$jobs" >&2
+}
+
+# The clang ASan+UBSan+libFuzzer build (tools/sanitize, tools/fuzz; one build
+# dir serves both): pyrolume_core, the CLI, the unit tests and tests/fuzz.
+# -O2 keeps the Monte Carlo unit tests quick; no NDEBUG, so asserts are on.
+PYROLUME_FUZZ_BUILD="${PYROLUME_FUZZ_BUILD:-$PYROLUME_ROOT/build-fuzz}"
+pyrolume_build_fuzz() {
+  local jobs
+  jobs="$(nproc 2>/dev/null || echo 2)"
+  cmake -S "$PYROLUME_ROOT" -B "$PYROLUME_FUZZ_BUILD" -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1" -DPYROLUME_FUZZ=ON >&2
+  cmake --build "$PYROLUME_FUZZ_BUILD" -j "$jobs" >&2
 }

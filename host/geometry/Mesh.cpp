@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 // The only translation unit that compiles tinyobjloader (header-only use).
@@ -31,28 +32,36 @@ Mesh load_obj(const std::filesystem::path& file) {
   std::error_code ec;
   if (!std::filesystem::exists(file, ec)) throw input_error(name, "", "no such file");
   if (std::filesystem::is_directory(file, ec)) throw input_error(name, "", "is a directory, not an OBJ file");
+  std::string text;
   {
-    std::ifstream probe(file, std::ios::binary);
-    if (!probe) throw input_error(name, "", "cannot open for reading");
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw input_error(name, "", "cannot open for reading");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    if (in.bad()) throw input_error(name, "", "cannot read");
+    text = ss.str();
   }
 
-  tinyobj::ObjReaderConfig config;
-  config.triangulate = true;
-  config.vertex_color = false;
-  config.mtl_search_path = file.parent_path().string();
-  tinyobj::ObjReader reader;
-  if (!reader.ParseFromFile(name, config))
-    throw input_error(name, "", "not a valid OBJ file: " + first_line(reader.Error()));
+  // From memory, with no material reader: materials are ignored anyway, and
+  // reading them would open whatever path a `mtllib` line names (a FIFO or
+  // "mtllib /dev/zero" would block or read forever).
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> materials;
+  std::string warn, err;
+  std::istringstream stream(text);
+  const bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream, /*readMatFn=*/nullptr,
+                                   /*triangulate=*/true, /*default_vcols_fallback=*/false);
+  if (!ok) throw input_error(name, "", "not a valid OBJ file: " + first_line(err));
   // A mesh whose first line already failed to parse often "succeeds" with
   // errors recorded; treat any error text as fatal.
-  if (!reader.Error().empty()) throw input_error(name, "", "not a valid OBJ file: " + first_line(reader.Error()));
+  if (!err.empty()) throw input_error(name, "", "not a valid OBJ file: " + first_line(err));
 
   // tinyobjloader skips a polygon with an out-of-range index with only a
   // warning: a mesh with holes must not render silently.
-  if (reader.Warning().find("invalid vertex index") != std::string::npos)
+  if (warn.find("invalid vertex index") != std::string::npos)
     throw input_error(name, "", "a face uses a vertex index out of range");
 
-  const tinyobj::attrib_t& attrib = reader.GetAttrib();
   Mesh mesh;
   const size_t np = attrib.vertices.size() / 3, nn = attrib.normals.size() / 3, nt = attrib.texcoords.size() / 2;
   mesh.positions.resize(np);
@@ -78,7 +87,7 @@ Mesh load_obj(const std::filesystem::path& file) {
     mesh.uvs[i] = uv;
   }
 
-  for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+  for (const tinyobj::shape_t& shape : shapes) {
     const auto& idx = shape.mesh.indices;
     size_t offset = 0;
     for (size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f) {

@@ -14,12 +14,14 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <new>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "image/AtomicFile.h"
 #include "util/Error.h"
@@ -112,10 +114,149 @@ void write_png(std::ostream& os, const Image& img, double exposure_stops) {
     throw std::runtime_error("PNG encoding failed");
 }
 
-Image read_exr(const fs::path& file) {
-  Imf::InputFile in(file.c_str());
+// OpenEXR input over the bytes read_image already holds, so the header checks
+// below and OpenEXR see the same data.
+class MemoryIStream : public Imf::IStream {
+ public:
+  MemoryIStream(const std::vector<unsigned char>& bytes, const std::string& name)
+      : Imf::IStream(name.c_str()), bytes_(bytes) {}
+  bool read(char c[], int n) override {
+    if (n < 0 || uint64_t(n) > bytes_.size() - pos_) throw std::runtime_error("early end of file");
+    std::memcpy(c, bytes_.data() + pos_, size_t(n));
+    pos_ += uint64_t(n);
+    return pos_ < bytes_.size();
+  }
+  uint64_t tellg() override { return pos_; }
+  void seekg(uint64_t pos) override {
+    if (pos > bytes_.size()) throw std::runtime_error("seek past the end of the file");
+    pos_ = pos;
+  }
+
+ private:
+  const std::vector<unsigned char>& bytes_;
+  uint64_t pos_ = 0;
+};
+
+// Limits on what an EXR header may ask for, checked before OpenEXR allocates
+// by it (its InputFile constructor sizes line buffers and the chunk offset
+// table from the header, and some attributes size arrays from their own
+// fields). Generous for any real image; docs/robustness.md lists them.
+constexpr int64_t kExrMaxPixels = int64_t(1) << 28;          // 16384 x 16384
+constexpr int64_t kExrMaxSide = int64_t(1) << 20;
+constexpr uint64_t kExrMaxChunkBytes = uint64_t(1) << 28;   // one scanline block or tile, decoded
+
+// Walks the EXR header(s): every attribute's size within the file, the
+// preview image and string vectors consistent with their sizes, and from
+// dataWindow, channels, compression and tiles: the image size, the bytes one
+// chunk decodes to and the offset table the file must hold.
+void check_exr_header(const std::vector<unsigned char>& b, const std::string& name) {
+  auto fail = [&](const std::string& why) { return input_error(name, "", "corrupt EXR: " + why); };
+  size_t p = 8;
+  if (b.size() < p) throw fail("truncated header");
+  uint32_t version;
+  std::memcpy(&version, b.data() + 4, 4);
+  const bool tiled_flag = version & 0x200, multipart = version & 0x1000;
+  auto i32 = [&](size_t at) {
+    int32_t v;
+    std::memcpy(&v, b.data() + at, 4);
+    return v;
+  };
+  auto cstring = [&](const char* what) {
+    const size_t start = p;
+    while (p < b.size() && b[p] != 0) ++p;
+    if (p >= b.size()) throw fail(std::string("unterminated ") + what);
+    return std::string(reinterpret_cast<const char*>(b.data() + start), p++ - start);
+  };
+  uint64_t table_entries = 0;
+  for (int part = 0;; ++part) {
+    if (p >= b.size()) throw fail("truncated header");
+    if (multipart && b[p] == 0) break;  // the empty header ends the list
+    bool have_dw = false, have_channels = false, tiled = tiled_flag && !multipart;
+    int64_t x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+    uint64_t pixel_bytes = 0;
+    int compression = 0;
+    uint32_t tw = 0, th = 0, level_mode = 0;
+    for (;;) {
+      const std::string attr = cstring("attribute name");
+      if (attr.empty()) break;
+      const std::string type = cstring("attribute type");
+      if (b.size() - p < 4) throw fail("truncated attribute \"" + attr + "\"");
+      const int32_t size = i32(p);
+      p += 4;
+      if (size < 0 || uint64_t(size) > b.size() - p)
+        throw fail("attribute \"" + attr + "\" claims " + std::to_string(size) + " bytes, past the end of the file");
+      const size_t v = p, end = p + size_t(size);
+      if (type == "preview") {
+        // PreviewImage: width, height, then 4 bytes per pixel.
+        if (size < 8) throw fail("preview attribute too short");
+        const int64_t w = uint32_t(i32(v)), h = uint32_t(i32(v + 4));
+        if (w * h * 4 != int64_t(size) - 8) throw fail("preview image size does not match its attribute");
+      } else if (type == "stringvector") {
+        for (size_t q = v; q < end;) {
+          if (end - q < 4) throw fail("string vector attribute \"" + attr + "\" truncated");
+          const int32_t n = i32(q);
+          q += 4;
+          if (n < 0 || size_t(n) > end - q) throw fail("string vector attribute \"" + attr + "\" overruns its size");
+          q += size_t(n);
+        }
+      } else if (attr == "dataWindow" && type == "box2i" && size == 16) {
+        x0 = i32(v), y0 = i32(v + 4), x1 = i32(v + 8), y1 = i32(v + 12);
+        have_dw = true;
+      } else if (attr == "compression" && type == "compression" && size == 1) {
+        compression = b[v];
+      } else if (attr == "tiles" && type == "tiledesc" && size == 9) {
+        tw = uint32_t(i32(v)), th = uint32_t(i32(v + 4)), level_mode = b[v + 8] & 0x0f;
+        tiled = true;
+      } else if (attr == "channels" && type == "chlist") {
+        // name\0, int32 pixel type, 4 bytes, int32 x and y sampling; "\0" ends it.
+        have_channels = true;
+        for (size_t q = v; q < end;) {
+          if (b[q] == 0) break;
+          while (q < end && b[q] != 0) ++q;
+          if (end - q < 17) throw fail("channel list truncated");
+          const int32_t t = i32(q + 1);
+          pixel_bytes += t == 1 ? 2 : 4;  // HALF, else UINT / FLOAT
+          q += 17;
+        }
+      }
+      p = end;
+    }
+    if (!have_dw || !have_channels) throw fail("header lacks dataWindow or channels");
+    const int64_t w = x1 - x0 + 1, h = y1 - y0 + 1;
+    if (w < 1 || h < 1 || w > kExrMaxSide || h > kExrMaxSide || w * h > kExrMaxPixels)
+      throw fail("data window " + std::to_string(w) + " x " + std::to_string(h) + " is empty or larger than " +
+                 std::to_string(kExrMaxPixels) + " pixels");
+    if (tiled) {
+      if (tw < 1 || th < 1 || uint64_t(tw) * th * std::max<uint64_t>(pixel_bytes, 1) > kExrMaxChunkBytes)
+        throw fail("tile size " + std::to_string(tw) + " x " + std::to_string(th) + " is invalid or too large");
+      // Tiles of every level (mip or rip levels rounded down): one offset each.
+      const auto tiles = [&](int64_t lw, int64_t lh) { return uint64_t((lw + tw - 1) / tw) * ((lh + th - 1) / th); };
+      int lx = 1, ly = 1;
+      if (level_mode != 0)
+        while ((w >> lx) > 0 || (h >> lx) > 0) ++lx;
+      if (level_mode == 2) ly = lx;  // ripmap: every x level by every y level
+      for (int a = 0; a < lx; ++a)
+        for (int c = 0; c < (level_mode == 2 ? ly : 1); ++c)
+          table_entries += tiles(std::max<int64_t>(w >> a, 1), std::max<int64_t>(h >> (level_mode == 2 ? c : a), 1));
+    } else {
+      static const int lines[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
+      const int per_chunk = compression >= 0 && compression < 10 ? lines[compression] : 1;
+      if (uint64_t(w) * pixel_bytes * uint64_t(per_chunk) > kExrMaxChunkBytes)
+        throw fail(std::to_string(w) + " pixels of " + std::to_string(pixel_bytes) +
+                   " bytes per scanline block of " + std::to_string(per_chunk) + " lines is too large");
+      table_entries += uint64_t((h + per_chunk - 1) / per_chunk);
+    }
+    if (!multipart) break;
+  }
+  if (table_entries * 8 > b.size() - std::min<size_t>(p, b.size()))
+    throw fail("the file is too short for the " + std::to_string(table_entries) + " chunks its header describes");
+}
+
+Image read_exr(const fs::path& file, const std::vector<unsigned char>& bytes) {
+  check_exr_header(bytes, file.string());
+  MemoryIStream stream(bytes, file.string());
+  Imf::InputFile in(stream);
   const Imath::Box2i dw = in.header().dataWindow();
-  Image img = make_image(dw.max.x - dw.min.x + 1, dw.max.y - dw.min.y + 1);
   const Imf::ChannelList& ch = in.header().channels();
   auto has = [&](const char* n) { return ch.findChannel(n) != nullptr; };
 
@@ -127,22 +268,34 @@ Image read_exr(const fs::path& file) {
   int var_count = int(has(var_names[0])) + int(has(var_names[1])) + int(has(var_names[2]));
   if (var_count != 0 && var_count != 3)
     throw input_error(file.string(), "", "EXR has only some of variance.R, variance.G, variance.B");
-  if (var_count == 3) img.variance.assign(img.rgb.size(), 0.0f);
 
-  // Slices are addressed by absolute data-window coordinates (OpenEXR convention),
-  // so the base pointer is shifted back by the window origin.
-  const size_t xs = 3 * sizeof(float), ys = xs * size_t(img.width);
-  auto base = [&](std::vector<float>& v, int c) {
-    return (char*)(v.data() + c) - ptrdiff_t(dw.min.x) * ptrdiff_t(xs) - ptrdiff_t(dw.min.y) * ptrdiff_t(ys);
-  };
-  // A FrameBuffer maps each name once, so a Y-only file fills R and is copied to G, B.
-  Imf::FrameBuffer fb;
-  for (int c = 0; c < 3; ++c) {
-    if (!gray || c == 0) fb.insert(gray ? "Y" : names[c], Imf::Slice(Imf::FLOAT, base(img.rgb, c), xs, ys, 1, 1, 0.0));
-    if (var_count == 3) fb.insert(var_names[c], Imf::Slice(Imf::FLOAT, base(img.variance, c), xs, ys, 1, 1, 0.0));
+  // Read in blocks of rows, growing the image as they decode: memory follows
+  // the pixel data the file really holds, not what a corrupt header claims
+  // (check_exr_header has bounded the window). Slice::Make addresses each
+  // block by absolute data-window coordinates without out-of-range pointer
+  // arithmetic.
+  Image img;
+  img.width = dw.max.x - dw.min.x + 1;
+  img.height = dw.max.y - dw.min.y + 1;
+  const size_t row_floats = size_t(img.width) * 3, xs = 3 * sizeof(float), ys = xs * size_t(img.width);
+  const int rows_per_block = int(std::max<size_t>(1, (size_t(16) << 20) / ys));
+  for (int y0 = 0; y0 < img.height; y0 += rows_per_block) {
+    const int rows = std::min(rows_per_block, img.height - y0);
+    img.rgb.resize(size_t(y0 + rows) * row_floats, 0.0f);
+    if (var_count == 3) img.variance.resize(img.rgb.size(), 0.0f);
+    const Imath::Box2i block(Imath::V2i(dw.min.x, dw.min.y + y0), Imath::V2i(dw.max.x, dw.min.y + y0 + rows - 1));
+    // A FrameBuffer maps each name once, so a Y-only file fills R and is copied to G, B.
+    Imf::FrameBuffer fb;
+    for (int c = 0; c < 3; ++c) {
+      const size_t at = size_t(y0) * row_floats + size_t(c);
+      if (!gray || c == 0)
+        fb.insert(gray ? "Y" : names[c], Imf::Slice::Make(Imf::FLOAT, img.rgb.data() + at, block, xs, ys));
+      if (var_count == 3)
+        fb.insert(var_names[c], Imf::Slice::Make(Imf::FLOAT, img.variance.data() + at, block, xs, ys));
+    }
+    in.setFrameBuffer(fb);
+    in.readPixels(block.min.y, block.max.y);
   }
-  in.setFrameBuffer(fb);
-  in.readPixels(dw.min.y, dw.max.y);
   if (gray)
     for (size_t i = 0; i < img.rgb.size(); i += 3) img.rgb[i + 1] = img.rgb[i + 2] = img.rgb[i];
   if (auto* a = in.header().findTypedAttribute<Imf::IntAttribute>("spp")) img.spp = a->value();
@@ -159,6 +312,18 @@ Image read_stb(const fs::path& file, const std::vector<unsigned char>& bytes) {
     const char* why = stbi_failure_reason();
     return input_error(file.string(), "", std::string("cannot decode image: ") + (why ? why : "unknown format"));
   };
+  // stb_image decodes a truncated file as if the missing bytes were zero, so
+  // a 61-byte TGA header claiming 20000 x 20000 "decodes" to gigabytes (found
+  // by fuzz_image). Bound the size by the header first: no format stb reads
+  // packs more than ~1000 pixels into a byte (zlib's limit), so 4096 per byte
+  // of file leaves any real image through.
+  if (stbi_info_from_memory(data, len, &w, &h, &n)) {
+    const int64_t pixels = int64_t(w) * int64_t(h);
+    if (w < 1 || h < 1 || pixels > kExrMaxPixels || pixels > int64_t(bytes.size()) * 4096)
+      throw input_error(file.string(), "",
+                        "image header claims " + std::to_string(w) + " x " + std::to_string(h) + " pixels for a " +
+                            std::to_string(bytes.size()) + "-byte file (corrupt or truncated)");
+  }
   if (stbi_is_hdr_from_memory(data, len)) {
     float* px = stbi_loadf_from_memory(data, len, &w, &h, &n, 3);
     if (!px) throw fail();
@@ -221,7 +386,7 @@ Image read_image(const fs::path& file) {
   // EXR magic number 20000630 (little-endian 76 2f 31 01).
   const bool exr = bytes.size() >= 4 && bytes[0] == 0x76 && bytes[1] == 0x2f && bytes[2] == 0x31 && bytes[3] == 0x01;
   try {
-    return exr ? read_exr(file) : read_stb(file, bytes);
+    return exr ? read_exr(file, bytes) : read_stb(file, bytes);
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {  // Iex from a corrupt or truncated EXR; bad_alloc from a bogus size

@@ -328,8 +328,9 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
   json root;
   try {
     root = json::parse(json_text);
-  } catch (const json::parse_error& e) {
-    // nlohmann's message carries the byte offset; keep it on one line.
+  } catch (const json::exception& e) {
+    // parse_error, and out_of_range for a number beyond double (1e400: found
+    // by fuzz_scene). nlohmann's message carries the byte offset; keep it on one line.
     std::string what = e.what();
     throw input_error(fname, "", "invalid JSON: " + what);
   }

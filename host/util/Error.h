@@ -10,11 +10,15 @@ struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// "FILE: KEY: REASON" — the shape every input error message takes.
+// "FILE: KEY: REASON" — the shape every input error message takes. Line
+// breaks (library messages such as NanoVDB's carry "\n\t") become spaces, so
+// the message stays one line.
 inline InputError input_error(const std::string& file, const std::string& key, const std::string& reason) {
   std::string msg = file;
   if (!key.empty()) msg += ": " + key;
   msg += ": " + reason;
+  for (char& c : msg)
+    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
   return InputError(msg);
 }
 

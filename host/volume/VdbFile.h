@@ -3,10 +3,14 @@
 // telling OpenVDB from NanoVDB files, initialising OpenVDB once, and turning a
 // grid's index->world map into a GLM matrix.
 #include <filesystem>
+#include <functional>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 #include <nanovdb/NanoVDB.h>
+#include <nanovdb/util/GridHandle.h>
+#include <nanovdb/util/HostBuffer.h>
 #include <openvdb/math/Transform.h>
 
 namespace pyrolume {
@@ -16,6 +20,36 @@ enum class VolumeFormat { OpenVdb, NanoVdb };
 // By magic bytes, not by extension. Throws InputError for a missing file, a
 // folder, or anything that is neither format.
 VolumeFormat detect_volume_format(const std::filesystem::path& file);
+
+// Walks an OpenVDB file's framing with every length, count and offset checked
+// against the file size, before OpenVDB reads it: OpenVDB trusts those numbers
+// and, on a corrupt or truncated file, allocates whatever a length field says
+// (gigabytes for a four-byte string), loops past the end, leaks nodes or reads
+// past its buffers. Checks the header, the file and grid metadata, the grid
+// descriptors and transforms and, for the grids `walk_tree` accepts (by grid
+// name), the tree: root tiles and children, internal and leaf node masks and
+// every compressed value chunk's size (ZIP, Blosc, raw; half or full
+// precision). Trees are walked for the value types pyrolume reads or prints
+// (float, double, int32, int64, vec3s, vec3d, vec3i on the standard 5-4-3
+// tree); file format versions 222 (OpenVDB 3, 2014) to 224.
+// Returns the names of the grids whose trees were walked; throws InputError
+// naming the file, the grid and what is wrong. (docs/robustness.md, "Fuzzing")
+std::vector<std::string> validate_openvdb_file(const std::filesystem::path& file,
+                                               const std::function<bool(const std::string&)>& walk_tree = {});
+
+// NanoVDB files: each segment header, grid metadata record and name, and each
+// grid's stored size checked against the file before nanovdb::io reads them
+// (it allocates by the stored sizes and reads names up to a NUL); only
+// uncompressed grids (this build has neither Blosc nor ZIP for NanoVDB).
+void validate_nanovdb_file(const std::filesystem::path& file);
+
+// A NanoVDB grid buffer as read, before any accessor walks it: the grid and
+// tree headers, and every node offset an accessor follows (root tiles ->
+// upper -> lower -> leaf nodes) inside the buffer and 32-byte aligned, FpN
+// bit widths valid. Grids of types pyrolume does not read values of are only
+// checked up to the tree header. Throws InputError naming file and grid.
+void validate_nanovdb_grid(const nanovdb::GridHandle<nanovdb::HostBuffer>& handle, const std::string& file,
+                           const std::string& grid);
 
 // openvdb::initialize() exactly once per process (it registers the grid types
 // that io::File needs to read anything).

@@ -1,5 +1,6 @@
 #include "volume/VdbInfo.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -159,6 +160,10 @@ GridReport report_openvdb(const openvdb::GridBase& g, const std::string& file) {
 
 int info_openvdb(const std::string& file, bool values, std::ostream& out) {
   ensure_openvdb_initialized();
+  // OpenVDB trusts the lengths and offsets it reads: check them first, and
+  // with --values read only the trees the check walked.
+  const std::vector<std::string> walked =
+      validate_openvdb_file(file, [values](const std::string&) { return values; });
   try {
     openvdb::io::File f(file);
     f.open(/*delayLoad=*/false);
@@ -173,15 +178,17 @@ int info_openvdb(const std::string& file, bool values, std::ostream& out) {
     // Per grid, so that one unregistered grid type spoils only its own block.
     for (const std::string& name : names) {
       openvdb::GridBase::Ptr g;
+      const bool read_values = values && std::find(walked.begin(), walked.end(), name) != walked.end();
       try {
-        g = values ? f.readGrid(name) : f.readGridMetadata(name);
+        g = read_values ? f.readGrid(name) : f.readGridMetadata(name);
       } catch (const openvdb::Exception& e) {
         out << "grid \"" << name << "\"\n  unreadable: " << e.what() << "\n";
         continue;
       }
       GridReport r = report_openvdb(*g, file);
-      if (values) fill_from_values(*g, r);
+      if (read_values) fill_from_values(*g, r);
       else fill_from_metadata(*g, r);
+      if (values && !read_values) r.note = "values not read: " + r.type + " trees are not checked";
       print_report(r, out);
     }
   } catch (const openvdb::Exception& e) {
@@ -210,11 +217,19 @@ void nano_grid(const nanovdb::NanoGrid<BuildT>& grid, bool values, GridReport& r
   const auto& b = grid.indexBBox();
   auto acc = grid.getAccessor();
   uint64_t n = 0;
+  // Visits every voxel of the box: refuse boxes too large to scan (a corrupt
+  // or huge bbox would run for hours). int64 counters: the box may end at INT32_MAX.
+  uint64_t box = 1;
+  for (int a = 0; a < 3; ++a) box *= uint64_t(std::max<int64_t>(0, int64_t(b.max()[a]) - b.min()[a] + 1));
+  if (box > (uint64_t(1) << 27)) {
+    r.note = "index bbox of " + std::to_string(box) + " voxels is too large to scan";
+    return;
+  }
   if (grid.activeVoxelCount() > 0)
-    for (int k = b.min()[2]; k <= b.max()[2]; ++k)
-      for (int j = b.min()[1]; j <= b.max()[1]; ++j)
-        for (int i = b.min()[0]; i <= b.max()[0]; ++i) {
-          const nanovdb::Coord ijk(i, j, k);
+    for (int64_t k = b.min()[2]; k <= b.max()[2]; ++k)
+      for (int64_t j = b.min()[1]; j <= b.max()[1]; ++j)
+        for (int64_t i = b.min()[0]; i <= b.max()[0]; ++i) {
+          const nanovdb::Coord ijk{int32_t(i), int32_t(j), int32_t(k)};
           if (!acc.isActive(ijk)) continue;
           ++n;
           const double v = double(acc.getValue(ijk));
@@ -234,6 +249,7 @@ void nano_grid(const nanovdb::NanoGrid<BuildT>& grid, bool values, GridReport& r
 
 int info_nanovdb(const std::string& file, bool values, std::ostream& out) {
   std::vector<nanovdb::io::GridMetaData> metas;
+  validate_nanovdb_file(file);  // nanovdb::io allocates by the sizes it reads
   try {
     metas = nanovdb::io::readGridMetaData(file);
   } catch (const std::exception& e) {
@@ -260,6 +276,7 @@ int info_nanovdb(const std::string& file, bool values, std::ostream& out) {
     } catch (const std::exception& e) {
       r.note = std::string("grid unreadable: ") + e.what();
     }
+    if (h) validate_nanovdb_grid(h, file, r.name);  // before any accessor follows its offsets
     if (h) {
       if (auto* g = h.grid<float>()) nano_grid(*g, values, r);
       else if (auto* g = h.grid<double>()) nano_grid(*g, values, r);

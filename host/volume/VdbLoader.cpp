@@ -123,6 +123,8 @@ GridChoice choose_grids(const std::vector<GridEntry>& entries, const Medium& m, 
   return c;
 }
 
+uint64_t max_dense_texels = uint64_t(1) << 32;
+
 int64_t floor_div(int64_t a, int64_t k) { return a >= 0 ? a / k : -((-a + k - 1) / k); }
 
 // Fills a DenseGrid from active voxels. With downsample k, coarse voxel J
@@ -168,7 +170,7 @@ class DenseBuilder {
     }
     // 2^32 texels is 16 GiB as float: past what any host or device here holds,
     // and texel offsets would overflow 32-bit shader arithmetic.
-    if (dims.x > (1 << 30) || dims.y > (1 << 30) || dims.z > (1 << 30) || texels > (uint64_t(1) << 32)) {
+    if (dims.x > (1 << 30) || dims.y > (1 << 30) || dims.z > (1 << 30) || texels > max_dense_texels) {
       std::ostringstream s;
       s << "active bounding box of " << dims.x - 2 << " x " << dims.y - 2 << " x " << dims.z - 2
         << " voxels is too large for a dense texture; use \"downsample\": k (box filter by k)";
@@ -305,6 +307,7 @@ std::vector<GridEntry> openvdb_grid_entries(openvdb::io::File& f) {
 VolumeGrids load_openvdb(const Medium& m, bool need_temperature, const DenseLimits& limits) {
   ensure_openvdb_initialized();
   const std::string file = m.file.string();
+  validate_openvdb_file(m.file);  // OpenVDB trusts the lengths and offsets it reads
   VolumeGrids out;
   try {
     openvdb::io::File f(file);
@@ -312,6 +315,13 @@ VolumeGrids load_openvdb(const Medium& m, bool need_temperature, const DenseLimi
     // memory-mapped file would add its pages to the RSS we promise to bound.
     f.open(/*delayLoad=*/false);
     const GridChoice c = choose_grids(openvdb_grid_entries(f), m, need_temperature, file, out.warnings);
+    // The trees of the grids about to be read, before OpenVDB allocates by them.
+    const std::vector<std::string> walked = validate_openvdb_file(m.file, [&](const std::string& name) {
+      return name == c.density.name || (c.temperature && name == c.temperature->name);
+    });
+    for (const GridEntry* e : {&c.density, c.temperature ? &*c.temperature : nullptr})
+      if (e && std::find(walked.begin(), walked.end(), e->name) == walked.end())
+        throw input_error(file, "grid \"" + e->name + "\"", "its tree type cannot be checked, so it is not read");
     auto load = [&](const GridEntry& e, Role role) {
       openvdb::GridBase::Ptr g = f.readGrid(e.name);  // only this grid's tree is read
       out.tree_mem_bytes += g->baseTree().memUsage();
@@ -348,10 +358,11 @@ DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Medium
   DenseBuilder b(out, {bbox.min()[0], bbox.min()[1], bbox.min()[2]}, {bbox.max()[0], bbox.max()[1], bbox.max()[2]},
                  m.downsample, role == Role::Density, file, role, limits);
   auto acc = grid.getAccessor();
-  for (int k = bbox.min()[2]; k <= bbox.max()[2]; ++k)
-    for (int j = bbox.min()[1]; j <= bbox.max()[1]; ++j)
-      for (int i = bbox.min()[0]; i <= bbox.max()[0]; ++i) {
-        const nanovdb::Coord ijk(i, j, k);
+  // int64 counters: the box may end at INT32_MAX (DenseBuilder bounded its size).
+  for (int64_t k = bbox.min()[2]; k <= bbox.max()[2]; ++k)
+    for (int64_t j = bbox.min()[1]; j <= bbox.max()[1]; ++j)
+      for (int64_t i = bbox.min()[0]; i <= bbox.max()[0]; ++i) {
+        const nanovdb::Coord ijk{int32_t(i), int32_t(j), int32_t(k)};
         if (acc.isActive(ijk)) b.add(i, j, k, double(acc.getValue(ijk)));
       }
   b.finish();
@@ -365,6 +376,7 @@ VolumeGrids load_nanovdb(const Medium& m, bool need_temperature, const DenseLimi
   const std::string file = m.file.string();
   VolumeGrids out;
   std::vector<nanovdb::io::GridMetaData> metas;
+  validate_nanovdb_file(m.file);  // nanovdb::io allocates by the sizes it reads
   try {
     metas = nanovdb::io::readGridMetaData(file);
   } catch (const std::exception& e) {
@@ -383,6 +395,7 @@ VolumeGrids load_nanovdb(const Medium& m, bool need_temperature, const DenseLimi
       throw input_error(file, role_key(role, e.name), std::string("cannot read NanoVDB grid: ") + ex.what());
     }
     if (!h) throw input_error(file, role_key(role, e.name), "cannot read NanoVDB grid");
+    validate_nanovdb_grid(h, file, e.name);  // before any accessor follows its offsets
     out.tree_mem_bytes += h.size();
     if (auto* g = h.grid<float>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
     if (auto* g = h.grid<double>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
@@ -398,6 +411,8 @@ VolumeGrids load_nanovdb(const Medium& m, bool need_temperature, const DenseLimi
 }
 
 }  // namespace
+
+void set_max_dense_texels(uint64_t texels) { max_dense_texels = std::min(texels, uint64_t(1) << 32); }
 
 VolumeGrids load_volume(const Medium& m, bool need_temperature, const DenseLimits& limits) {
   const std::string file = m.file.string();

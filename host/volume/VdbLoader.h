@@ -1,6 +1,8 @@
 #pragma once
 // Loads the grids a `type: vdb` medium names from an OpenVDB (.vdb) or NanoVDB
 // (.nvdb) file into dense arrays (docs/volumes.md).
+#include <cstdint>
+
 #include <glm/glm.hpp>
 
 #include "scene/Scene.h"
@@ -21,6 +23,13 @@ inline constexpr const char* kDefaultDensityGrid = "density";
 // VolumeGrids::warnings. A grid past `limits` throws InputError (file, grid,
 // the limit, the "downsample" that would fit) before its dense array exists.
 VolumeGrids load_volume(const Medium& m, bool need_temperature, const DenseLimits& limits = {});
+
+// The most texels one dense grid may have (default 2^32, 16 GiB as float:
+// past what any host or device here holds); beyond it load_volume throws
+// InputError and suggests "downsample". The fuzz target and the corrupt-input
+// tests lower it: a few bytes of active tiles can describe a legitimately huge
+// volume, and allocating it teaches them nothing.
+void set_max_dense_texels(uint64_t texels);
 
 // The medium's `transform` as a matrix: T * Rz * Ry * Rx * S, i.e. scale first,
 // then rotate about X, Y, Z (degrees, right-handed), then translate.
