@@ -130,6 +130,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"fov", R"({"camera": {"fov_deg": 180}})", "camera.fov_deg"},
         BadCase{"up parallel", R"({"camera": {"position": [0,0,0], "look_at": [0,1,0], "up": [0,1,0]}})", "camera.up"},
         BadCase{"estimator", R"({"integrator": {"emission_estimator": "track"}})", "integrator.emission_estimator"},
+        BadCase{"light_only", R"({"integrator": {"light_only": "yes"}})", "integrator.light_only"},
         BadCase{"max_depth", R"({"integrator": {"max_depth": -1}})", "integrator.max_depth"},
         BadCase{"background", R"({"background": {"rgb": [0, 0, -1]}})", "background.rgb"},
         BadCase{"duplicate names",
