@@ -155,6 +155,57 @@ float emission_pdf(GpuEmissionCdf e, vec3 p) {
   return emission_pmf[e.offsets.y + cell] * e.measure.y;
 }
 
+// Solid-angle pdf at o of direction w (unit) toward a point drawn by
+// emission_sample: ∫₀^∞ pdf(o + t·w) t² dt over the cells the ray crosses, by
+// 3D DDA (Amanatides & Woo 1987); EmissionCdf::direction_pdf on the host. The
+// map to cell coordinates is affine, so t stays the world distance there.
+float emission_direction_pdf(GpuEmissionCdf e, vec3 o, vec3 w) {
+  if (e.cells.w == 0u) return 0.0;
+  vec4 o1 = vec4(o, 1.0), w0 = vec4(w, 0.0);
+  vec3 co = vec3(dot(e.world_to_cell_row0, o1), dot(e.world_to_cell_row1, o1), dot(e.world_to_cell_row2, o1));
+  vec3 cw = vec3(dot(e.world_to_cell_row0, w0), dot(e.world_to_cell_row1, w0), dot(e.world_to_cell_row2, w0));
+  ivec3 n = ivec3(e.cells.xyz);
+  const float BIG = 3.0e38;
+  float t0 = 0.0, t1 = BIG;
+  vec3 t_next = vec3(BIG), t_delta = vec3(BIG);
+  for (int a = 0; a < 3; ++a) {
+    if (cw[a] == 0.0) {
+      if (co[a] < 0.0 || co[a] >= float(n[a])) return 0.0;
+      continue;
+    }
+    float ta = -co[a] / cw[a], tb = (float(n[a]) - co[a]) / cw[a];
+    t0 = max(t0, min(ta, tb));
+    t1 = min(t1, max(ta, tb));
+  }
+  if (!(t0 < t1)) return 0.0;
+  ivec3 cell = clamp(ivec3(floor(co + cw * t0)), ivec3(0), n - 1);
+  ivec3 stp = ivec3(0);
+  for (int a = 0; a < 3; ++a) {
+    if (cw[a] > 0.0) {
+      stp[a] = 1;
+      t_next[a] = (float(cell[a] + 1) - co[a]) / cw[a];
+      t_delta[a] = 1.0 / cw[a];
+    } else if (cw[a] < 0.0) {
+      stp[a] = -1;
+      t_next[a] = (float(cell[a]) - co[a]) / cw[a];
+      t_delta[a] = -1.0 / cw[a];
+    }
+  }
+  float sum = 0.0, t = t0;
+  // At most one step per cell face crossed: n.x + n.y + n.z.
+  for (int k = 0; k < n.x + n.y + n.z && t < t1; ++k) {
+    int a = t_next.x <= t_next.y ? (t_next.x <= t_next.z ? 0 : 2) : (t_next.y <= t_next.z ? 1 : 2);
+    float tb = min(t_next[a], t1);
+    float pmf = emission_pmf[e.offsets.y + uint((cell.z * n.y + cell.y) * n.x + cell.x)];
+    sum += pmf * (tb - t) * (tb * tb + tb * t + t * t);  // tb³ − t³, factored
+    t = tb;
+    cell[a] += stp[a];
+    if (cell[a] < 0 || cell[a] >= n[a]) break;
+    t_next[a] += t_delta[a];
+  }
+  return sum * e.measure.y * (1.0 / 3.0);
+}
+
 #endif  // LIGHTS_EMISSION
 
 #endif  // PYROLUME_LIGHTS_GLSL

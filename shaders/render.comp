@@ -252,42 +252,32 @@ void coefficients_at(vec3 x, float t, vec2 span[MEDIA_N], out vec3 sigma_a, out 
   }
 }
 
-// MIS weight of light that phase/BSDF sampling found, against next-event
-// estimation's pdf p_light for it (same measure): the power heuristic (Veach
+// MIS weight of the radiance that phase/BSDF sampling finds along its ray
+// before the next real event (emission at tentative collisions, the
+// environment on escape), against next-event estimation's solid-angle pdf
+// p_light for the same direction (docs/mis.md): the power heuristic (Veach
 // 1997 eq. 9.13) as 1/(1 + r²), which cannot overflow. pdf_dir = 0 marks a
-// camera ray, whose light next-event estimation never finds: weight 1.
-float unidirectional_weight(float pdf_dir, float p_unidirectional, float p_light) {
+// camera or light ray: weight 1.
+float unidirectional_weight(float pdf_dir, float p_light) {
   if (!NEE || !(pdf_dir > 0.0) || !(p_light > 0.0)) return 1.0;
   if (LIGHT_STRATEGY == LIGHT_STRATEGY_LIGHT_ONLY) return 0.0;
-  float r = p_light / p_unidirectional;
+  float r = p_light / pdf_dir;
   return 1.0 / (1.0 + r * r);
 }
-float light_weight(float p_light, float p_unidirectional) {
+float light_weight(float p_light, float pdf_dir) {
   if (LIGHT_STRATEGY == LIGHT_STRATEGY_LIGHT_ONLY) return 1.0;
-  float r = p_unidirectional / p_light;
+  float r = pdf_dir / p_light;
   return 1.0 / (1.0 + r * r);
 }
 
 // Emitted power per unit length, Σ sigma_a_i(x)·Le_i(x), over the media at t.
-// With next-event estimation each emissive grid's term is MIS-weighted: the
-// walk found x with pdf p_unidirectional = pdf_dir·σ̄·R, next-event estimation
-// would have with P_i·pdf_V(x)·dist² (docs/mis.md).
-vec3 emission_at(vec3 x, float t, vec2 span[MEDIA_N], float rho[MEDIA_N], float pdf_dir, float p_unidirectional,
-                 float dist) {
+vec3 emission_at(vec3 x, float t, vec2 span[MEDIA_N], float rho[MEDIA_N]) {
   vec3 E = vec3(0.0);
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     if (!(span[i].x <= t && t < span[i].y)) continue;
     GpuMedium m = media[i];
     if (HAS_GRIDS && uint(m.sigma_a.w) == SHAPE_GRID) {
-      if (rho[i] > 0.0) {
-        uint slot = uint(m.bounds0.x);
-        vec3 e = rho[i] * m.sigma_a.rgb * grid_le(m, slot, x);
-        if (NEE && pdf_dir > 0.0 && emission_lights[slot].measure.w > 0.0 && max3(e) > 0.0) {
-          float p_light = emission_lights[slot].measure.w * emission_pdf(emission_lights[slot], x) * dist * dist;
-          e *= unidirectional_weight(pdf_dir, p_unidirectional, p_light);
-        }
-        E += e;
-      }
+      if (rho[i] > 0.0) E += rho[i] * m.sigma_a.rgb * grid_le(m, uint(m.bounds0.x), x);
     } else {
       E += m.emission.rgb;
     }
@@ -355,122 +345,55 @@ vec3 transmittance(vec3 o, vec3 d, bool ratio, inout uint rng, inout PathStats s
   return T;
 }
 
-// Ratio tracking along a shadow ray for next-event estimation, to t_max (INF:
-// to infinity); 0 if a surface is in the way. Returns the transmittance
-// estimate T (with Russian roulette, as transmittance() above). R: the product
-// of the null-event probabilities the walk's spectral tracking would have
-// taken at the same tentative collisions, for a path of weight w (only ratios
-// of w matter), without the roulette (docs/mis.md); sigma_end: the majorant
-// at t_max, the rate at which the walk samples a collision there.
-vec3 shadow_transmittance(vec3 o, vec3 d, float t_max, vec3 w, inout uint rng, inout PathStats stats, out float R,
-                          out float sigma_end) {
-  R = 1.0;
-  sigma_end = 0.0;
-  if (HAS_SURFACES && occluded_surfaces(o, d, t_max)) return vec3(0.0);
-  vec2 span[MEDIA_N];
-  bool any_hit;
-  media_spans(o, d, span, any_hit);
-  if (!any_hit) return vec3(1.0);
-  vec3 T = vec3(1.0);
-  float t = 0.0;
-  // A bound for real GPUs' watchdogs: 2^24 steps without the roulette ending
-  // the ray count as opaque. (On llvmpipe the pass's shared loop budget runs
-  // out first, and run_pass redoes the pass: PassStatus.)
-  bool done = false;
-  for (uint n = 0u; n < (1u << 24); ++n) {
-    float t_next;
-    bool any_ahead;
-    float sigma_bar = majorant_at(o, d, t, span, t_next, any_ahead);
-    if (!any_ahead || t >= t_max) { done = true; break; }
-    if (sigma_bar <= 0.0) { t = t_next; continue; }
-    float dt = sample_free_flight(sigma_bar, rng_next(rng));
-    if (t + dt >= min(t_next, t_max)) { t = min(t_next, t_max); continue; }
-    t += dt;
-    vec3 sigma_a, sigma_s;
-    float rho[MEDIA_N];
-    coefficients_at(o + t * d, t, span, sigma_a, sigma_s, rho, stats);
-    vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
-    float p_null = avg3(sigma_n * w) / (sigma_bar * avg3(w));
-    R *= p_null;
-    w *= sigma_n / (sigma_bar * max(p_null, 1e-30));
-    T *= sigma_n / sigma_bar;
-    float q = max3(T);
-    if (q < 0.1) {  // Russian roulette on the estimate only: R stays the walk's probability
-      if (rng_next(rng) >= q) return vec3(0.0);
-      T /= q;
+// The solid-angle pdf with which next-event estimation at o picks direction
+// d (docs/mis.md): the environment map's, and each emissive grid's pdf of the
+// direction toward a point of its emission CDF, mixed by the light choice.
+float light_direction_pdf(vec3 o, vec3 d) {
+  float p = 0.0;
+  if (HAS_ENVIRONMENT && frame.lights.x > 0.0) p += frame.lights.x * env_pdf(environment, d);
+  if (HAS_GRIDS && HAS_EMISSION)
+    for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+      if (uint(media[i].sigma_a.w) != SHAPE_GRID) continue;
+      GpuEmissionCdf e = emission_lights[uint(media[i].bounds0.x)];
+      if (e.measure.w > 0.0) p += e.measure.w * emission_direction_pdf(e, o, d);
     }
-  }
-  if (!done) return vec3(0.0);
-  if (!isinf(t_max)) {
-    float t_next;
-    bool any_ahead;
-    sigma_end = majorant_at(o, d, t_max, span, t_next, any_ahead);
-  }
-  return T;
+  return p;
 }
 
-// A light sample for next-event estimation from point o: direction, distance
-// (INF for the environment), solid-angle pdf (light choice included; 0: none),
-// and the radiance it sends along -dir before attenuation: the environment's
-// radiance, or σa·Le per unit length at the sampled point of an emissive grid
-// (volume pdf × dist², no cosine: docs/mis.md).
-struct LightSample {
-  vec3 dir;
-  float dist;
-  float pdf;
-  vec3 Le;
-  bool volume;
-};
-
-LightSample sample_light(vec3 o, inout uint rng, inout PathStats stats) {
-  LightSample ls;
-  ls.dir = vec3(0.0, 0.0, 1.0);
-  ls.dist = INF;
-  ls.pdf = 0.0;
-  ls.Le = vec3(0.0);
-  ls.volume = false;
+// A light direction for next-event estimation from point o: the environment
+// map's, or toward a point drawn from an emissive grid's emission CDF (the
+// light chosen by frame.lights.x and each grid's measure.w). false: none.
+bool sample_light_direction(vec3 o, inout uint rng, out vec3 dir) {
+  dir = vec3(0.0, 0.0, 1.0);
   float u = rng_next(rng);
   vec2 u2 = vec2(rng_next(rng), rng_next(rng));
   float u_z = rng_next(rng);
   if (HAS_ENVIRONMENT && u < frame.lights.x) {
     EnvSample es = env_sample(environment, u2);
-    ls.dir = es.dir;
-    ls.pdf = frame.lights.x * es.pdf;
-    ls.Le = es.radiance;
-    return ls;
+    dir = es.dir;
+    return es.pdf > 0.0;
   }
-  if (!HAS_GRIDS || !HAS_EMISSION) return ls;
+  if (!HAS_GRIDS || !HAS_EMISSION) return false;
   u -= frame.lights.x;
   // The grid medium whose light probability covers u.
   // (The last light when rounding leaves u past them all, like the CPU reference.)
   uint pick = MEDIUM_COUNT;
-  float p_pick = 0.0;
   bool found = false;
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     if (uint(media[i].sigma_a.w) != SHAPE_GRID) continue;
     float p = emission_lights[uint(media[i].bounds0.x)].measure.w;
     if (!(p > 0.0) || found) continue;
     pick = i;
-    p_pick = p;
     if (u < p) found = true; else u -= p;
   }
-  if (pick == MEDIUM_COUNT) return ls;
-  GpuMedium m = media[pick];
-  uint slot = uint(m.bounds0.x);
-  EmissionSample es = emission_sample(emission_lights[slot], rng_next(rng), vec3(u2, u_z));
-  if (!(es.pdf > 0.0)) return ls;
+  if (pick == MEDIUM_COUNT) return false;
+  EmissionSample es = emission_sample(emission_lights[uint(media[pick].bounds0.x)], rng_next(rng), vec3(u2, u_z));
+  if (!(es.pdf > 0.0)) return false;
   vec3 v = es.p - o;
   float dist = length(v);
-  if (!(dist > 0.0)) return ls;
-  vec4 dims = grids[slot].density_dims;
-  float rho = dims.w * density_at(slot, density_texel(slot, es.p) / dims.xyz);
-  stats.lookups += 1.0;
-  ls.dir = v / dist;
-  ls.dist = dist;
-  ls.pdf = p_pick * es.pdf * dist * dist;
-  ls.Le = rho * m.sigma_a.rgb * grid_le(m, slot, es.p);
-  ls.volume = true;
-  return ls;
+  if (!(dist > 0.0)) return false;
+  dir = v / dist;
+  return true;
 }
 
 // One path's state between tracking steps (see main: paths are regenerated
@@ -482,13 +405,21 @@ struct PathState {
   float t;     // distance along the current ray
   uint depth;  // scattering events (medium and surface) so far
   bool fresh;  // the ray changed: recompute the media spans and the surface hit
-  // MIS (docs/mis.md): the solid-angle pdf with which the ray's direction was
-  // sampled at its vertex (0: camera ray); R, the product of the null-event
-  // probabilities taken since; t_shift, how far the origin has moved from the
-  // vertex (the shift to the first thing the ray reaches).
-  float pdf_dir, R, t_shift;
+  // MIS (docs/mis.md): the solid-angle pdfs with which the vertex's own
+  // sampling (0: camera or light ray) and next-event estimation pick the
+  // ray's direction.
+  float pdf_dir, p_light;
   bool has_hit;     // a surface lies ahead on the current ray
   SurfaceHit hit;   // the closest one (t = its distance)
+  // Next-event estimation runs as a light ray in this same state: it collects
+  // what arrives along the light direction until its first real event
+  // (weight w = path weight · f · MIS weight / p_light), then the path goes on
+  // with the continuation sampled at the vertex (next_*), one tracking step
+  // per loop iteration like any other ray (LAVAPIPE.md: divergence).
+  bool light_ray;
+  bool next_ends;  // the continuation has no weight or depth left
+  vec3 next_o, next_d, next_w;
+  float next_pdf_dir, next_p_light;
 };
 
 // Radiance of a ray that leaves the scene: the environment map (+Z up,
@@ -498,20 +429,63 @@ vec3 escaped_radiance(vec3 d) { return HAS_ENVIRONMENT ? env_radiance(environmen
 // The path leaves the scene: add what it sees, MIS-weighted when the
 // environment is a light.
 void escape(inout PathState p) {
-  float w = 1.0;
-  if (NEE && HAS_ENVIRONMENT && frame.lights.x > 0.0)
-    w = unidirectional_weight(p.pdf_dir, p.pdf_dir * p.R, frame.lights.x * env_pdf(environment, p.d));
-  p.L += w * p.w * escaped_radiance(p.d);
+  p.L += unidirectional_weight(p.pdf_dir, p.p_light) * p.w * escaped_radiance(p.d);
 }
 
 // Start a new ray at a vertex, its direction sampled with solid-angle pdf pdf_dir.
-void new_ray(inout PathState p, vec3 o, vec3 d, float pdf_dir) {
+void new_ray(inout PathState p, vec3 o, vec3 d, float pdf_dir, float p_light) {
   p.o = o;
   p.d = d;
   p.fresh = true;
   p.pdf_dir = pdf_dir;
-  p.R = 1.0;
-  p.t_shift = 0.0;
+  p.p_light = p_light;
+}
+
+// The current ray ends. A light ray hands over to the continuation its vertex
+// sampled; returns true when the path has ended.
+bool ray_ends(inout PathState p) {
+  if (!NEE || !p.light_ray) return true;
+  p.light_ray = false;
+  if (p.next_ends) return true;
+  p.w = p.next_w;
+  new_ray(p, p.next_o, p.next_d, p.next_pdf_dir, p.next_p_light);
+  return false;
+}
+
+// Leave vertex o along d (weight w, the vertex's pdf pdf_dir). With
+// next-event estimation, first a light ray along light_dir, which the vertex's
+// lobe weights by f_light with pdf pdf_light (0: no light direction), and the
+// continuation waits. Returns true when the path has ended.
+bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 w, float pdf_dir, vec3 light_dir, vec3 f_light,
+                  float pdf_light) {
+  const bool ends = max3(w) <= 0.0;
+  if (!NEE) {
+    p.w = w;
+    new_ray(p, o, d, pdf_dir, 0.0);
+    return ends;
+  }
+  const float p_light_d = ends ? 0.0 : light_direction_pdf(o, d);
+  float p_l = 0.0;
+  vec3 w_light = vec3(0.0);
+  if (pdf_light > 0.0 && max3(p.w * f_light) > 0.0) {
+    p_l = light_direction_pdf(o, light_dir);
+    if (p_l > 0.0) w_light = p.w * f_light * (light_weight(p_l, pdf_light) / p_l);
+  }
+  if (!(max3(w_light) > 0.0)) {
+    p.w = w;
+    new_ray(p, o, d, pdf_dir, p_light_d);
+    return ends;
+  }
+  p.next_ends = ends;
+  p.next_o = o;
+  p.next_d = d;
+  p.next_w = w;
+  p.next_pdf_dir = pdf_dir;
+  p.next_p_light = p_light_d;
+  p.light_ray = true;
+  p.w = w_light;
+  new_ray(p, o, light_dir, 0.0, 0.0);
+  return false;
 }
 
 // A Lambertian bounce at the surface ahead: weight × albedo (cosine sampling's
@@ -527,22 +501,14 @@ bool surface_bounce(inout PathState p, inout uint rng, inout PathStats stats) {
   if (m.info.x != NO_TEXTURE) albedo *= albedo_texture_at(m.info.x, vec2(si.uv.x, 1.0 - si.uv.y));  // OBJ v=0 at the bottom
   vec3 n = dot(si.normal, p.d) < 0.0 ? si.normal : -si.normal;
   vec3 o = offset_ray_origin(si.position, n);
-  if (NEE && max3(p.w * albedo) > 0.0) {
-    // Next-event estimation: f·cos = albedo·cos/π, BSDF pdf cos/π.
-    LightSample ls = sample_light(o, rng, stats);
-    float cos_l = dot(n, ls.dir);
-    if (ls.pdf > 0.0 && cos_l > 0.0 && max3(ls.Le) > 0.0) {
-      float R, sigma_end;
-      vec3 T = shadow_transmittance(o, ls.dir, ls.dist, p.w * albedo, rng, stats, R, sigma_end);
-      float pdf_bsdf = cos_l * (1.0 / PI);
-      float p_uni = pdf_bsdf * R * (ls.volume ? sigma_end : 1.0);
-      p.L += p.w * albedo * pdf_bsdf * T * ls.Le * (light_weight(ls.pdf, p_uni) / ls.pdf);
-    }
-  }
-  p.w *= albedo;
+  // Next-event estimation: f·cos = albedo·cos/π, BSDF pdf cos/π.
+  vec3 light_dir = vec3(0.0);
+  float pdf_light = 0.0;
+  if (NEE && max3(p.w * albedo) > 0.0 && sample_light_direction(o, rng, light_dir))
+    pdf_light = max(dot(n, light_dir), 0.0) * (1.0 / PI);
   vec3 d = sample_cosine_hemisphere(n, vec2(rng_next(rng), rng_next(rng)));
-  new_ray(p, o, d, max(dot(n, d), 0.0) * (1.0 / PI));
-  return max3(p.w) <= 0.0;
+  return leave_vertex(p, o, d, p.w * albedo, max(dot(n, d), 0.0) * (1.0 / PI), light_dir, albedo * pdf_light,
+                      pdf_light);
 }
 
 // One step of delta tracking along one path; returns true when the path has
@@ -565,7 +531,7 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     p.t = 0.0;
     if (!any_hit && !p.has_hit) {
       escape(p);
-      return true;
+      return ray_ends(p);
     }
     // Move the origin to the first thing the ray reaches, so every later
     // position o + t·d is computed with a small t: from a camera 1e4 units
@@ -576,7 +542,6 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
       if (span[i].y > 0.0) t0 = min(t0, span[i].x);
     if (t0 > 0.0 && !isinf(t0)) {
       p.o += t0 * p.d;
-      p.t_shift += t0;
       for (uint i = 0u; i < MEDIUM_COUNT; ++i)
         if (span[i].y > 0.0) span[i] -= t0;
       if (p.has_hit) p.hit.t -= t0;
@@ -590,12 +555,12 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   const float t_surface = p.has_hit ? p.hit.t : INF;
   if (isinf(t_next) && !p.has_hit) {
     escape(p);
-    return true;
+    return ray_ends(p);
   }
   const float t_end = min(t_next, t_surface);
   float dt = sigma_bar > 0.0 ? sample_free_flight(sigma_bar, rng_next(rng)) : INF;
   if (p.t + dt >= t_end) {
-    if (p.has_hit && t_surface <= t_next) return surface_bounce(p, rng, stats);
+    if (p.has_hit && t_surface <= t_next) return NEE && p.light_ray ? ray_ends(p) : surface_bounce(p, rng, stats);
     p.t = t_next;
     return false;
   }
@@ -607,7 +572,8 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   coefficients_at(x, p.t, span, sigma_a, sigma_s, rho, stats);
   if (HAS_EMISSION && COLLISION_ESTIMATOR) {
     // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.
-    p.L += p.w * emission_at(x, p.t, span, rho, p.pdf_dir, p.pdf_dir * sigma_bar * p.R, p.t_shift + p.t) / sigma_bar;
+    // With next-event estimation the ray's own MIS weight (light rays: 1).
+    p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_bar) * p.w * emission_at(x, p.t, span, rho);
   }
   vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
   float c = sigma_bar * avg3(p.w);
@@ -617,10 +583,11 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   if (u < p_a) {
     // Absorbed: the absorption estimator collects sigma_a·Le / (sigma_bar·P_a).
     stats.events += 1.0;
-    if (HAS_EMISSION && !COLLISION_ESTIMATOR) p.L += p.w * emission_at(x, p.t, span, rho, 0.0, 0.0, 0.0) / (sigma_bar * p_a);
-    return true;
+    if (HAS_EMISSION && !COLLISION_ESTIMATOR) p.L += p.w * emission_at(x, p.t, span, rho) / (sigma_bar * p_a);
+    return ray_ends(p);
   } else if (HAS_SCATTERING && u < p_a + p_s) {
     stats.events += 1.0;
+    if (NEE && p.light_ray) return ray_ends(p);  // a light ray ends at its first real event
     if (p.depth >= frame.image.w) return true;  // max_depth reached
     ++p.depth;
     p.w *= sigma_s / (sigma_bar * p_s);
@@ -637,20 +604,13 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
       total += q[i];
     }
     for (uint i = 0u; i < MEDIUM_COUNT; ++i) q[i] /= total;
-    if (NEE) {
-      LightSample ls = sample_light(x, rng, stats);
-      if (ls.pdf > 0.0 && max3(ls.Le) > 0.0) {
-        vec3 f = vec3(0.0);
-        float pdf_phase = 0.0;
-        for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-          float hg = hg_pdf(dot(p.d, ls.dir), media[i].sigma_s.w);
-          f += share[i] * hg;
-          pdf_phase += q[i] * hg;
-        }
-        float R, sigma_end;
-        vec3 T = shadow_transmittance(x, ls.dir, ls.dist, p.w * f / pdf_phase, rng, stats, R, sigma_end);
-        float p_uni = pdf_phase * R * (ls.volume ? sigma_end : 1.0);
-        p.L += p.w * f * T * ls.Le * (light_weight(ls.pdf, p_uni) / ls.pdf);
+    vec3 light_dir = vec3(0.0), f_light = vec3(0.0);
+    float pdf_light = 0.0;
+    if (NEE && sample_light_direction(x, rng, light_dir)) {
+      for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+        float hg = hg_pdf(dot(p.d, light_dir), media[i].sigma_s.w);
+        f_light += share[i] * hg;
+        pdf_light += q[i] * hg;
       }
     }
     float pick = rng_next(rng), acc = 0.0, g = 0.0;
@@ -668,14 +628,12 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
       f += share[i] * hg;
       pdf_phase += q[i] * hg;
     }
-    p.w *= f / pdf_phase;
-    new_ray(p, x, d, pdf_phase);
+    return leave_vertex(p, x, d, p.w * (f / pdf_phase), pdf_phase, light_dir, f_light, pdf_light);
   } else {
     float p_n = 1.0 - p_a - p_s;
     p.w *= sigma_n / (sigma_bar * p_n);
-    p.R *= p_n;
   }
-  return max3(p.w) <= 0.0;
+  return max3(p.w) <= 0.0 ? ray_ends(p) : false;
 }
 
 // A camera ray through pixel `pixel` for sample `k`, with that sample's random stream.
@@ -699,8 +657,11 @@ PathState camera_path(uvec2 pixel, uint k, out uint rng) {
   p.fresh = true;
   p.has_hit = false;
   p.pdf_dir = 0.0;
-  p.R = 1.0;
-  p.t_shift = 0.0;
+  p.p_light = 0.0;
+  p.light_ray = false;
+  p.next_ends = true;
+  p.next_o = p.next_d = p.next_w = vec3(0.0);
+  p.next_pdf_dir = p.next_p_light = 0.0;
   return p;
 }
 

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <unordered_map>
 
 #include "color/Blackbody.h"
@@ -207,6 +208,53 @@ double EmissionCdf::pdf(const glm::dvec3& p) const {
   const glm::dvec3 f = glm::floor(c);
   if (f.x < 0 || f.y < 0 || f.z < 0 || f.x >= cells_.x || f.y >= cells_.y || f.z >= cells_.z) return 0.0;
   return double(pmf_[size_t(linear_cell(glm::ivec3(f)))]) / cell_volume_;
+}
+
+double EmissionCdf::direction_pdf(const glm::dvec3& o, const glm::dvec3& w) const {
+  if (empty()) return 0.0;
+  // The map to cell coordinates is affine, so the ray keeps its parameter t
+  // (world distance, w unit length) there: c(t) = co + t·cw.
+  const glm::dvec3 co = world_to_cell(o);
+  const glm::dvec3 cw = glm::dvec3(world_to_cell_ * glm::dvec4(w, 0.0));
+  const glm::dvec3 n(cells_);
+  double t0 = 0.0, t1 = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (cw[a] == 0.0) {
+      if (co[a] < 0.0 || co[a] >= n[a]) return 0.0;
+      continue;
+    }
+    const double ta = -co[a] / cw[a], tb = (n[a] - co[a]) / cw[a];
+    t0 = std::max(t0, std::min(ta, tb));
+    t1 = std::min(t1, std::max(ta, tb));
+  }
+  if (!(t0 < t1)) return 0.0;
+  // 3D DDA (Amanatides & Woo 1987) over the cells the ray crosses; in each the
+  // volume pdf is constant, and ∫ t² dt over [ta, tb] is (tb³ − ta³)/3.
+  glm::ivec3 cell = glm::clamp(glm::ivec3(glm::floor(co + cw * t0)), glm::ivec3(0), cells_ - 1);
+  glm::ivec3 step(0);
+  glm::dvec3 t_next(std::numeric_limits<double>::infinity()), t_delta(std::numeric_limits<double>::infinity());
+  for (int a = 0; a < 3; ++a) {
+    if (cw[a] > 0.0) {
+      step[a] = 1;
+      t_next[a] = (cell[a] + 1 - co[a]) / cw[a];
+      t_delta[a] = 1.0 / cw[a];
+    } else if (cw[a] < 0.0) {
+      step[a] = -1;
+      t_next[a] = (cell[a] - co[a]) / cw[a];
+      t_delta[a] = -1.0 / cw[a];
+    }
+  }
+  double sum = 0.0, t = t0;
+  while (t < t1) {
+    const int a = t_next.x <= t_next.y ? (t_next.x <= t_next.z ? 0 : 2) : (t_next.y <= t_next.z ? 1 : 2);
+    const double tb = std::min(t_next[a], t1);
+    sum += double(pmf_[size_t(linear_cell(cell))]) * (tb - t) * (tb * tb + tb * t + t * t);  // tb³ − t³
+    t = tb;
+    cell[a] += step[a];
+    if (cell[a] < 0 || cell[a] >= cells_[a]) break;
+    t_next[a] += t_delta[a];
+  }
+  return sum / (3.0 * cell_volume_);
 }
 
 gpu::GpuEmissionCdf EmissionCdf::gpu_header(uint32_t entry_offset, uint32_t pmf_offset) const {

@@ -98,6 +98,9 @@ class EmissionCdf {
   EmissionSample sample(double u, const glm::dvec3& u3) const;
   // The volume pdf of the cell containing world point p (0 outside every cell).
   double pdf(const glm::dvec3& p) const;
+  // The solid-angle pdf at o of direction w (unit) toward a point drawn by
+  // sample(): ∫₀^∞ pdf(o + t·w) t² dt, exactly, over the cells the ray crosses.
+  double direction_pdf(const glm::dvec3& o, const glm::dvec3& w) const;
 
   // ---- what the GPU reads (shaders/shared/light_types.h, shaders/lights.glsl) ----
   const std::vector<float>& gpu_cdf() const { return cdf_; }          // inclusive, last = 1

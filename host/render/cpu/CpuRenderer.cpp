@@ -38,6 +38,13 @@ struct Scratch {
   std::vector<double> rho;  // density looked up at the current collision, per present medium
   std::vector<double> lobe_w, lobe_g;  // the phase mixture at a scattering: σs_i/σs and g_i
   LeCache Le_cache;
+  // The walk of a light ray runs inside the walk that sampled it and needs
+  // scratch of its own.
+  std::unique_ptr<Scratch> nested;
+  Scratch& light_ray() {
+    if (!nested) nested = std::make_unique<Scratch>();
+    return *nested;
+  }
 };
 
 struct ThreadCounters {
@@ -73,21 +80,36 @@ struct WalkScene {
 };
 
 // The MIS state of the ray being tracked (docs/mis.md): the solid-angle pdf
-// with which its direction was sampled at its vertex (0 for the camera ray,
-// whose light is never found by next-event estimation), and R, the product of
-// the null probabilities 1 − σt/σ̄ taken since that vertex.
+// with which its direction was sampled at its vertex (0 for the camera ray and
+// for light rays, whose radiance is never weighted), and the solid-angle pdf
+// with which next-event estimation at that vertex picks the same direction.
 struct RayMis {
   double pdf_dir = 0.0;
-  double R = 1.0;
+  double p_light = 0.0;
 };
 
-// MIS weight of emission that BSDF/phase sampling found: light `p_light`
-// (the pdf next-event estimation would have had, in the same measure) against
-// p_unidirectional. 1 where the light cannot be sampled or there is no NEE.
-double unidirectional_weight(const WalkLights& lights, const RayMis& mis, double p_unidirectional, double p_light) {
-  if (!lights.active() || !(mis.pdf_dir > 0.0) || !(p_light > 0.0)) return 1.0;
+// MIS weight of the radiance that BSDF/phase sampling finds along its ray
+// before the next real event (emission at tentative collisions, the
+// environment on escape): the same for all of it, since both strategies
+// estimate that radiance along the same direction. 1 where next-event
+// estimation cannot pick the direction or there is none.
+double unidirectional_weight(const WalkLights& lights, const RayMis& mis) {
+  if (!lights.active() || !(mis.pdf_dir > 0.0) || !(mis.p_light > 0.0)) return 1.0;
   if (lights.selection.strategy == LightStrategy::LightOnly) return 0.0;
-  return power_heuristic(p_unidirectional, p_light);
+  return power_heuristic(mis.pdf_dir, mis.p_light);
+}
+
+// The solid-angle pdf with which next_event at o picks direction d: the
+// environment map's, and for each emissive grid the pdf of the direction
+// toward a point drawn from its emission CDF (EmissionCdf::direction_pdf),
+// mixed by the light selection probabilities.
+double light_direction_pdf(const WalkScene& ws, const glm::dvec3& o, const glm::dvec3& d) {
+  const WalkLights& lights = ws.lights;
+  double p = 0.0;
+  if (lights.selection.p_env > 0.0) p += lights.selection.p_env * ws.environment->pdf(d);
+  for (size_t j = 0; j < lights.cdf.size(); ++j)
+    if (lights.selection.p_medium[j] > 0.0) p += lights.selection.p_medium[j] * lights.cdf[j]->direction_pdf(o, d);
+  return p;
 }
 
 // The value f (BSDF·|cos| or phase function, channel c) and the solid-angle pdf
@@ -96,34 +118,30 @@ struct VertexLobe {
   double f = 0.0, pdf = 0.0;
 };
 
+double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
+                    Scratch& s, int max_depth);
+
 // One next-event estimate from vertex o (the offset origin the continuing ray
-// also uses): pick a light, sample it, trace a shadow ray (surfaces block;
-// ratio tracking through the media), weight by the power heuristic against the
-// vertex's own sampling. Returns the radiance toward the vertex times f / pdf,
-// MIS-weighted, without the path weight β.
+// also uses), a direction sampled from the lights (docs/mis.md): the
+// environment map's 2D CDF, or a point from an emissive grid's emission CDF
+// and the direction toward it. The radiance arriving along that direction is
+// estimated the way the walk finds it, by a walk that ends at its first real
+// event (max_depth 0: emission at every tentative collision up to it, the
+// environment if it escapes, nothing past a surface). Weighted by the power
+// heuristic against the vertex's own sampling, both pdfs in solid angle.
+// Returns the radiance times f / pdf, without the path weight β.
 template <class Lobe>
 double next_event(const WalkScene& ws, int c, const glm::dvec3& o, Lobe lobe, Pcg32& rng, ThreadCounters& cnt,
                   Scratch& s) {
   const WalkLights& lights = ws.lights;
-  const bool light_only = lights.selection.strategy == LightStrategy::LightOnly;
   double u = rng.uniform();
   const double u_env = rng.uniform(), v_env = rng.uniform();
   const glm::dvec3 u3(rng.uniform(), rng.uniform(), rng.uniform());
-  TrackingCounters tc;
-  double result = 0.0;
+  glm::dvec3 dir;
   if (u < lights.selection.p_env) {
     const EnvSample es = ws.environment->sample({u_env, v_env});
     if (!(es.pdf > 0.0)) return 0.0;
-    const VertexLobe l = lobe(es.dir);
-    if (!(l.f > 0.0)) return 0.0;
-    if (!ws.surfaces.empty() && geometry::occluded(ws.surfaces, geometry::Ray{o, es.dir},
-                                                   std::numeric_limits<double>::infinity()))
-      return 0.0;
-    const ShadowTracking st =
-        ratio_tracking_to(ws.md, c, o, es.dir, std::numeric_limits<double>::infinity(), rng, &tc);
-    const double p_light = lights.selection.p_env * es.pdf;
-    const double w = light_only ? 1.0 : power_heuristic(p_light, l.pdf * st.T);
-    result = l.f * st.T * es.radiance[c] * w / p_light;
+    dir = es.dir;
   } else {
     u -= lights.selection.p_env;
     int j = -1;
@@ -140,23 +158,15 @@ double next_event(const WalkScene& ws, int c, const glm::dvec3& o, Lobe lobe, Pc
     const glm::dvec3 v = es.p - o;
     const double r = glm::length(v);
     if (!(r > 0.0)) return 0.0;
-    const glm::dvec3 w_dir = v / r;
-    const VertexLobe l = lobe(w_dir);
-    if (!(l.f > 0.0)) return 0.0;
-    if (!ws.surfaces.empty() && geometry::occluded(ws.surfaces, geometry::Ray{o, w_dir}, r)) return 0.0;
-    const ShadowTracking st = ratio_tracking_to(ws.md, c, o, w_dir, r, rng, &tc);
-    const MediumData& m = ws.md.media[j];
-    const double rho = grid_density(m, es.p);
-    ++tc.density_lookups;
-    const double e = grid_sigma_a_Le(m, j, c, es.p, rho, s.Le_cache);  // σa_j Le_j at the light point
-    // Volume → solid angle at o: × r², no cosine (a medium has no surface).
-    const double p_light = lights.selection.p_medium[j] * es.pdf * r * r;
-    const double w = light_only ? 1.0 : power_heuristic(p_light, l.pdf * st.sigma_maj_end * st.T);
-    result = l.f * st.T * e * w / p_light;
+    dir = v / r;
   }
-  cnt.density_lookups += tc.density_lookups;
-  cnt.majorant_violations += tc.majorant_violations;
-  return result;
+  const VertexLobe l = lobe(dir);
+  if (!(l.f > 0.0)) return 0.0;
+  const double p_light = light_direction_pdf(ws, o, dir);
+  if (!(p_light > 0.0)) return 0.0;
+  const double radiance = walk_channel(ws, c, o, dir, rng, cnt, s.light_ray(), 0);
+  const double w = lights.selection.strategy == LightStrategy::LightOnly ? 1.0 : power_heuristic(p_light, l.pdf);
+  return l.f * radiance * w / p_light;
 }
 
 // One random walk of a *grey* world: colour channel c alone.
@@ -209,7 +219,7 @@ double next_event(const WalkScene& ws, int c, const glm::dvec3& o, Lobe lobe, Pc
 // weighted by the power heuristic with the unidirectional pdf
 // pdf_dir · σ̄(x) · R (per unit volume: / t², which the light pdf × t² cancels).
 double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
-                    Scratch& s) {
+                    Scratch& s, int max_depth) {
   const MediaData& md = ws.md;
   const WalkLights& lights = ws.lights;
   const bool collision_estimator = ws.collision_estimator;
@@ -225,6 +235,7 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
                                                                  std::numeric_limits<double>::infinity(), hit);
     const double t_surf = hit_surface ? hit.t : std::numeric_limits<double>::infinity();
 
+    const double w_ray = unidirectional_weight(lights, mis);  // what this ray finds before its next event
     ray_spans(md, o, d, s.spans, s.cuts);
     bool scattered = false;
     for (size_t k = 0; k + 1 < s.cuts.size() && !scattered; ++k) {
@@ -252,33 +263,25 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
           sigma_s += m.sigma_s[c] * rho;
         }
         if (exceeds_majorant(sigma_a + sigma_s, sigma_maj)) ++cnt.majorant_violations;
-        auto emitted = [&](bool mis_weighted) {  // Σ σa_i Le_i at x (× each light's MIS weight)
+        auto emitted = [&] {  // Σ σa_i Le_i at x
           double e = 0.0;
           for (size_t j = 0; j < s.present.size(); ++j) {
             const int i = s.present[j];
             const MediumData& m = md.media[i];
-            double e_i = m.is_vdb() ? grid_sigma_a_Le(m, i, c, x, s.rho[j], s.Le_cache) : m.sigma_a_Le[c];
-            if (mis_weighted && e_i > 0.0 && lights.active() && lights.cdf[i]) {
-              const double p_light = lights.selection.p_medium[i] * lights.cdf[i]->pdf(x) * t * t;
-              e_i *= unidirectional_weight(lights, mis, mis.pdf_dir * sigma_maj * mis.R, p_light);
-            }
-            e += e_i;
+            e += m.is_vdb() ? grid_sigma_a_Le(m, i, c, x, s.rho[j], s.Le_cache) : m.sigma_a_Le[c];
           }
           return e;
         };
-        if (collision_estimator && sigma_a > 0.0) L += beta * emitted(true) / sigma_maj;
+        if (collision_estimator && sigma_a > 0.0) L += beta * w_ray * emitted() / sigma_maj;
 
         const double u = rng.uniform() * sigma_maj;
         if (u < sigma_a) {
           ++cnt.collisions;
-          return collision_estimator ? L : beta * emitted(false) / sigma_a;
+          return collision_estimator ? L : beta * emitted() / sigma_a;
         }
-        if (!(u < sigma_a + sigma_s)) {  // null collision
-          mis.R *= 1.0 - (sigma_a + sigma_s) / sigma_maj;
-          continue;
-        }
+        if (!(u < sigma_a + sigma_s)) continue;  // null collision
         ++cnt.collisions;
-        if (scatters == ws.max_depth) return collision_estimator ? L : 0.0;
+        if (scatters == max_depth) return collision_estimator ? L : 0.0;
         ++scatters;
         // The phase function of the mixture: Σ_i (σs_i/σs) HG(g_i).
         s.lobe_w.clear();
@@ -307,23 +310,19 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
         glm::dvec2 uv(rng.uniform(), rng.uniform());
         o = x;
         d = sample_hg(d_in, g, uv).direction;
-        mis = RayMis{phase(d).pdf, 1.0};
+        mis = RayMis{phase(d).pdf, lights.active() ? light_direction_pdf(ws, o, d) : 0.0};
         scattered = true;
         break;
       }
     }
     if (scattered) continue;
     if (!hit_surface) {
-      double w = 1.0;
-      if (ws.environment && lights.selection.p_env > 0.0)
-        w = unidirectional_weight(lights, mis, mis.pdf_dir * mis.R,
-                                  lights.selection.p_env * ws.environment->pdf(d));
-      return L + beta * w * ws.escaped(d, c);
+      return L + beta * w_ray * ws.escaped(d, c);
     }
 
     // Reached the surface: a Lambertian bounce.
     ++cnt.collisions;
-    if (scatters == ws.max_depth) return collision_estimator ? L : 0.0;
+    if (scatters == max_depth) return collision_estimator ? L : 0.0;
     ++scatters;
     const double albedo = geometry::albedo_at(ws.surfaces, hit)[c];
     if (!(beta * albedo > 0.0)) return L;  // black surface: nothing more can arrive
@@ -338,7 +337,7 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
     glm::dvec2 uv(rng.uniform(), rng.uniform());
     const BsdfSample bs = sample_cosine_hemisphere(n_f, uv);
     d = bs.direction;
-    mis = RayMis{bs.pdf, 1.0};
+    mis = RayMis{bs.pdf, lights.active() ? light_direction_pdf(ws, o, d) : 0.0};
   }
 }
 
@@ -485,7 +484,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
               glm::dvec3 dir = camera_ray_direction(scene.camera, W, H, fx, fy);
               glm::dvec3 L;
               for (int c = 0; c < 3; ++c)
-                L[c] = walk_channel(walk_scene, c, scene.camera.position, dir, rng, cnt, scratch);
+                L[c] = walk_channel(walk_scene, c, scene.camera.position, dir, rng, cnt, scratch, max_depth);
               if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z)) {
                 ++cnt.nonfinite;
                 L = glm::dvec3(0.0);  // recorded as 0, counted in nonfinite_samples
