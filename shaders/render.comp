@@ -407,8 +407,10 @@ struct PathState {
   bool fresh;  // the ray changed: recompute the media spans and the surface hit
   // MIS (docs/mis.md): the solid-angle pdfs with which the vertex's own
   // sampling (0: camera or light ray) and next-event estimation pick the
-  // ray's direction.
+  // ray's direction; p_light < 0: not computed yet (ray_weight), from the
+  // vertex the ray left, vertex_o.
   float pdf_dir, p_light;
+  vec3 vertex_o;
   bool has_hit;     // a surface lies ahead on the current ray
   SurfaceHit hit;   // the closest one (t = its distance)
   // Next-event estimation runs as a light ray in this same state: it collects
@@ -419,7 +421,7 @@ struct PathState {
   bool light_ray;
   bool next_ends;  // the continuation has no weight or depth left
   vec3 next_o, next_d, next_w;
-  float next_pdf_dir, next_p_light;
+  float next_pdf_dir;
 };
 
 // Radiance of a ray that leaves the scene: the environment map (+Z up,
@@ -428,8 +430,17 @@ vec3 escaped_radiance(vec3 d) { return HAS_ENVIRONMENT ? env_radiance(environmen
 
 // The path leaves the scene: add what it sees, MIS-weighted when the
 // environment is a light.
+// MIS weight of what the current ray finds; next-event estimation's pdf for
+// its direction is computed on first use (most rays find no light to weigh,
+// and for a ray through an emissive grid it is a walk over its blocks).
+float ray_weight(inout PathState p) {
+  if (!NEE || !(p.pdf_dir > 0.0)) return 1.0;
+  if (p.p_light < 0.0) p.p_light = light_direction_pdf(p.vertex_o, p.d);
+  return unidirectional_weight(p.pdf_dir, p.p_light);
+}
+
 void escape(inout PathState p) {
-  p.L += unidirectional_weight(p.pdf_dir, p.p_light) * p.w * escaped_radiance(p.d);
+  p.L += ray_weight(p) * p.w * escaped_radiance(p.d);
 }
 
 // Start a new ray at a vertex, its direction sampled with solid-angle pdf pdf_dir.
@@ -439,6 +450,7 @@ void new_ray(inout PathState p, vec3 o, vec3 d, float pdf_dir, float p_light) {
   p.fresh = true;
   p.pdf_dir = pdf_dir;
   p.p_light = p_light;
+  p.vertex_o = o;
 }
 
 // The current ray ends. A light ray hands over to the continuation its vertex
@@ -448,7 +460,7 @@ bool ray_ends(inout PathState p) {
   p.light_ray = false;
   if (p.next_ends) return true;
   p.w = p.next_w;
-  new_ray(p, p.next_o, p.next_d, p.next_pdf_dir, p.next_p_light);
+  new_ray(p, p.next_o, p.next_d, p.next_pdf_dir, -1.0);
   return false;
 }
 
@@ -464,7 +476,6 @@ bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 w, float pdf_dir, vec3
     new_ray(p, o, d, pdf_dir, 0.0);
     return ends;
   }
-  const float p_light_d = ends ? 0.0 : light_direction_pdf(o, d);
   float p_l = 0.0;
   vec3 w_light = vec3(0.0);
   if (pdf_light > 0.0 && max3(p.w * f_light) > 0.0) {
@@ -473,7 +484,7 @@ bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 w, float pdf_dir, vec3
   }
   if (!(max3(w_light) > 0.0)) {
     p.w = w;
-    new_ray(p, o, d, pdf_dir, p_light_d);
+    new_ray(p, o, d, pdf_dir, -1.0);  // p_light when needed (ray_weight)
     return ends;
   }
   p.next_ends = ends;
@@ -481,7 +492,6 @@ bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 w, float pdf_dir, vec3
   p.next_d = d;
   p.next_w = w;
   p.next_pdf_dir = pdf_dir;
-  p.next_p_light = p_light_d;
   p.light_ray = true;
   p.w = w_light;
   new_ray(p, o, light_dir, 0.0, 0.0);
@@ -573,7 +583,8 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   if (HAS_EMISSION && COLLISION_ESTIMATOR) {
     // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.
     // With next-event estimation the ray's own MIS weight (light rays: 1).
-    p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_bar) * p.w * emission_at(x, p.t, span, rho);
+    vec3 e = emission_at(x, p.t, span, rho);
+    if (max3(e) > 0.0) p.L += (ray_weight(p) / sigma_bar) * p.w * e;
   }
   vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
   float c = sigma_bar * avg3(p.w);
@@ -658,10 +669,11 @@ PathState camera_path(uvec2 pixel, uint k, out uint rng) {
   p.has_hit = false;
   p.pdf_dir = 0.0;
   p.p_light = 0.0;
+  p.vertex_o = p.o;
   p.light_ray = false;
   p.next_ends = true;
   p.next_o = p.next_d = p.next_w = vec3(0.0);
-  p.next_pdf_dir = p.next_p_light = 0.0;
+  p.next_pdf_dir = 0.0;
   return p;
 }
 

@@ -175,6 +175,54 @@ EmissionCdf EmissionCdf::build(const DenseGrid& density, const DenseGrid* temper
   return e;
 }
 
+EmissionCdf EmissionCdf::blocks(int b) const {
+  if (empty() || b <= 1) return *this;
+  const auto t0 = std::chrono::steady_clock::now();
+  EmissionCdf e;
+  const glm::ivec3 C = cells_;
+  e.cells_ = (C + (b - 1)) / b;
+  glm::dmat4 scale(1.0);
+  scale[0][0] = scale[1][1] = scale[2][2] = double(b);
+  e.cell_to_world_ = cell_to_world_ * scale;
+  e.world_to_cell_ = glm::inverse(e.cell_to_world_);
+  e.cell_volume_ = cell_volume_ * double(b) * b * b;
+  e.power_ = power_;
+  const size_t nblock = e.cell_count();
+  std::vector<double> sum(nblock, 0.0);
+  for (int k = 0; k < C.z; ++k)
+    for (int j = 0; j < C.y; ++j)
+      for (int i = 0; i < C.x; ++i) {
+        const float w = weight_[size_t(linear_cell({i, j, k}))];
+        if (w > 0.0f) sum[size_t(e.linear_cell({i / b, j / b, k / b}))] += double(w);
+      }
+  std::vector<double> w;
+  e.weight_.assign(nblock, 0.0f);
+  for (size_t c = 0; c < nblock; ++c)
+    if (sum[c] > 0.0) {
+      e.weight_[c] = float(sum[c] / (double(b) * b * b));  // mean weight per unit volume
+      w.push_back(sum[c]);
+      e.entries_.push_back(uint32_t(c));
+    }
+  const int n = int(w.size());
+  std::vector<float> cdf(size_t(n) + 1);
+  build_cdf(w.data(), n, cdf.data());
+  e.cdf_.assign(cdf.begin() + 1, cdf.end());
+  e.pmf_.assign(nblock, 0.0f);
+  for (int j = 0; j < n; ++j) e.pmf_[e.entries_[j]] = float(bin_probability(cdf.data(), j));
+  e.build_seconds_ = build_seconds_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return e;
+}
+
+EmissionCdf EmissionCdf::build_light(const Medium& m, const StoredVolume& vol) {
+  const EmissionCdf cells = build(m, vol);
+  return cells.blocks(light_block(cells.cells()));
+}
+
+int EmissionCdf::light_block(const glm::ivec3& cells) {
+  const int longest = std::max(cells.x, std::max(cells.y, cells.z));
+  return std::max(1, (longest + kLightBlocksPerAxis - 1) / kLightBlocksPerAxis);
+}
+
 double EmissionCdf::cell_weight(const glm::ivec3& c) const {
   if (weight_.empty() || glm::any(glm::lessThan(c, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(c, cells_)))
     return 0.0;

@@ -83,6 +83,19 @@ class EmissionCdf {
   double power() const { return power_; }
   double seconds_to_build() const { return build_seconds_; }
 
+  // The same distribution over blocks of b³ cells (the grid of blocks covers
+  // the cells, the last ones may reach past them): a block's probability is
+  // the sum of its cells', and a point is uniform inside the block. Lights in
+  // the renderers use blocks of light_block(cells()): next-event estimation
+  // needs the pdf of a whole direction, a sum over every cell the ray crosses
+  // (direction_pdf), and ≤ kLightBlocksPerAxis blocks per axis keep that walk
+  // short (docs/mis.md).
+  EmissionCdf blocks(int b) const;
+  static constexpr int kLightBlocksPerAxis = 24;
+  // What both renderers sample: build(m, vol).blocks(light_block(...)).
+  static EmissionCdf build_light(const Medium& m, const StoredVolume& vol);
+  static int light_block(const glm::ivec3& cells);
+
   // The unnormalised weight w of a cell and its probability (as stored, float).
   double cell_weight(const glm::ivec3& c) const;
   double cell_pmf(int64_t cell) const { return pmf_.empty() ? 0.0 : double(pmf_[size_t(cell)]); }

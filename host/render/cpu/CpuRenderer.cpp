@@ -436,7 +436,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   if (scene.integrator.mis && collision_estimator)
     for (size_t i = 0; i < scene.media.size(); ++i)
       if (media.media[i].is_vdb() && media.media[i].volume && scene.media[i].emission.emits()) {
-        cdfs[i] = EmissionCdf::build(scene.media[i], *media.media[i].volume);
+        cdfs[i] = EmissionCdf::build_light(scene.media[i], *media.media[i].volume);
         if (!cdfs[i]->empty()) lights.cdf[i] = &*cdfs[i];
       }
   lights.selection = select_lights(scene, environment ? &*environment : nullptr, lights.cdf);

@@ -351,7 +351,7 @@ RenderSession::EmissionLights RenderSession::build_emission_lights(
     for (const GpuGridSource& src : g.grid_sources) {
       const Medium& m = scene.media[src.medium];
       if (!m.emission.emits() || !volumes[src.medium]) continue;
-      cdfs[src.medium] = EmissionCdf::build(m, *volumes[src.medium]);
+      cdfs[src.medium] = EmissionCdf::build_light(m, *volumes[src.medium]);
       if (!cdfs[src.medium]->empty()) by_medium[src.medium] = &*cdfs[src.medium];
     }
   out.selection = select_lights(scene, environment_ ? &*environment_ : nullptr, by_medium);
