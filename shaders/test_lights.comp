@@ -27,13 +27,15 @@ layout(std430, binding = 5) readonly buffer EmissionPmfBlock { float emission_pm
 struct Query {
   vec4 u;       // xy: env_sample u2; z: emission_sample u
   vec4 u3;      // xyz: emission_sample u3
-  vec4 dir;     // xyz: a direction for env_radiance / env_pdf
+  vec4 dir;     // xyz: a direction for env_radiance / env_pdf / emission_direction_pdf;
+                // w: emission_direction_pdf's origin is point − w·dir
   vec4 point;   // xyz: a world point for emission_pdf
   vec4 env_s;   // out: sampled dir, pdf
   vec4 env_r;   // out: sampled radiance; w: env_pdf(sampled dir)
   vec4 env_q;   // out: env_radiance(dir); w: env_pdf(dir)
   vec4 em_s;    // out: sampled point, pdf
-  vec4 em_q;    // out: x: cell (bits), y: emission_pdf(sampled point), z: emission_pdf(point)
+  vec4 em_q;    // out: x: cell (bits), y: emission_pdf(sampled point), z: emission_pdf(point),
+                // w: emission_direction_pdf(point − dir.w·dir, dir)
 };
 layout(std430, binding = 6) buffer QueryBlock { Query queries[]; };
 
@@ -47,6 +49,7 @@ void main() {
   q.env_q = vec4(env_radiance(env, q.dir.xyz), env_pdf(env, q.dir.xyz));
   EmissionSample ms = emission_sample(emission, q.u.z, q.u3.xyz);
   q.em_s = vec4(ms.p, ms.pdf);
-  q.em_q = vec4(uintBitsToFloat(ms.cell), emission_pdf(emission, ms.p), emission_pdf(emission, q.point.xyz), 0.0);
+  q.em_q = vec4(uintBitsToFloat(ms.cell), emission_pdf(emission, ms.p), emission_pdf(emission, q.point.xyz),
+                emission_direction_pdf(emission, q.point.xyz - q.dir.w * q.dir.xyz, q.dir.xyz));
   queries[i] = q;
 }

@@ -161,17 +161,19 @@ void check(const EnvironmentMap& env, const EmissionCdf& cdf, uint32_t seed) {
   const int n = 4096;
   std::vector<Query> q(n);
   std::vector<EmissionSample> cpu_points(n);
+  const double extent = glm::length(cdf.cell_to_world(glm::dvec3(cdf.cells())) - cdf.cell_to_world(glm::dvec3(0.0)));
   for (int k = 0; k < n; ++k) {
     q[k].u = {U(rng), U(rng), U(rng), 0.0f};
     q[k].u3 = {Uin(rng), Uin(rng), Uin(rng), 0.0f};
     const float z = 2 * U(rng) - 1, phi = 6.2831853f * U(rng), s = std::sqrt(std::max(0.0f, 1 - z * z));
-    q[k].dir = {s * std::cos(phi), s * std::sin(phi), z, 0.0f};
     cpu_points[k] = cdf.sample(U(rng), {Uin(rng), Uin(rng), Uin(rng)});
+    // Direction pdfs from inside the grid (even k) and from outside, toward the point.
+    const float back = k % 2 ? float(2.0 * extent) : 0.0f;
+    q[k].dir = {s * std::cos(phi), s * std::sin(phi), z, back};
     q[k].point = glm::vec4(glm::vec3(cpu_points[k].p), 0.0f);
   }
   run_queries(ctx, env, cdf, q);
-  int env_pdf_boundary = 0, query_pdf_boundary = 0;
-  const double extent = glm::length(cdf.cell_to_world(glm::dvec3(cdf.cells())) - cdf.cell_to_world(glm::dvec3(0.0)));
+  int env_pdf_boundary = 0, query_pdf_boundary = 0, direction_pdfs = 0;
   for (int k = 0; k < n; ++k) {
     const Query& g = q[k];
     // Environment sample: same texel (same float CDF search), same direction.
@@ -218,7 +220,16 @@ void check(const EnvironmentMap& env, const EmissionCdf& cdf, uint32_t seed) {
     ASSERT_LT(rel(g.em_s.w, m.pdf), 1e-5) << k;
     ASSERT_LT(rel(g.em_q.y, m.pdf), 1e-5) << k;  // emission_pdf(sampled point), away from faces
     ASSERT_LT(rel(g.em_q.z, cpu_points[k].pdf), 1e-5) << k;
+    // The pdf of a direction: the same walk over the cells in float. Where a
+    // ray grazes a cell edge the two may take a cell more or less.
+    const glm::dvec3 o = glm::dvec3(glm::vec3(g.point)) - double(g.dir.w) * d;
+    const double dir_pdf = cdf.direction_pdf(o, d);
+    ASSERT_GT(dir_pdf, 0.0) << k;  // the ray passes through the sampled point
+    if (rel(g.em_q.w, dir_pdf) > 1e-3) ++direction_pdfs;
+    ASSERT_LT(rel(g.em_q.w, dir_pdf), 2e-2) << k << ": " << g.em_q.w << " vs " << dir_pdf;
   }
+  std::printf("direction pdfs off by more than 1e-3: %d of %d\n", direction_pdfs, n);
+  EXPECT_LE(direction_pdfs, n / 100);
   // The float (u, v) lands across a texel edge for ~0.3 % of directions at 512 × 256.
   std::printf("env pdf at a texel edge: %d sampled, %d given directions of %d\n", env_pdf_boundary,
               query_pdf_boundary, n);
@@ -244,4 +255,6 @@ TEST(LightGpu, DemoFireMatchesTheCpu) {
   ASSERT_FALSE(cdf.empty());
   EnvironmentMap env = EnvironmentMap::from_image(sky(512, 256), 1.0, -75.0);
   check(env, cdf, 2);
+  // What the renderers sample: blocks of cells.
+  check(env, EmissionCdf::build_light(scene.media[0], vol), 3);
 }

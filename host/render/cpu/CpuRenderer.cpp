@@ -23,7 +23,6 @@
 #include "render/cpu/Media.h"
 #include "render/cpu/Rng.h"
 #include "render/cpu/Sampling.h"
-#include "render/cpu/Transmittance.h"
 
 namespace pyrolume {
 namespace cpu {

@@ -10,13 +10,10 @@ namespace {
 
 // Walks the tentative collisions of [0, t_max] segment by segment (the majorant
 // is constant between consecutive cuts); `at_collision(sigma_t, sigma_maj)`
-// returns false to stop. Returns false when stopped early. sigma_maj_end, when
-// given, receives the majorant of the segment that holds t_max (0 where no
-// medium is; left alone when stopped before reaching it).
+// returns false to stop. Returns false when stopped early.
 template <class F>
 bool for_each_tentative_collision(const MediaData& md, int c, const glm::dvec3& o, const glm::dvec3& d,
-                                  double t_max, Pcg32& rng, TrackingCounters* counters, F at_collision,
-                                  double* sigma_maj_end = nullptr) {
+                                  double t_max, Pcg32& rng, TrackingCounters* counters, F at_collision) {
   thread_local std::vector<Span> spans;
   thread_local std::vector<double> cuts;
   thread_local std::vector<int> present;
@@ -27,7 +24,6 @@ bool for_each_tentative_collision(const MediaData& md, int c, const glm::dvec3& 
     if (!(a < t_max)) break;
     const double b = std::min(cuts[k + 1], t_max);
     const double sigma_maj = media_present(md, spans, a, cuts[k + 1], c, present);
-    if (sigma_maj_end && t_max <= cuts[k + 1]) *sigma_maj_end = sigma_maj;  // the cuts are the spans' own ends
     if (!(sigma_maj > 0.0)) continue;
     for (double t = a;;) {
       t += sample_free_flight(sigma_maj, rng.uniform());
@@ -68,20 +64,6 @@ double delta_tracking_transmittance(const MediaData& md, int c, const glm::dvec3
     return !(rng.uniform() * sigma_maj < sigma_t);  // real collision: stop
   });
   return escaped ? 1.0 : 0.0;
-}
-
-ShadowTracking ratio_tracking_to(const MediaData& md, int c, const glm::dvec3& o, const glm::dvec3& d, double t_max,
-                                 Pcg32& rng, TrackingCounters* counters) {
-  ShadowTracking r;
-  // Stopped early only when T reached 0, where sigma_maj_end does not matter.
-  for_each_tentative_collision(
-      md, c, o, d, t_max, rng, counters,
-      [&](double sigma_t, double sigma_maj) {
-        r.T *= 1.0 - sigma_t / sigma_maj;
-        return r.T != 0.0;
-      },
-      &r.sigma_maj_end);
-  return r;
 }
 
 }  // namespace pyrolume::cpu

@@ -37,19 +37,4 @@ double ratio_tracking_transmittance(const MediaData& md, int c, const glm::dvec3
 double delta_tracking_transmittance(const MediaData& md, int c, const glm::dvec3& o, const glm::dvec3& d,
                                     double t_max, Pcg32& rng, TrackingCounters* counters = nullptr);
 
-// Ratio tracking without roulette, for next-event estimation (docs/mis.md):
-// T = Π (1 − σt(x_k)/σ̄_k) over the tentative collisions x_k of [0, t_max).
-// T is the transmittance estimate and also the product of the null
-// probabilities a delta-tracking walk would have taken at the same points,
-// which the MIS weight needs (Miller et al. 2019); roulette would change the
-// first but not the second, so the plain reference keeps none.
-// sigma_maj_end: the majorant σ̄ of the segment that contains t_max (0 when no
-// medium is there): the rate at which delta tracking samples a collision at t_max.
-struct ShadowTracking {
-  double T = 1.0;
-  double sigma_maj_end = 0.0;
-};
-ShadowTracking ratio_tracking_to(const MediaData& md, int c, const glm::dvec3& o, const glm::dvec3& d, double t_max,
-                                 Pcg32& rng, TrackingCounters* counters = nullptr);
-
 }  // namespace pyrolume::cpu
