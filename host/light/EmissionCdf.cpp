@@ -54,10 +54,9 @@ EmissionCdf EmissionCdf::build(const Medium& m, const StoredVolume& vol) {
 //    assets/volumes/fire.vdb (Release, one core);
 //  - only cells that can emit are searched (15 % of fire.vdb's box: 176 k
 //    entries), so a sample is one binary search of ≤ 18 steps, fewer dependent
-//    loads than the two searches of a two-level scheme and far fewer than one
-//    shadow ray's ratio-tracking lookups;
-//  - MIS needs pdf(x) at every collision that collects emission: a dense
-//    per-cell pmf array makes that one load, with no search.
+//    loads than the two searches of a two-level scheme;
+//  - a dense per-cell pmf array makes pdf(x) one load, with no search, and
+//    direction_pdf one load per cell crossed.
 EmissionCdf EmissionCdf::build(const DenseGrid& density, const DenseGrid* temperature, const EmissionParams& p) {
   const auto t0 = std::chrono::steady_clock::now();
   EmissionCdf e;

@@ -38,8 +38,8 @@ struct LightSelection {
 // by power ∫ w dV (EmissionCdf::power).
 //
 // Strategy: Mis or LightOnly needs integrator.mis, the collision emission
-// estimator (Miller et al. 2019: MIS pdfs come from σ̄·T_maj, which the
-// absorption estimator does not have), max_depth ≥ 1 and at least one light.
+// estimator (what the renderers' MIS is written and tested for; docs/mis.md),
+// max_depth ≥ 1 and at least one light.
 LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs);
 
 // One line for stderr when the scene file asks for MIS ("mis": true written
