@@ -428,8 +428,6 @@ struct PathState {
 // docs/lights.md), or the constant background.
 vec3 escaped_radiance(vec3 d) { return HAS_ENVIRONMENT ? env_radiance(environment, d) : frame.background.rgb; }
 
-// The path leaves the scene: add what it sees, MIS-weighted when the
-// environment is a light.
 // MIS weight of what the current ray finds; next-event estimation's pdf for
 // its direction is computed on first use (most rays find no light to weigh,
 // and for a ray through an emissive grid it is a walk over its blocks).
@@ -439,6 +437,7 @@ float ray_weight(inout PathState p) {
   return unidirectional_weight(p.pdf_dir, p.p_light);
 }
 
+// The ray leaves the scene: add what it sees, MIS-weighted.
 void escape(inout PathState p) {
   p.L += ray_weight(p) * p.w * escaped_radiance(p.d);
 }

@@ -51,6 +51,8 @@ class RenderSession {
   // Passes are split when the device cannot finish them (PassStatus): the
   // largest pass size that has worked, and the samples lost at 1 spp per pass.
   int max_pass_spp() const { return max_pass_spp_; }
+  // Next-event estimation is on: every vertex sends a light ray too.
+  bool next_event_estimation() const { return light_selection_.strategy != LightStrategy::Bsdf; }
   uint64_t dropped_samples() const { return dropped_samples_; }
   int width() const { return settings_.width; }
   int height() const { return settings_.height; }

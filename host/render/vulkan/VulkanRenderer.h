@@ -25,7 +25,7 @@ class VulkanRenderer : public Backend {
   // Samples per pixel per dispatch: a fixed function of the image size, so the
   // pass schedule (and with it the float summation order) never depends on
   // timing and reruns are bit-identical.
-  static int spp_per_pass(int width, int height, int spp);
+  static int spp_per_pass(int width, int height, int spp, int rays_per_vertex = 1);
 
   // Sequences (docs/animation.md): keep the session between renders and, when
   // the next scene differs only in its media's grids and keyed values (same
