@@ -405,12 +405,10 @@ struct PathState {
   float t;     // distance along the current ray
   uint depth;  // scattering events (medium and surface) so far
   bool fresh;  // the ray changed: recompute the media spans and the surface hit
-  // MIS (docs/mis.md): the solid-angle pdfs with which the vertex's own
-  // sampling (0: camera or light ray) and next-event estimation pick the
-  // ray's direction; p_light < 0: not computed yet (ray_weight), from the
-  // vertex the ray left, vertex_o.
+  // MIS (docs/mis.md): the solid-angle pdfs with which the vertex's
+  // continuation (0: camera or light ray) and next-event estimation pick the
+  // ray's direction.
   float pdf_dir, p_light;
-  vec3 vertex_o;
   bool has_hit;     // a surface lies ahead on the current ray
   SurfaceHit hit;   // the closest one (t = its distance)
   // Next-event estimation runs as a light ray in this same state: it collects
@@ -421,21 +419,15 @@ struct PathState {
   bool light_ray;
   bool next_ends;  // the continuation has no weight or depth left
   vec3 next_o, next_d, next_w;
-  float next_pdf_dir;
+  float next_pdf_dir, next_p_light;
 };
 
 // Radiance of a ray that leaves the scene: the environment map (+Z up,
 // docs/lights.md), or the constant background.
 vec3 escaped_radiance(vec3 d) { return HAS_ENVIRONMENT ? env_radiance(environment, d) : frame.background.rgb; }
 
-// MIS weight of what the current ray finds; next-event estimation's pdf for
-// its direction is computed on first use (most rays find no light to weigh,
-// and for a ray through an emissive grid it is a walk over its blocks).
-float ray_weight(inout PathState p) {
-  if (!NEE || !(p.pdf_dir > 0.0)) return 1.0;
-  if (p.p_light < 0.0) p.p_light = light_direction_pdf(p.vertex_o, p.d);
-  return unidirectional_weight(p.pdf_dir, p.p_light);
-}
+// MIS weight of what the current ray finds before its next real event.
+float ray_weight(PathState p) { return unidirectional_weight(p.pdf_dir, p.p_light); }
 
 // The ray leaves the scene: add what it sees, MIS-weighted.
 void escape(inout PathState p) {
@@ -449,7 +441,6 @@ void new_ray(inout PathState p, vec3 o, vec3 d, float pdf_dir, float p_light) {
   p.fresh = true;
   p.pdf_dir = pdf_dir;
   p.p_light = p_light;
-  p.vertex_o = o;
 }
 
 // The current ray ends. A light ray hands over to the continuation its vertex
@@ -459,38 +450,55 @@ bool ray_ends(inout PathState p) {
   p.light_ray = false;
   if (p.next_ends) return true;
   p.w = p.next_w;
-  new_ray(p, p.next_o, p.next_d, p.next_pdf_dir, -1.0);
+  new_ray(p, p.next_o, p.next_d, p.next_pdf_dir, p.next_p_light);
   return false;
 }
 
-// Leave vertex o along d (weight w, the vertex's pdf pdf_dir). With
-// next-event estimation, first a light ray along light_dir, which the vertex's
-// lobe weights by f_light with pdf pdf_light (0: no light direction), and the
+// Whether a vertex draws its continuation from the lights (with next-event
+// estimation, probability 1 − frame.lights.y; docs/mis.md "Guided
+// continuation") and, if so, the direction. false with dir unset: its own lobe.
+bool continue_toward_light(vec3 o, inout uint rng, out vec3 dir, out bool none) {
+  dir = vec3(0.0, 0.0, 1.0);
+  none = false;
+  if (!NEE || rng_next(rng) < frame.lights.y) return false;
+  none = !sample_light_direction(o, rng, dir);
+  return true;
+}
+
+// Leave vertex o along d, which the vertex's lobe weights by f with pdf
+// pdf_own (the continuation's pdf is the mixture with the lights'). With
+// next-event estimation, first a light ray along light_dir, which the lobe
+// weights by f_light with pdf pdf_light (0: no light direction), and the
 // continuation waits. Returns true when the path has ended.
-bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 w, float pdf_dir, vec3 light_dir, vec3 f_light,
+bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 f, float pdf_own, vec3 light_dir, vec3 f_light,
                   float pdf_light) {
-  const bool ends = max3(w) <= 0.0;
   if (!NEE) {
-    p.w = w;
-    new_ray(p, o, d, pdf_dir, 0.0);
-    return ends;
+    p.w *= f / pdf_own;
+    new_ray(p, o, d, pdf_own, 0.0);
+    return !(max3(p.w) > 0.0);
   }
+  const float c = frame.lights.y;
+  const float p_light_d = max3(f) > 0.0 ? light_direction_pdf(o, d) : 0.0;
+  const float p_mix = c * pdf_own + (1.0 - c) * p_light_d;
+  const vec3 w = p_mix > 0.0 ? p.w * f / p_mix : vec3(0.0);
+  const bool ends = !(max3(w) > 0.0);
   float p_l = 0.0;
   vec3 w_light = vec3(0.0);
   if (pdf_light > 0.0 && max3(p.w * f_light) > 0.0) {
     p_l = light_direction_pdf(o, light_dir);
-    if (p_l > 0.0) w_light = p.w * f_light * (light_weight(p_l, pdf_light) / p_l);
+    if (p_l > 0.0) w_light = p.w * f_light * (light_weight(p_l, c * pdf_light + (1.0 - c) * p_l) / p_l);
   }
   if (!(max3(w_light) > 0.0)) {
     p.w = w;
-    new_ray(p, o, d, pdf_dir, -1.0);  // p_light when needed (ray_weight)
+    new_ray(p, o, d, p_mix, p_light_d);
     return ends;
   }
   p.next_ends = ends;
   p.next_o = o;
   p.next_d = d;
   p.next_w = w;
-  p.next_pdf_dir = pdf_dir;
+  p.next_pdf_dir = p_mix;
+  p.next_p_light = p_light_d;
   p.light_ray = true;
   p.w = w_light;
   new_ray(p, o, light_dir, 0.0, 0.0);
@@ -515,9 +523,11 @@ bool surface_bounce(inout PathState p, inout uint rng, inout PathStats stats) {
   float pdf_light = 0.0;
   if (NEE && max3(p.w * albedo) > 0.0 && sample_light_direction(o, rng, light_dir))
     pdf_light = max(dot(n, light_dir), 0.0) * (1.0 / PI);
-  vec3 d = sample_cosine_hemisphere(n, vec2(rng_next(rng), rng_next(rng)));
-  return leave_vertex(p, o, d, p.w * albedo, max(dot(n, d), 0.0) * (1.0 / PI), light_dir, albedo * pdf_light,
-                      pdf_light);
+  vec3 d;
+  bool none;
+  if (!continue_toward_light(o, rng, d, none)) d = sample_cosine_hemisphere(n, vec2(rng_next(rng), rng_next(rng)));
+  const float pdf_own = none ? 0.0 : max(dot(n, d), 0.0) * (1.0 / PI);
+  return leave_vertex(p, o, d, albedo * pdf_own, pdf_own, light_dir, albedo * pdf_light, pdf_light);
 }
 
 // One step of delta tracking along one path; returns true when the path has
@@ -623,14 +633,18 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
         pdf_light += q[i] * hg;
       }
     }
-    float pick = rng_next(rng), acc = 0.0, g = 0.0;
-    for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-      if (q[i] <= 0.0) continue;
-      acc += q[i];
-      g = media[i].sigma_s.w;
-      if (pick < acc) break;
+    vec3 d;
+    bool none;
+    if (!continue_toward_light(x, rng, d, none)) {
+      float pick = rng_next(rng), acc = 0.0, g = 0.0;
+      for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+        if (q[i] <= 0.0) continue;
+        acc += q[i];
+        g = media[i].sigma_s.w;
+        if (pick < acc) break;
+      }
+      d = sample_hg(p.d, g, vec2(rng_next(rng), rng_next(rng)));
     }
-    vec3 d = sample_hg(p.d, g, vec2(rng_next(rng), rng_next(rng)));
     vec3 f = vec3(0.0);
     float pdf_phase = 0.0;
     for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
@@ -638,7 +652,8 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
       f += share[i] * hg;
       pdf_phase += q[i] * hg;
     }
-    return leave_vertex(p, x, d, p.w * (f / pdf_phase), pdf_phase, light_dir, f_light, pdf_light);
+    if (none) f = vec3(0.0);
+    return leave_vertex(p, x, d, f, pdf_phase, light_dir, f_light, pdf_light);
   } else {
     float p_n = 1.0 - p_a - p_s;
     p.w *= sigma_n / (sigma_bar * p_n);
@@ -668,11 +683,10 @@ PathState camera_path(uvec2 pixel, uint k, out uint rng) {
   p.has_hit = false;
   p.pdf_dir = 0.0;
   p.p_light = 0.0;
-  p.vertex_o = p.o;
   p.light_ray = false;
   p.next_ends = true;
   p.next_o = p.next_d = p.next_w = vec3(0.0);
-  p.next_pdf_dir = 0.0;
+  p.next_pdf_dir = p.next_p_light = 0.0;
   return p;
 }
 

@@ -125,7 +125,7 @@ int main(int argc, char** argv) try {
     Scene s = base;
     s.integrator.mis = mis;
     s.integrator.emission_estimator = "collision";
-    s.integrator.light_only = false;
+    s.integrator.light_only = mis && std::getenv("BENCH_MIS_LIGHT_ONLY");
     return s;
   };
   std::fprintf(stderr, "bench_mis: reference, MIS, %d spp ...\n", o.ref_spp);

@@ -39,6 +39,7 @@ LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, cons
   const bool eligible = in.mis && in.emission_estimator == "collision" && in.max_depth >= 1 && s.any() &&
                         scene_scatters(scene);
   s.strategy = !eligible ? LightStrategy::Bsdf : (in.light_only ? LightStrategy::LightOnly : LightStrategy::Mis);
+  s.p_continue_own = s.strategy == LightStrategy::Bsdf ? 1.0 : kContinueOwn;
   return s;
 }
 

@@ -25,12 +25,18 @@ struct LightSelection {
   // Per scene medium: probability of picking its emission CDF (0: not a light).
   std::vector<double> p_medium;
   LightStrategy strategy = LightStrategy::Bsdf;
+  // With next-event estimation, the probability that a vertex's continuation
+  // is drawn from its own lobe; otherwise from the lights, by the same
+  // distribution as next-event estimation (docs/mis.md "Guided continuation").
+  double p_continue_own = 1.0;
 
   bool any() const;
 };
 
 // env: the loaded environment map or null; cdfs: per scene medium, its emission
 // CDF or null (homogeneous media and grids that emit nothing are not lights).
+//
+// Continuation: p_continue_own = kContinueOwn with next-event estimation, 1 without.
 //
 // Choice between lights: the environment and the emissive media get 1/2 each
 // when both exist (their powers, ∫Y dω and ∫Y(σa Le) dV, have different units,
@@ -40,6 +46,7 @@ struct LightSelection {
 // Strategy: Mis or LightOnly needs integrator.mis, the collision emission
 // estimator (what the renderers' MIS is written and tested for; docs/mis.md),
 // max_depth ≥ 1 and at least one light.
+inline constexpr double kContinueOwn = 0.5;
 LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs);
 
 // One line for stderr when the scene file asks for MIS ("mis": true written

@@ -108,7 +108,9 @@ struct FrameConstants {
   uvec4 image;           // x width, y height, z medium count, w max_depth
   uvec4 sampling;        // x seed, y frame, z unused, w unused
   vec4 lights;           // x: probability that next-event estimation picks the environment
-                         // (each emissive grid's is its GpuEmissionCdf measure.w); yzw: unused
+                         // (each emissive grid's is its GpuEmissionCdf measure.w); y: probability
+                         // that a vertex's continuation comes from its own lobe (LightSelection
+                         // p_continue_own); zw: unused
 };
 
 // Per-pass values (push constants).

@@ -23,6 +23,7 @@
 #include "render/cpu/Media.h"
 #include "render/cpu/Rng.h"
 #include "render/cpu/Sampling.h"
+#include "render/cpu/Transmittance.h"
 
 namespace pyrolume {
 namespace cpu {
@@ -78,6 +79,36 @@ struct WalkScene {
   }
 };
 
+// σa and σs of channel c at x, summed over the media present (s.present);
+// s.rho keeps each one's density for the phase mixture and the emission.
+void coefficients_at(const MediaData& md, int c, const glm::dvec3& x, Scratch& s, ThreadCounters& cnt,
+                     double& sigma_a, double& sigma_s) {
+  sigma_a = sigma_s = 0.0;
+  s.rho.resize(s.present.size());
+  for (size_t j = 0; j < s.present.size(); ++j) {
+    const MediumData& m = md.media[s.present[j]];
+    double rho = 1.0;
+    if (m.is_vdb()) {
+      rho = grid_density(m, x);
+      ++cnt.density_lookups;
+    }
+    s.rho[j] = rho;
+    sigma_a += m.sigma_a[c] * rho;
+    sigma_s += m.sigma_s[c] * rho;
+  }
+}
+
+// Σ σa_i Le_i of channel c at x over the media present (after coefficients_at).
+double emitted_at(const MediaData& md, int c, const glm::dvec3& x, Scratch& s) {
+  double e = 0.0;
+  for (size_t j = 0; j < s.present.size(); ++j) {
+    const int i = s.present[j];
+    const MediumData& m = md.media[i];
+    e += m.is_vdb() ? grid_sigma_a_Le(m, i, c, x, s.rho[j], s.Le_cache) : m.sigma_a_Le[c];
+  }
+  return e;
+}
+
 // The MIS state of the ray being tracked (docs/mis.md): the solid-angle pdf
 // with which its direction was sampled at its vertex (0 for the camera ray and
 // for light rays, whose radiance is never weighted), and the solid-angle pdf
@@ -117,55 +148,96 @@ struct VertexLobe {
   double f = 0.0, pdf = 0.0;
 };
 
-double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
-                    Scratch& s, int max_depth);
-
 // One next-event estimate from vertex o (the offset origin the continuing ray
 // also uses), a direction sampled from the lights (docs/mis.md): the
 // environment map's 2D CDF, or a point from an emissive grid's emission CDF
-// and the direction toward it. The radiance arriving along that direction is
-// estimated the way the walk finds it, by a walk that ends at its first real
-// event (max_depth 0: emission at every tentative collision up to it, the
-// environment if it escapes, nothing past a surface). Weighted by the power
-// heuristic against the vertex's own sampling, both pdfs in solid angle.
+// and the direction toward it. The radiance arriving along that direction
+// before anything scatters it is estimated by a light ray
+// (light_ray_radiance). Weighted by the power heuristic against the vertex's
+// own sampling, both pdfs in solid angle.
 // Returns the radiance times f / pdf, without the path weight β.
-template <class Lobe>
-double next_event(const WalkScene& ws, int c, const glm::dvec3& o, Lobe lobe, Pcg32& rng, ThreadCounters& cnt,
-                  Scratch& s) {
+double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
+                    Scratch& s, int max_depth);
+
+// One light direction from vertex o, drawn from the mixture of eq. (3) of
+// docs/mis.md: the environment map's 2D CDF, or a point from an emissive
+// grid's emission CDF and the direction toward it. false: nothing drawn.
+bool light_direction(const WalkScene& ws, const glm::dvec3& o, Pcg32& rng, glm::dvec3& dir) {
   const WalkLights& lights = ws.lights;
   double u = rng.uniform();
   const double u_env = rng.uniform(), v_env = rng.uniform();
   const glm::dvec3 u3(rng.uniform(), rng.uniform(), rng.uniform());
-  glm::dvec3 dir;
   if (u < lights.selection.p_env) {
     const EnvSample es = ws.environment->sample({u_env, v_env});
-    if (!(es.pdf > 0.0)) return 0.0;
     dir = es.dir;
-  } else {
-    u -= lights.selection.p_env;
-    int j = -1;
-    for (size_t i = 0; i < lights.cdf.size(); ++i) {
-      const double p = lights.selection.p_medium[i];
-      if (!(p > 0.0)) continue;
-      j = int(i);
-      if (u < p) break;
-      u -= p;
-    }
-    if (j < 0) return 0.0;
-    const EmissionSample es = lights.cdf[j]->sample(u_env, u3);
-    if (!(es.pdf > 0.0)) return 0.0;
-    const glm::dvec3 v = es.p - o;
-    const double r = glm::length(v);
-    if (!(r > 0.0)) return 0.0;
-    dir = v / r;
+    return es.pdf > 0.0;
   }
+  u -= lights.selection.p_env;
+  int j = -1;
+  for (size_t i = 0; i < lights.cdf.size(); ++i) {
+    const double p = lights.selection.p_medium[i];
+    if (!(p > 0.0)) continue;
+    j = int(i);
+    if (u < p) break;
+    u -= p;
+  }
+  if (j < 0) return false;
+  const EmissionSample es = lights.cdf[j]->sample(u_env, u3);
+  if (!(es.pdf > 0.0)) return false;
+  const glm::dvec3 v = es.p - o;
+  const double r = glm::length(v);
+  if (!(r > 0.0)) return false;
+  dir = v / r;
+  return true;
+}
+
+template <class Lobe>
+double next_event(const WalkScene& ws, int c, const glm::dvec3& o, Lobe lobe, Pcg32& rng, ThreadCounters& cnt,
+                  Scratch& s) {
+  const WalkLights& lights = ws.lights;
+  glm::dvec3 dir;
+  if (!light_direction(ws, o, rng, dir)) return 0.0;
   const VertexLobe l = lobe(dir);
   if (!(l.f > 0.0)) return 0.0;
   const double p_light = light_direction_pdf(ws, o, dir);
   if (!(p_light > 0.0)) return 0.0;
   const double radiance = walk_channel(ws, c, o, dir, rng, cnt, s.light_ray(), 0);
-  const double w = lights.selection.strategy == LightStrategy::LightOnly ? 1.0 : power_heuristic(p_light, l.pdf);
+  // Against the continuation's mixture pdf for the same direction.
+  const double c_own = lights.selection.p_continue_own;
+  const double w = lights.selection.strategy == LightStrategy::LightOnly
+                       ? 1.0
+                       : power_heuristic(p_light, c_own * l.pdf + (1.0 - c_own) * p_light);
   return l.f * radiance * w / p_light;
+}
+
+// The direction the path leaves vertex o by: with lights, from the mixture
+// p_m = c·p_vertex + (1 − c)·p_light (c = selection.p_continue_own), else from
+// the vertex's own sampling (sample_own). weight = f/p_m; mis records p_m and
+// p_light for the weights of what the ray finds. false: the direction carries
+// nothing (below a surface).
+template <class Lobe, class Own>
+bool continue_from(const WalkScene& ws, const glm::dvec3& o, Lobe& lobe, Own sample_own, Pcg32& rng, glm::dvec3& d,
+                   double& weight, RayMis& mis) {
+  if (!ws.lights.active()) {
+    d = sample_own();
+    const VertexLobe l = lobe(d);
+    weight = l.pdf > 0.0 ? l.f / l.pdf : 0.0;
+    mis = RayMis{l.pdf, 0.0};
+    return l.f > 0.0;
+  }
+  const double c = ws.lights.selection.p_continue_own;
+  if (rng.uniform() < c) {
+    d = sample_own();
+  } else if (!light_direction(ws, o, rng, d)) {
+    return false;
+  }
+  const VertexLobe l = lobe(d);
+  if (!(l.f > 0.0)) return false;
+  const double p_light = light_direction_pdf(ws, o, d);
+  const double p_m = c * l.pdf + (1.0 - c) * p_light;
+  weight = l.f / p_m;
+  mis = RayMis{p_m, p_light};
+  return true;
 }
 
 // One random walk of a *grey* world: colour channel c alone.
@@ -247,36 +319,15 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
         t += sample_free_flight(sigma_maj, rng.uniform());
         if (!(t < b)) break;  // memoryless: restart the flight at b
         const glm::dvec3 x = o + t * d;
-        // Look up the local coefficients of the media present.
-        double sigma_a = 0.0, sigma_s = 0.0;
-        s.rho.resize(s.present.size());
-        for (size_t j = 0; j < s.present.size(); ++j) {
-          const MediumData& m = md.media[s.present[j]];
-          double rho = 1.0;
-          if (m.is_vdb()) {
-            rho = grid_density(m, x);
-            ++cnt.density_lookups;
-          }
-          s.rho[j] = rho;
-          sigma_a += m.sigma_a[c] * rho;
-          sigma_s += m.sigma_s[c] * rho;
-        }
+        double sigma_a, sigma_s;
+        coefficients_at(md, c, x, s, cnt, sigma_a, sigma_s);
         if (exceeds_majorant(sigma_a + sigma_s, sigma_maj)) ++cnt.majorant_violations;
-        auto emitted = [&] {  // Σ σa_i Le_i at x
-          double e = 0.0;
-          for (size_t j = 0; j < s.present.size(); ++j) {
-            const int i = s.present[j];
-            const MediumData& m = md.media[i];
-            e += m.is_vdb() ? grid_sigma_a_Le(m, i, c, x, s.rho[j], s.Le_cache) : m.sigma_a_Le[c];
-          }
-          return e;
-        };
-        if (collision_estimator && sigma_a > 0.0) L += beta * w_ray * emitted() / sigma_maj;
+        if (collision_estimator && sigma_a > 0.0) L += beta * w_ray * emitted_at(md, c, x, s) / sigma_maj;
 
         const double u = rng.uniform() * sigma_maj;
         if (u < sigma_a) {
           ++cnt.collisions;
-          return collision_estimator ? L : beta * emitted() / sigma_a;
+          return collision_estimator ? L : beta * emitted_at(md, c, x, s) / sigma_a;
         }
         if (!(u < sigma_a + sigma_s)) continue;  // null collision
         ++cnt.collisions;
@@ -306,10 +357,12 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
           pick -= s.lobe_w[l];
           if (pick < 0.0) break;
         }
-        glm::dvec2 uv(rng.uniform(), rng.uniform());
         o = x;
-        d = sample_hg(d_in, g, uv).direction;
-        mis = RayMis{phase(d).pdf, lights.active() ? light_direction_pdf(ws, o, d) : 0.0};
+        double weight;
+        if (!continue_from(ws, o, phase, [&] { return sample_hg(d_in, g, {rng.uniform(), rng.uniform()}).direction; },
+                           rng, d, weight, mis))
+          return L;
+        beta *= weight;
         scattered = true;
         break;
       }
@@ -332,11 +385,12 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
       return VertexLobe{albedo * cos_theta / std::numbers::pi, cos_theta / std::numbers::pi};
     };
     if (lights.active()) L += beta * next_event(ws, c, o, lambert, rng, cnt, s);
-    beta *= albedo;
-    glm::dvec2 uv(rng.uniform(), rng.uniform());
-    const BsdfSample bs = sample_cosine_hemisphere(n_f, uv);
-    d = bs.direction;
-    mis = RayMis{bs.pdf, lights.active() ? light_direction_pdf(ws, o, d) : 0.0};
+    double weight;
+    if (!continue_from(ws, o, lambert,
+                       [&] { return sample_cosine_hemisphere(n_f, {rng.uniform(), rng.uniform()}).direction; }, rng, d,
+                       weight, mis))
+      return L;
+    beta *= weight;
   }
 }
 

@@ -385,6 +385,7 @@ void RenderSession::upload_constants(const Scene& scene) {
     now.grids[i].blackbody_lut = gpu_scene_.grids[i].blackbody_lut;
   gpu::FrameConstants frame = build_frame_constants(scene, settings_, uint32_t(now.media.size()));
   frame.lights.x = float(light_selection_.p_env);
+  frame.lights.y = float(light_selection_.p_continue_own);
   frame_buffer_.upload(ctx_, &frame, sizeof frame);
   if (!now.media.empty()) media_buffer_.upload(ctx_, now.media.data(), now.media.size() * sizeof(gpu::GpuMedium));
   if (!now.grids.empty()) grid_buffer_.upload(ctx_, now.grids.data(), now.grids.size() * sizeof(gpu::GpuGrid));
