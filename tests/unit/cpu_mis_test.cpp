@@ -114,6 +114,7 @@ TEST(LightSelection, ProbabilitiesAndStrategies) {
   // Two emissive grids of equal power share the media's half equally.
   LightSelection l = select_lights(s, &env, {&cdf, &cdf});
   EXPECT_EQ(l.strategy, LightStrategy::Mis);
+  EXPECT_DOUBLE_EQ(l.p_continue_own, kContinueOwn);  // continuations guided toward the lights
   EXPECT_DOUBLE_EQ(l.p_env, 0.5);
   EXPECT_DOUBLE_EQ(l.p_medium[0], 0.25);
   EXPECT_DOUBLE_EQ(l.p_medium[1], 0.25);
@@ -128,6 +129,7 @@ TEST(LightSelection, ProbabilitiesAndStrategies) {
   Scene off = s;
   off.integrator.mis = false;
   EXPECT_EQ(select_lights(off, &env, {&cdf}).strategy, LightStrategy::Bsdf);
+  EXPECT_DOUBLE_EQ(select_lights(off, &env, {&cdf}).p_continue_own, 1.0);  // BSDF sampling only
   Scene absorption = s;
   absorption.integrator.emission_estimator = "absorption";
   EXPECT_EQ(select_lights(absorption, &env, {&cdf}).strategy, LightStrategy::Bsdf);
