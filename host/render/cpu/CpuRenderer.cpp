@@ -284,11 +284,12 @@ bool continue_from(const WalkScene& ws, const glm::dvec3& o, Lobe& lobe, Own sam
 // collected before). Both count as real events.
 //
 // Next-event estimation (docs/mis.md), with the collision estimator only: at
-// every scattering and surface vertex that max_depth allows, one light sample
-// (next_event); emission from a light that the walk itself then finds (σa_j Le_j
-// of an emissive grid at a tentative collision, the environment on escape) is
-// weighted by the power heuristic with the unidirectional pdf
-// pdf_dir · σ̄(x) · R (per unit volume: / t², which the light pdf × t² cancels).
+// every scattering and surface vertex that max_depth allows, one light
+// direction and a light ray along it (next_event, which runs this walk with
+// max_depth 0); the continuation is drawn from the vertex's lobe or the lights
+// (continue_from), and what its ray finds before the next real event (emission
+// at tentative collisions, the environment on escape) is weighted by the power
+// heuristic of the two direction pdfs (unidirectional_weight).
 double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
                     Scratch& s, int max_depth) {
   const MediaData& md = ws.md;
