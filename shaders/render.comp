@@ -472,23 +472,24 @@ bool continue_toward_light(vec3 o, inout uint rng, out vec3 dir, out bool none) 
 // continuation waits. Returns true when the path has ended.
 bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 f, float pdf_own, vec3 light_dir, vec3 f_light,
                   float pdf_light) {
+  // "<= 0", not "!(> 0)": a NaN weight goes on and is counted (nonfinite_samples).
   if (!NEE) {
     p.w *= f / pdf_own;
     new_ray(p, o, d, pdf_own, 0.0);
-    return !(max3(p.w) > 0.0);
+    return max3(p.w) <= 0.0;
   }
   const float c = frame.lights.y;
   const float p_light_d = max3(f) > 0.0 ? light_direction_pdf(o, d) : 0.0;
   const float p_mix = c * pdf_own + (1.0 - c) * p_light_d;
   const vec3 w = p_mix > 0.0 ? p.w * f / p_mix : vec3(0.0);
-  const bool ends = !(max3(w) > 0.0);
+  const bool ends = max3(w) <= 0.0;
   float p_l = 0.0;
   vec3 w_light = vec3(0.0);
   if (pdf_light > 0.0 && max3(p.w * f_light) > 0.0) {
     p_l = light_direction_pdf(o, light_dir);
     if (p_l > 0.0) w_light = p.w * f_light * (light_weight(p_l, c * pdf_light + (1.0 - c) * p_l) / p_l);
   }
-  if (!(max3(w_light) > 0.0)) {
+  if (max3(w_light) <= 0.0) {
     p.w = w;
     new_ray(p, o, d, p_mix, p_light_d);
     return ends;
