@@ -426,12 +426,9 @@ struct PathState {
 // docs/lights.md), or the constant background.
 vec3 escaped_radiance(vec3 d) { return HAS_ENVIRONMENT ? env_radiance(environment, d) : frame.background.rgb; }
 
-// MIS weight of what the current ray finds before its next real event.
-float ray_weight(PathState p) { return unidirectional_weight(p.pdf_dir, p.p_light); }
-
 // The ray leaves the scene: add what it sees, MIS-weighted.
 void escape(inout PathState p) {
-  p.L += ray_weight(p) * p.w * escaped_radiance(p.d);
+  p.L += unidirectional_weight(p.pdf_dir, p.p_light) * p.w * escaped_radiance(p.d);
 }
 
 // Start a new ray at a vertex, its direction sampled with solid-angle pdf pdf_dir.
@@ -531,6 +528,19 @@ bool surface_bounce(inout PathState p, inout uint rng, inout PathStats stats) {
   return leave_vertex(p, o, d, albedo * pdf_own, pdf_own, light_dir, albedo * pdf_light, pdf_light);
 }
 
+// The phase function of a scattering mixture from d_in toward w: its value
+// f = Σ_i share_i·HG_i (per channel) and the pdf with which the vertex samples
+// w, Σ_i q_i·HG_i (lobe i picked with probability q_i).
+void phase_mixture(vec3 d_in, vec3 w, vec3 share[MEDIA_N], float q[MEDIA_N], out vec3 f, out float pdf) {
+  f = vec3(0.0);
+  pdf = 0.0;
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+    float hg = hg_pdf(dot(d_in, w), media[i].sigma_s.w);
+    f += share[i] * hg;
+    pdf += q[i] * hg;
+  }
+}
+
 // One step of delta tracking along one path; returns true when the path has
 // ended (p.L is then final).
 //
@@ -594,7 +604,7 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.
     // With next-event estimation the ray's own MIS weight (light rays: 1).
     vec3 e = emission_at(x, p.t, span, rho);
-    if (max3(e) > 0.0) p.L += (ray_weight(p) / sigma_bar) * p.w * e;
+    if (max3(e) > 0.0) p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_bar) * p.w * e;
   }
   vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
   float c = sigma_bar * avg3(p.w);
@@ -627,13 +637,7 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     for (uint i = 0u; i < MEDIUM_COUNT; ++i) q[i] /= total;
     vec3 light_dir = vec3(0.0), f_light = vec3(0.0);
     float pdf_light = 0.0;
-    if (NEE && sample_light_direction(x, rng, light_dir)) {
-      for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-        float hg = hg_pdf(dot(p.d, light_dir), media[i].sigma_s.w);
-        f_light += share[i] * hg;
-        pdf_light += q[i] * hg;
-      }
-    }
+    if (NEE && sample_light_direction(x, rng, light_dir)) phase_mixture(p.d, light_dir, share, q, f_light, pdf_light);
     vec3 d;
     bool none;
     if (!continue_toward_light(x, rng, d, none)) {
@@ -646,18 +650,13 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
       }
       d = sample_hg(p.d, g, vec2(rng_next(rng), rng_next(rng)));
     }
-    vec3 f = vec3(0.0);
-    float pdf_phase = 0.0;
-    for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-      float hg = hg_pdf(dot(p.d, d), media[i].sigma_s.w);
-      f += share[i] * hg;
-      pdf_phase += q[i] * hg;
-    }
+    vec3 f;
+    float pdf_phase;
+    phase_mixture(p.d, d, share, q, f, pdf_phase);
     if (none) f = vec3(0.0);
     return leave_vertex(p, x, d, f, pdf_phase, light_dir, f_light, pdf_light);
   } else {
-    float p_n = 1.0 - p_a - p_s;
-    p.w *= sigma_n / (sigma_bar * p_n);
+    p.w *= sigma_n / (sigma_bar * (1.0 - p_a - p_s));
   }
   return max3(p.w) <= 0.0 ? ray_ends(p) : false;
 }
