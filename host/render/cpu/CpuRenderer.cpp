@@ -148,14 +148,6 @@ struct VertexLobe {
   double f = 0.0, pdf = 0.0;
 };
 
-// One next-event estimate from vertex o (the offset origin the continuing ray
-// also uses), a direction sampled from the lights (docs/mis.md): the
-// environment map's 2D CDF, or a point from an emissive grid's emission CDF
-// and the direction toward it. The radiance arriving along that direction
-// before anything scatters it is estimated by a light ray
-// (light_ray_radiance). Weighted by the power heuristic against the vertex's
-// own sampling, both pdfs in solid angle.
-// Returns the radiance times f / pdf, without the path weight β.
 double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
                     Scratch& s, int max_depth);
 
@@ -191,6 +183,12 @@ bool light_direction(const WalkScene& ws, const glm::dvec3& o, Pcg32& rng, glm::
   return true;
 }
 
+// One next-event estimate from vertex o (the offset origin the continuing ray
+// also uses), a direction from the lights (light_direction). The radiance
+// arriving along it before anything scatters it is estimated by a light ray:
+// the walk itself with max_depth 0. Weighted by the power heuristic against
+// the continuation's pdf for the same direction, both in solid angle.
+// Returns the radiance times f / pdf, without the path weight β.
 template <class Lobe>
 double next_event(const WalkScene& ws, int c, const glm::dvec3& o, Lobe lobe, Pcg32& rng, ThreadCounters& cnt,
                   Scratch& s) {
@@ -369,9 +367,7 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
       }
     }
     if (scattered) continue;
-    if (!hit_surface) {
-      return L + beta * w_ray * ws.escaped(d, c);
-    }
+    if (!hit_surface) return L + beta * w_ray * ws.escaped(d, c);
 
     // Reached the surface: a Lambertian bounce.
     ++cnt.collisions;
