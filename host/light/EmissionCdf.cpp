@@ -163,15 +163,19 @@ EmissionCdf EmissionCdf::build(const DenseGrid& density, const DenseGrid* temper
   for (double x : w) total += x;
   e.power_ = total * e.cell_volume_;
 
+  e.entries_ = std::move(entries);
+  e.set_distribution(w);
+  e.build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return e;
+}
+
+void EmissionCdf::set_distribution(const std::vector<double>& w) {
   const int n = int(w.size());
   std::vector<float> cdf(size_t(n) + 1);
   build_cdf(w.data(), n, cdf.data());
-  e.cdf_.assign(cdf.begin() + 1, cdf.end());  // inclusive: cdf_[j] = P(entry <= j)
-  e.entries_ = std::move(entries);
-  e.pmf_.assign(ncell, 0.0f);
-  for (int j = 0; j < n; ++j) e.pmf_[e.entries_[j]] = float(bin_probability(cdf.data(), j));
-  e.build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return e;
+  cdf_.assign(cdf.begin() + 1, cdf.end());  // inclusive: cdf_[j] = P(entry <= j)
+  pmf_.assign(cell_count(), 0.0f);
+  for (int j = 0; j < n; ++j) pmf_[entries_[j]] = float(bin_probability(cdf.data(), j));
 }
 
 EmissionCdf EmissionCdf::blocks(int b) const {
@@ -202,12 +206,7 @@ EmissionCdf EmissionCdf::blocks(int b) const {
       w.push_back(sum[c]);
       e.entries_.push_back(uint32_t(c));
     }
-  const int n = int(w.size());
-  std::vector<float> cdf(size_t(n) + 1);
-  build_cdf(w.data(), n, cdf.data());
-  e.cdf_.assign(cdf.begin() + 1, cdf.end());
-  e.pmf_.assign(nblock, 0.0f);
-  for (int j = 0; j < n; ++j) e.pmf_[e.entries_[j]] = float(bin_probability(cdf.data(), j));
+  e.set_distribution(w);
   e.build_seconds_ = build_seconds_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return e;
 }

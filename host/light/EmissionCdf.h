@@ -124,6 +124,9 @@ class EmissionCdf {
   gpu::GpuEmissionCdf gpu_header(uint32_t entry_offset = 0, uint32_t pmf_offset = 0) const;
 
  private:
+  // The float CDF over entries_ (weights w, one per entry) and the per-cell pmf.
+  void set_distribution(const std::vector<double>& w);
+
   glm::ivec3 cells_{0};
   glm::dmat4 cell_to_world_{1.0}, world_to_cell_{1.0};
   double cell_volume_ = 0.0;
