@@ -95,6 +95,18 @@ inline void expect_same_image(const RenderResult& a, const RenderResult& b, doub
   std::printf("%s: %s\n", what, z.summary().c_str());
 }
 
+// On the fire over a plane under a sky (every strategy has finite variance
+// there), MIS at 256 spp and light sampling only at 256 spp converge to BSDF
+// sampling only at bsdf_spp. render(scene) is one backend's render; `who`
+// prefixes the reports.
+template <class Render>
+void expect_strategies_agree(Render render, const std::filesystem::path& dir, int bsdf_spp, const std::string& who) {
+  auto scene = [&](Strategy k, int spp) { return fire_over_plane_scene(dir, k, true, false, 24, 18, spp); };
+  const RenderResult bsdf = render(scene(Strategy::Bsdf, bsdf_spp));
+  expect_same_image(render(scene(Strategy::Mis, 256)), bsdf, 0.02, (who + "MIS vs BSDF only").c_str());
+  expect_same_image(render(scene(Strategy::LightOnly, 256)), bsdf, 0.02, (who + "light only vs BSDF only").c_str());
+}
+
 // Σ over the pixel-channels of the rows from `first_row` down of the
 // per-sample variance: the plane in front of the fire in fire_over_plane_scene.
 inline double lower_rows_variance(const RenderResult& r, int first_row) {

@@ -35,11 +35,7 @@ RenderResult render(const Scene& s) {
 // Terrain-like: an absorbing fire over a plane under a sky. All three
 // strategies have finite variance here.
 TEST(CpuMis, FireOverPlaneWithSkyStrategiesAgree) {
-  const auto dir = test::temp_dir("cpu_mis_plane");
-  auto scene = [&](Strategy k, int spp) { return test::fire_over_plane_scene(dir, k, true, false, 24, 18, spp); };
-  RenderResult bsdf = render(scene(Strategy::Bsdf, 1024));
-  test::expect_same_image(render(scene(Strategy::Mis, 256)), bsdf, 0.02, "MIS vs BSDF only");
-  test::expect_same_image(render(scene(Strategy::LightOnly, 256)), bsdf, 0.02, "light only vs BSDF only");
+  test::expect_strategies_agree([](const Scene& s) { return render(s); }, test::temp_dir("cpu_mis_plane"), 1024, "");
 }
 
 // The fire scatters too: MIS at medium vertices inside the emitter.

@@ -59,11 +59,8 @@ TEST_F(VulkanMis, EmissiveScatteringGridMatchesCpu) {
 }
 
 TEST_F(VulkanMis, StrategiesAgreeOnGpu) {
-  const auto dir = test::temp_dir("vk_mis_plane");
-  auto scene = [&](Strategy k, int spp) { return test::fire_over_plane_scene(dir, k, true, false, 24, 18, spp); };
-  RenderResult bsdf = gpu(scene(Strategy::Bsdf, 2048));
-  test::expect_same_image(gpu(scene(Strategy::Mis, 256)), bsdf, 0.02, "GPU MIS vs BSDF only");
-  test::expect_same_image(gpu(scene(Strategy::LightOnly, 256)), bsdf, 0.02, "GPU light only vs BSDF only");
+  test::expect_strategies_agree([this](const Scene& s) { return gpu(s); }, test::temp_dir("vk_mis_plane"), 2048,
+                                "GPU ");
 }
 
 TEST_F(VulkanMis, FurnaceSphereIsOneWithSkyAsLight) {
