@@ -24,6 +24,19 @@ template <class B>
 class HardMedia : public hard::HardCase<B> {};
 TYPED_TEST_SUITE(HardMedia, hard::Backends, hard::BackendNames);
 
+// The camera deep inside a homogeneous sphere of radius 50 (σ = 10, g 0.3),
+// emitting red Le (σa·Le): the high-albedo cases below, where escape is
+// negligible and max_depth truncates the paths.
+Scene deep_sphere_scene(int size, int spp, int max_depth, double sigma_a, double sigma_s, double Le) {
+  Scene s = test::analytic_base_scene(size, size, spp);
+  s.camera.position = {0.3, -0.2, 0.1};
+  s.camera.look_at = {1.0, 0.5, 2.0};
+  s.integrator.max_depth = max_depth;
+  s.media.push_back(test::homogeneous_sphere("deep", {0, 0, 0}, 50.0, glm::dvec3(sigma_a), glm::dvec3(sigma_s), 0.3,
+                                             glm::dvec3(1.0, 0.0, 0.0), Le));
+  return s;
+}
+
 // Density 0 everywhere: an all-zero grid with constant emission, an all-zero
 // grid with a hot temperature grid, and a homogeneous sphere with σa = σs = 0
 // (it "emits" σa·Le = 0), overlapping. Every sample is the background exactly;
@@ -236,12 +249,7 @@ TYPED_TEST(HardMedia, AbsorptionOnlyWithAZeroChannel) {
 // assumption holds on both backends (green and blue must be exactly 0).
 // Tolerance 2 %: ~630 collisions per path make 8192 samples what fits.
 TYPED_TEST(HardMedia, Albedo0999WithMaxDepth1000) {
-  Scene s = test::analytic_base_scene(8, 8, 128);
-  s.camera.position = {0.3, -0.2, 0.1};
-  s.camera.look_at = {1.0, 0.5, 2.0};
-  s.integrator.max_depth = 1000;
-  s.media.push_back(test::homogeneous_sphere("deep", {0, 0, 0}, 50.0, glm::dvec3(0.01), glm::dvec3(9.99), 0.3,
-                                             glm::dvec3(1.0, 0.0, 0.0), 2.0));
+  const Scene s = deep_sphere_scene(8, 128, 1000, 0.01, 9.99, 2.0);
   const double alpha = 9.99 / 10.0;
   const glm::dvec3 L = glm::dvec3(2.0, 0.0, 0.0) * (1.0 - std::pow(alpha, 1001.0));
   const RenderResult r = this->expect_closed_form(s, [L](int, int) { return L; }, "albedo 0.999", pooled(0.02));
@@ -259,12 +267,7 @@ TYPED_TEST(HardMedia, Albedo0999WithMaxDepth1000) {
 // the driver's loop budget per dispatch: the renderer must notice and split
 // the passes (RenderSession::run_pass) rather than drop samples.
 TYPED_TEST(HardMedia, LongPathsAlbedo09995WithMaxDepth5000) {
-  Scene s = test::analytic_base_scene(4, 4, 64);
-  s.camera.position = {0.3, -0.2, 0.1};
-  s.camera.look_at = {1.0, 0.5, 2.0};
-  s.integrator.max_depth = 5000;
-  s.media.push_back(test::homogeneous_sphere("deep", {0, 0, 0}, 50.0, glm::dvec3(0.005), glm::dvec3(9.995), 0.3,
-                                             glm::dvec3(1.0, 0.0, 0.0), 1.0));
+  const Scene s = deep_sphere_scene(4, 64, 5000, 0.005, 9.995, 1.0);
   const double alpha = 9.995 / 10.0, events = (1.0 - std::pow(alpha, 5001.0)) / (1.0 - alpha);
   const glm::dvec3 L = glm::dvec3(1.0, 0.0, 0.0) * (1.0 - std::pow(alpha, 5001.0));
   Scene one = s;
