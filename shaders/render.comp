@@ -462,6 +462,13 @@ bool continue_toward_light(vec3 o, inout uint rng, out vec3 dir, out bool none) 
   return true;
 }
 
+// The continuation's solid-angle pdf of a direction that the vertex's lobe
+// draws with pdf_own and the lights with p_light (docs/mis.md eq. 5).
+float continuation_pdf(float pdf_own, float p_light) {
+  const float c = frame.lights.y;
+  return c * pdf_own + (1.0 - c) * p_light;
+}
+
 // Leave vertex o along d, which the vertex's lobe weights by f with pdf
 // pdf_own (the continuation's pdf is the mixture with the lights'). With
 // next-event estimation, first a light ray along light_dir, which the lobe
@@ -475,16 +482,15 @@ bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 f, float pdf_own, vec3
     new_ray(p, o, d, pdf_own, 0.0);
     return max3(p.w) <= 0.0;
   }
-  const float c = frame.lights.y;
   const float p_light_d = max3(f) > 0.0 ? light_direction_pdf(o, d) : 0.0;
-  const float p_mix = c * pdf_own + (1.0 - c) * p_light_d;
+  const float p_mix = continuation_pdf(pdf_own, p_light_d);
   const vec3 w = p_mix > 0.0 ? p.w * f / p_mix : vec3(0.0);
   const bool ends = max3(w) <= 0.0;
   float p_l = 0.0;
   vec3 w_light = vec3(0.0);
   if (pdf_light > 0.0 && max3(p.w * f_light) > 0.0) {
     p_l = light_direction_pdf(o, light_dir);
-    if (p_l > 0.0) w_light = p.w * f_light * (light_weight(p_l, c * pdf_light + (1.0 - c) * p_l) / p_l);
+    if (p_l > 0.0) w_light = p.w * f_light * (light_weight(p_l, continuation_pdf(pdf_light, p_l)) / p_l);
   }
   if (max3(w_light) <= 0.0) {
     p.w = w;

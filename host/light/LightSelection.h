@@ -19,6 +19,11 @@ enum class LightStrategy {
   LightOnly,  // debug (integrator.light_only): next-event estimation only
 };
 
+// With next-event estimation, the share of continuations drawn from the
+// vertex's own lobe (docs/mis.md "Guided continuation": the best of 1, 1/2
+// and 1/4 on terrain_explosion).
+inline constexpr double kContinueOwn = 0.5;
+
 struct LightSelection {
   // Probability that one next-event sample picks the environment map.
   double p_env = 0.0;
@@ -31,6 +36,11 @@ struct LightSelection {
   double p_continue_own = 1.0;
 
   bool any() const;
+  // The continuation's solid-angle pdf of a direction that the vertex's lobe
+  // draws with p_own and the lights with p_light (docs/mis.md eq. 5).
+  double continuation_pdf(double p_own, double p_light) const {
+    return p_continue_own * p_own + (1.0 - p_continue_own) * p_light;
+  }
 };
 
 // env: the loaded environment map or null; cdfs: per scene medium, its emission
@@ -46,7 +56,6 @@ struct LightSelection {
 // Strategy: Mis or LightOnly needs integrator.mis, the collision emission
 // estimator (what the renderers' MIS is written and tested for; docs/mis.md),
 // max_depth ≥ 1 and at least one light.
-inline constexpr double kContinueOwn = 0.5;
 LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs);
 
 // One line for stderr when the scene file asks for MIS ("mis": true written

@@ -201,10 +201,9 @@ double next_event(const WalkScene& ws, int c, const glm::dvec3& o, Lobe lobe, Pc
   if (!(p_light > 0.0)) return 0.0;
   const double radiance = walk_channel(ws, c, o, dir, rng, cnt, s.light_ray(), 0);
   // Against the continuation's mixture pdf for the same direction.
-  const double c_own = lights.selection.p_continue_own;
   const double w = lights.selection.strategy == LightStrategy::LightOnly
                        ? 1.0
-                       : power_heuristic(p_light, c_own * l.pdf + (1.0 - c_own) * p_light);
+                       : power_heuristic(p_light, lights.selection.continuation_pdf(l.pdf, p_light));
   return l.f * radiance * w / p_light;
 }
 
@@ -223,8 +222,7 @@ bool continue_from(const WalkScene& ws, const glm::dvec3& o, Lobe& lobe, Own sam
     mis = RayMis{l.pdf, 0.0};
     return l.f > 0.0;
   }
-  const double c = ws.lights.selection.p_continue_own;
-  if (rng.uniform() < c) {
+  if (rng.uniform() < ws.lights.selection.p_continue_own) {
     d = sample_own();
   } else if (!light_direction(ws, o, rng, d)) {
     return false;
@@ -232,7 +230,7 @@ bool continue_from(const WalkScene& ws, const glm::dvec3& o, Lobe& lobe, Own sam
   const VertexLobe l = lobe(d);
   if (!(l.f > 0.0)) return false;
   const double p_light = light_direction_pdf(ws, o, d);
-  const double p_m = c * l.pdf + (1.0 - c) * p_light;
+  const double p_m = ws.lights.selection.continuation_pdf(l.pdf, p_light);
   weight = l.f / p_m;
   mis = RayMis{p_m, p_light};
   return true;
