@@ -9,10 +9,11 @@
 //   #define LIGHTS_ENVIRONMENT   // env_radiance / env_sample / env_pdf, needs:
 //     layout(std430, binding = …) readonly buffer EnvTexelBlock { vec4 env_texels[]; };
 //     layout(std430, binding = …) readonly buffer EnvCdfBlock { float env_cdf[]; };
-//   #define LIGHTS_EMISSION      // emission_sample / emission_pdf, needs:
+//   #define LIGHTS_EMISSION      // emission_sample / emission_pdf / emission_direction_pdf, needs:
 //     layout(std430, binding = …) readonly buffer EmissionCdfBlock { float emission_cdf[]; };
 //     layout(std430, binding = …) readonly buffer EmissionCellBlock { uint emission_cells[]; };
 //     layout(std430, binding = …) readonly buffer EmissionPmfBlock { float emission_pmf[]; };
+//     layout(std430, binding = …) readonly buffer EmissionClusterBlock { GpuEmissionCluster emission_clusters[]; };
 //
 // The GpuEnvironment / GpuEmissionCdf headers are passed by value (keep them in
 // a uniform block). Block names are free; the array names are the contract.
@@ -121,46 +122,92 @@ struct EmissionSample {
   uint cell;  // linear cell index; 0xffffffff: no sample
 };
 
-// Cell by the inclusive CDF (the first entry whose CDF exceeds u), then a
-// uniform point in the cell's world-space parallelepiped.
-EmissionSample emission_sample(GpuEmissionCdf e, float u, vec3 u3) {
+// I_s(o) of cluster s (absolute index): its share of the emission over the
+// squared distance from o, bounded by its radius (EmissionCdf::cluster_importance).
+float emission_cluster_importance(uint s, vec3 o) {
+  vec3 d = o - emission_clusters[s].sphere.xyz;
+  return emission_clusters[s].power.x / max(dot(d, d), emission_clusters[s].sphere.w);
+}
+
+// Σ_s I_s(o): the normaliser of the distribution seen from o; one per vertex,
+// passed to the functions below as `norm`.
+float emission_receiver_norm(GpuEmissionCdf e, vec3 o) {
+  if (e.cells.w == 0u) return 0.0;
+  float z = 0.0;
+  uint n = e.clusters.x * e.clusters.y * e.clusters.z;
+  for (uint s = 0u; s < n; ++s)
+    if (emission_clusters[e.offsets.z + s].power.x > 0.0) z += emission_cluster_importance(e.offsets.z + s, o);
+  return z;
+}
+
+// The cluster of a cell; inv_k = 1/k. (cell + 0.5)/k is at least 1/(2k) from
+// an integer, far more than float rounding, so the float product is exact
+// after floor, and it avoids an integer division (scalarised on llvmpipe).
+uint emission_cluster_of(GpuEmissionCdf e, uvec3 cell, float inv_k) {
+  uvec3 c = uvec3((vec3(cell) + 0.5) * inv_k);
+  return e.offsets.z + (c.z * e.clusters.y + c.y) * e.clusters.x + c.x;
+}
+
+// From receiver o: a cluster by I_s(o) (the first whose running sum exceeds
+// u·norm; the last nonempty one if rounding leaves none), then u_cell picks
+// the cell by the cluster's inclusive CDF (its own number: u rescaled inside
+// the cluster would lose float precision in small clusters), then a uniform
+// point in the cell's world-space parallelepiped (EmissionCdf::sample_from).
+EmissionSample emission_sample(GpuEmissionCdf e, vec3 o, float norm, float u, float u_cell, vec3 u3) {
   EmissionSample s;
   s.p = vec3(0.0);
   s.pdf = 0.0;
   s.cell = 0xffffffffu;
-  uint n = e.cells.w;
-  if (n == 0u) return s;
+  if (e.cells.w == 0u || !(norm > 0.0)) return s;
+  float target = u * norm, acc = 0.0, share = 0.0;
+  uint pick = 0xffffffffu;
+  uint n = e.clusters.x * e.clusters.y * e.clusters.z;
+  for (uint k = 0u; k < n; ++k) {
+    uint c = e.offsets.z + k;
+    if (!(emission_clusters[c].power.x > 0.0)) continue;
+    float i = emission_cluster_importance(c, o);
+    pick = c;
+    share = i;
+    acc += i;
+    if (target < acc) break;
+  }
+  if (pick == 0xffffffffu || !(share > 0.0)) return s;
   uint base = e.offsets.x;
-  uint lo = 0u, hi = n - 1u;
+  uint lo = emission_clusters[pick].entries.x, hi = lo + emission_clusters[pick].entries.y - 1u;
   while (lo < hi) {
     uint mid = (lo + hi) / 2u;
-    if (emission_cdf[base + mid] <= u) lo = mid + 1u; else hi = mid;
+    if (emission_cdf[base + mid] <= u_cell) lo = mid + 1u; else hi = mid;
   }
   uint cell = emission_cells[base + lo];
   uint X = e.cells.x, Y = e.cells.y;
   vec4 c1 = vec4(float(cell % X) + u3.x, float((cell / X) % Y) + u3.y, float(cell / (X * Y)) + u3.z, 1.0);
   s.p = vec3(dot(e.cell_to_world_row0, c1), dot(e.cell_to_world_row1, c1), dot(e.cell_to_world_row2, c1));
-  s.pdf = emission_pmf[e.offsets.y + cell] * e.measure.y;
+  s.pdf = share / norm * emission_pmf[e.offsets.y + cell] * e.measure.y;
   s.cell = cell;
   return s;
 }
 
-// Volume pdf of the cell containing world point p (0 outside the grid's cells).
-float emission_pdf(GpuEmissionCdf e, vec3 p) {
-  if (e.cells.w == 0u) return 0.0;
+// Volume pdf from receiver o of the cell containing world point p (0 outside
+// the grid's cells).
+float emission_pdf(GpuEmissionCdf e, vec3 o, float norm, vec3 p) {
+  if (e.cells.w == 0u || !(norm > 0.0)) return 0.0;
   vec4 p1 = vec4(p, 1.0);
   vec3 c = floor(vec3(dot(e.world_to_cell_row0, p1), dot(e.world_to_cell_row1, p1), dot(e.world_to_cell_row2, p1)));
   if (any(lessThan(c, vec3(0.0))) || any(greaterThanEqual(c, vec3(e.cells.xyz)))) return 0.0;
-  uint cell = (uint(c.z) * e.cells.y + uint(c.y)) * e.cells.x + uint(c.x);
-  return emission_pmf[e.offsets.y + cell] * e.measure.y;
+  uvec3 ci = uvec3(c);
+  uint cell = (ci.z * e.cells.y + ci.y) * e.cells.x + ci.x;
+  float q = emission_pmf[e.offsets.y + cell];
+  if (!(q > 0.0)) return 0.0;
+  return emission_cluster_importance(emission_cluster_of(e, ci, 1.0 / float(e.clusters.w)), o) / norm * q * e.measure.y;
 }
 
 // Solid-angle pdf at o of direction w (unit) toward a point drawn by
-// emission_sample: ∫₀^∞ pdf(o + t·w) t² dt over the cells the ray crosses, by
-// 3D DDA (Amanatides & Woo 1987); EmissionCdf::direction_pdf on the host. The
-// map to cell coordinates is affine, so t stays the world distance there.
-float emission_direction_pdf(GpuEmissionCdf e, vec3 o, vec3 w) {
-  if (e.cells.w == 0u) return 0.0;
+// emission_sample from o: ∫₀^∞ pdf(o + t·w) t² dt over the cells the ray
+// crosses, by 3D DDA (Amanatides & Woo 1987); EmissionCdf::direction_pdf on
+// the host. The map to cell coordinates is affine, so t stays the world
+// distance there.
+float emission_direction_pdf(GpuEmissionCdf e, vec3 o, float norm, vec3 w) {
+  if (e.cells.w == 0u || !(norm > 0.0)) return 0.0;
   vec4 o1 = vec4(o, 1.0), w0 = vec4(w, 0.0);
   vec3 co = vec3(dot(e.world_to_cell_row0, o1), dot(e.world_to_cell_row1, o1), dot(e.world_to_cell_row2, o1));
   vec3 cw = vec3(dot(e.world_to_cell_row0, w0), dot(e.world_to_cell_row1, w0), dot(e.world_to_cell_row2, w0));
@@ -191,19 +238,28 @@ float emission_direction_pdf(GpuEmissionCdf e, vec3 o, vec3 w) {
       t_delta[a] = -1.0 / cw[a];
     }
   }
-  float sum = 0.0, t = t0;
+  float sum = 0.0, t = t0, importance = 0.0;
+  uint last = 0xffffffffu;
+  const float inv_k = 1.0 / float(e.clusters.w);
   // At most one step per cell face crossed: n.x + n.y + n.z.
   for (int k = 0; k < n.x + n.y + n.z && t < t1; ++k) {
     int a = t_next.x <= t_next.y ? (t_next.x <= t_next.z ? 0 : 2) : (t_next.y <= t_next.z ? 1 : 2);
     float tb = min(t_next[a], t1);
-    float pmf = emission_pmf[e.offsets.y + uint((cell.z * n.y + cell.y) * n.x + cell.x)];
-    sum += pmf * (tb - t) * (tb * tb + tb * t + t * t);  // tb³ − t³, factored
+    float q = emission_pmf[e.offsets.y + uint((cell.z * n.y + cell.y) * n.x + cell.x)];
+    if (q > 0.0) {
+      uint s = emission_cluster_of(e, uvec3(cell), inv_k);
+      if (s != last) {
+        importance = emission_cluster_importance(s, o);
+        last = s;
+      }
+      sum += importance * q * (tb - t) * (tb * tb + tb * t + t * t);  // tb³ − t³, factored
+    }
     t = tb;
     cell[a] += stp[a];
     if (cell[a] < 0 || cell[a] >= n[a]) break;
     t_next[a] += t_delta[a];
   }
-  return sum * e.measure.y * (1.0 / 3.0);
+  return sum * e.measure.y * (1.0 / 3.0) / norm;
 }
 
 #endif  // LIGHTS_EMISSION

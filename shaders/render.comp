@@ -70,6 +70,9 @@ layout(std140, set = 0, binding = BINDING_ENV_HEADER) uniform EnvHeaderBlock { G
 layout(std430, set = 0, binding = BINDING_EMISSION_CDF) readonly buffer EmissionCdfBlock { float emission_cdf[]; };
 layout(std430, set = 0, binding = BINDING_EMISSION_CELLS) readonly buffer EmissionCellBlock { uint emission_cells[]; };
 layout(std430, set = 0, binding = BINDING_EMISSION_PMF) readonly buffer EmissionPmfBlock { float emission_pmf[]; };
+layout(std430, set = 0, binding = BINDING_EMISSION_CLUSTERS) readonly buffer EmissionClusterBlock {
+  GpuEmissionCluster emission_clusters[];
+};
 layout(std140, set = 0, binding = BINDING_EMISSION_HEADERS) uniform EmissionHeaderBlock {
   GpuEmissionCdf emission_lights[MAX_GRIDS];  // by grid slot; measure.w: probability of picking it
 };
@@ -345,17 +348,30 @@ vec3 transmittance(vec3 o, vec3 d, bool ratio, inout uint rng, inout PathStats s
   return T;
 }
 
+// The normalisers of the emissive grids' light distributions seen from
+// vertex o (emission_receiver_norm), by grid slot: computed once per vertex.
+void light_norms(vec3 o, out vec4 norm) {
+  norm = vec4(0.0);
+  if (HAS_GRIDS && HAS_EMISSION)
+    for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+      if (uint(media[i].sigma_a.w) != SHAPE_GRID) continue;
+      const uint slot = uint(media[i].bounds0.x);
+      if (emission_lights[slot].measure.w > 0.0) norm[slot] = emission_receiver_norm(emission_lights[slot], o);
+    }
+}
+
 // The solid-angle pdf with which next-event estimation at o picks direction
 // d (docs/mis.md): the environment map's, and each emissive grid's pdf of the
-// direction toward a point of its emission CDF, mixed by the light choice.
-float light_direction_pdf(vec3 o, vec3 d) {
+// direction toward a point of its emission CDF seen from o, mixed by the
+// light choice. norm: light_norms(o).
+float light_direction_pdf(vec3 o, vec4 norm, vec3 d) {
   float p = 0.0;
   if (HAS_ENVIRONMENT && frame.lights.x > 0.0) p += frame.lights.x * env_pdf(environment, d);
   if (HAS_GRIDS && HAS_EMISSION)
     for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
       if (uint(media[i].sigma_a.w) != SHAPE_GRID) continue;
       GpuEmissionCdf e = emission_lights[uint(media[i].bounds0.x)];
-      if (e.measure.w > 0.0) p += e.measure.w * emission_direction_pdf(e, o, d);
+      if (e.measure.w > 0.0) p += e.measure.w * emission_direction_pdf(e, o, norm[uint(media[i].bounds0.x)], d);
     }
   return p;
 }
@@ -363,7 +379,7 @@ float light_direction_pdf(vec3 o, vec3 d) {
 // A light direction for next-event estimation from point o: the environment
 // map's, or toward a point drawn from an emissive grid's emission CDF (the
 // light chosen by frame.lights.x and each grid's measure.w). false: none.
-bool sample_light_direction(vec3 o, inout uint rng, out vec3 dir) {
+bool sample_light_direction(vec3 o, vec4 norm, inout uint rng, out vec3 dir) {
   dir = vec3(0.0, 0.0, 1.0);
   float u = rng_next(rng);
   vec2 u2 = vec2(rng_next(rng), rng_next(rng));
@@ -387,7 +403,9 @@ bool sample_light_direction(vec3 o, inout uint rng, out vec3 dir) {
     if (u < p) found = true; else u -= p;
   }
   if (pick == MEDIUM_COUNT) return false;
-  EmissionSample es = emission_sample(emission_lights[uint(media[pick].bounds0.x)], rng_next(rng), vec3(u2, u_z));
+  const uint slot = uint(media[pick].bounds0.x);
+  const float u_cluster = rng_next(rng), u_cell = rng_next(rng);
+  EmissionSample es = emission_sample(emission_lights[slot], o, norm[slot], u_cluster, u_cell, vec3(u2, u_z));
   if (!(es.pdf > 0.0)) return false;
   vec3 v = es.p - o;
   float dist = length(v);
@@ -420,6 +438,12 @@ struct PathState {
   bool next_ends;  // the continuation has no weight or depth left
   vec3 next_o, next_d, next_w;
   float next_pdf_dir, next_p_light;
+  // A surface vertex sends integrator.surface_light_samples light rays, one
+  // after another: how many are still to come, and what their weights need
+  // (the path weight at the vertex, the normal on the incident side, the albedo).
+  uint lights_left;
+  vec3 vertex_w, vertex_n, vertex_albedo;
+  vec4 vertex_norm;  // light_norms at the current vertex, by grid slot (MAX_GRIDS = 4)
 };
 
 // Radiance of a ray that leaves the scene: the environment map (+Z up,
@@ -440,10 +464,40 @@ void new_ray(inout PathState p, vec3 o, vec3 d, float pdf_dir, float p_light) {
   p.p_light = p_light;
 }
 
-// The current ray ends. A light ray hands over to the continuation its vertex
-// sampled; returns true when the path has ended.
-bool ray_ends(inout PathState p) {
+// The continuation's solid-angle pdf of a direction that the vertex's lobe
+// draws with pdf_own and the lights with p_light (docs/mis.md eq. 5).
+float continuation_pdf(float pdf_own, float p_light) {
+  const float c = frame.lights.y;
+  return c * pdf_own + (1.0 - c) * p_light;
+}
+
+// The next of a surface vertex's light rays (docs/mis.md "Several light
+// samples"): a light direction from the vertex, its weight w·f·MIS weight /
+// (n·p_light) for the n = frame.lights.z samples. false: none is left.
+bool next_surface_light_ray(inout PathState p, inout uint rng) {
+  const float n = frame.lights.z;
+  while (p.lights_left > 0u) {
+    --p.lights_left;
+    vec3 dir;
+    if (!sample_light_direction(p.next_o, p.vertex_norm, rng, dir)) continue;
+    const float pdf_own = max(dot(p.vertex_n, dir), 0.0) * (1.0 / PI);
+    const float p_l = pdf_own > 0.0 ? light_direction_pdf(p.next_o, p.vertex_norm, dir) : 0.0;
+    if (!(p_l > 0.0)) continue;
+    const vec3 w = p.vertex_w * p.vertex_albedo * pdf_own *
+                   (light_weight(n * p_l, continuation_pdf(pdf_own, p_l)) / (n * p_l));
+    if (max3(w) <= 0.0) continue;
+    p.w = w;
+    new_ray(p, p.next_o, dir, 0.0, 0.0);
+    return true;
+  }
+  return false;
+}
+
+// The current ray ends. A light ray hands over to the vertex's next light ray
+// or to the continuation it sampled; returns true when the path has ended.
+bool ray_ends(inout PathState p, inout uint rng) {
   if (!NEE || !p.light_ray) return true;
+  if (next_surface_light_ray(p, rng)) return false;
   p.light_ray = false;
   if (p.next_ends) return true;
   p.w = p.next_w;
@@ -454,56 +508,47 @@ bool ray_ends(inout PathState p) {
 // Whether a vertex draws its continuation from the lights (with next-event
 // estimation, probability 1 − frame.lights.y; docs/mis.md "Guided
 // continuation") and, if so, the direction. false with dir unset: its own lobe.
-bool continue_toward_light(vec3 o, inout uint rng, out vec3 dir, out bool none) {
+bool continue_toward_light(vec3 o, vec4 norm, inout uint rng, out vec3 dir, out bool none) {
   dir = vec3(0.0, 0.0, 1.0);
   none = false;
   if (!NEE || rng_next(rng) < frame.lights.y) return false;
-  none = !sample_light_direction(o, rng, dir);
+  none = !sample_light_direction(o, norm, rng, dir);
   return true;
-}
-
-// The continuation's solid-angle pdf of a direction that the vertex's lobe
-// draws with pdf_own and the lights with p_light (docs/mis.md eq. 5).
-float continuation_pdf(float pdf_own, float p_light) {
-  const float c = frame.lights.y;
-  return c * pdf_own + (1.0 - c) * p_light;
 }
 
 // Leave vertex o along d, which the vertex's lobe weights by f with pdf
 // pdf_own (the continuation's pdf is the mixture with the lights'). With
-// next-event estimation, first a light ray along light_dir, which the lobe
-// weights by f_light with pdf pdf_light (0: no light direction), and the
-// continuation waits. Returns true when the path has ended.
-bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 f, float pdf_own, vec3 light_dir, vec3 f_light,
-                  float pdf_light) {
+// next-event estimation, first the vertex's n_light light rays, the first
+// along light_dir, which the lobe weights by f_light with pdf pdf_light (0: no
+// light direction; the others: next_surface_light_ray), and the continuation
+// waits. Returns true when the path has ended.
+bool leave_vertex(inout PathState p, inout uint rng, vec3 o, vec3 d, vec3 f, float pdf_own, vec3 light_dir,
+                  vec3 f_light, float pdf_light, uint n_light) {
   // "<= 0", not "!(> 0)": a NaN weight goes on and is counted (nonfinite_samples).
   if (!NEE) {
     p.w *= f / pdf_own;
     new_ray(p, o, d, pdf_own, 0.0);
     return max3(p.w) <= 0.0;
   }
-  const float p_light_d = max3(f) > 0.0 ? light_direction_pdf(o, d) : 0.0;
+  const float n = float(n_light);
+  const float p_light_d = max3(f) > 0.0 ? light_direction_pdf(o, p.vertex_norm, d) : 0.0;
   const float p_mix = continuation_pdf(pdf_own, p_light_d);
   const vec3 w = p_mix > 0.0 ? p.w * f / p_mix : vec3(0.0);
-  const bool ends = max3(w) <= 0.0;
-  float p_l = 0.0;
   vec3 w_light = vec3(0.0);
   if (pdf_light > 0.0 && max3(p.w * f_light) > 0.0) {
-    p_l = light_direction_pdf(o, light_dir);
-    if (p_l > 0.0) w_light = p.w * f_light * (light_weight(p_l, continuation_pdf(pdf_light, p_l)) / p_l);
+    const float p_l = light_direction_pdf(o, p.vertex_norm, light_dir);
+    if (p_l > 0.0) w_light = p.w * f_light * (light_weight(n * p_l, continuation_pdf(pdf_light, p_l)) / (n * p_l));
   }
-  if (max3(w_light) <= 0.0) {
-    p.w = w;
-    new_ray(p, o, d, p_mix, p_light_d);
-    return ends;
-  }
-  p.next_ends = ends;
+  p.next_ends = max3(w) <= 0.0;
   p.next_o = o;
   p.next_d = d;
   p.next_w = w;
   p.next_pdf_dir = p_mix;
-  p.next_p_light = p_light_d;
+  p.next_p_light = n * p_light_d;
+  p.lights_left = n_light - 1u;
+  p.vertex_w = p.w;
   p.light_ray = true;
+  if (max3(w_light) <= 0.0) return ray_ends(p, rng);  // the next light ray, or the continuation
   p.w = w_light;
   new_ray(p, o, light_dir, 0.0, 0.0);
   return false;
@@ -525,13 +570,18 @@ bool surface_bounce(inout PathState p, inout uint rng, inout PathStats stats) {
   // Next-event estimation: f·cos = albedo·cos/π, BSDF pdf cos/π.
   vec3 light_dir = vec3(0.0);
   float pdf_light = 0.0;
-  if (NEE && max3(p.w * albedo) > 0.0 && sample_light_direction(o, rng, light_dir))
+  if (NEE) light_norms(o, p.vertex_norm);
+  if (NEE && max3(p.w * albedo) > 0.0 && sample_light_direction(o, p.vertex_norm, rng, light_dir))
     pdf_light = max(dot(n, light_dir), 0.0) * (1.0 / PI);
   vec3 d;
   bool none;
-  if (!continue_toward_light(o, rng, d, none)) d = sample_cosine_hemisphere(n, vec2(rng_next(rng), rng_next(rng)));
+  if (!continue_toward_light(o, p.vertex_norm, rng, d, none))
+    d = sample_cosine_hemisphere(n, vec2(rng_next(rng), rng_next(rng)));
   const float pdf_own = none ? 0.0 : max(dot(n, d), 0.0) * (1.0 / PI);
-  return leave_vertex(p, o, d, albedo * pdf_own, pdf_own, light_dir, albedo * pdf_light, pdf_light);
+  p.vertex_n = n;
+  p.vertex_albedo = albedo;
+  const uint n_light = NEE && max3(p.w * albedo) > 0.0 ? uint(frame.lights.z) : 1u;
+  return leave_vertex(p, rng, o, d, albedo * pdf_own, pdf_own, light_dir, albedo * pdf_light, pdf_light, n_light);
 }
 
 // The phase function of a scattering mixture from d_in toward w: its value
@@ -567,7 +617,7 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     p.t = 0.0;
     if (!any_hit && !p.has_hit) {
       escape(p);
-      return ray_ends(p);
+      return ray_ends(p, rng);
     }
     // Move the origin to the first thing the ray reaches, so every later
     // position o + t·d is computed with a small t: from a camera 1e4 units
@@ -591,12 +641,12 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   const float t_surface = p.has_hit ? p.hit.t : INF;
   if (isinf(t_next) && !p.has_hit) {
     escape(p);
-    return ray_ends(p);
+    return ray_ends(p, rng);
   }
   const float t_end = min(t_next, t_surface);
   float dt = sigma_bar > 0.0 ? sample_free_flight(sigma_bar, rng_next(rng)) : INF;
   if (p.t + dt >= t_end) {
-    if (p.has_hit && t_surface <= t_next) return NEE && p.light_ray ? ray_ends(p) : surface_bounce(p, rng, stats);
+    if (p.has_hit && t_surface <= t_next) return NEE && p.light_ray ? ray_ends(p, rng) : surface_bounce(p, rng, stats);
     p.t = t_next;
     return false;
   }
@@ -621,10 +671,10 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     // Absorbed: the absorption estimator collects sigma_a·Le / (sigma_bar·P_a).
     stats.events += 1.0;
     if (HAS_EMISSION && !COLLISION_ESTIMATOR) p.L += p.w * emission_at(x, p.t, span, rho) / (sigma_bar * p_a);
-    return ray_ends(p);
+    return ray_ends(p, rng);
   } else if (HAS_SCATTERING && u < p_a + p_s) {
     stats.events += 1.0;
-    if (NEE && p.light_ray) return ray_ends(p);  // a light ray ends at its first real event
+    if (NEE && p.light_ray) return ray_ends(p, rng);  // a light ray ends at its first real event
     if (p.depth >= frame.image.w) return true;  // max_depth reached
     ++p.depth;
     p.w *= sigma_s / (sigma_bar * p_s);
@@ -643,10 +693,12 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     for (uint i = 0u; i < MEDIUM_COUNT; ++i) q[i] /= total;
     vec3 light_dir = vec3(0.0), f_light = vec3(0.0);
     float pdf_light = 0.0;
-    if (NEE && sample_light_direction(x, rng, light_dir)) phase_mixture(p.d, light_dir, share, q, f_light, pdf_light);
+    if (NEE) light_norms(x, p.vertex_norm);
+    if (NEE && sample_light_direction(x, p.vertex_norm, rng, light_dir))
+      phase_mixture(p.d, light_dir, share, q, f_light, pdf_light);
     vec3 d;
     bool none;
-    if (!continue_toward_light(x, rng, d, none)) {
+    if (!continue_toward_light(x, p.vertex_norm, rng, d, none)) {
       float pick = rng_next(rng), acc = 0.0, g = 0.0;
       for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
         if (q[i] <= 0.0) continue;
@@ -660,11 +712,11 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     float pdf_phase;
     phase_mixture(p.d, d, share, q, f, pdf_phase);
     if (none) f = vec3(0.0);
-    return leave_vertex(p, x, d, f, pdf_phase, light_dir, f_light, pdf_light);
+    return leave_vertex(p, rng, x, d, f, pdf_phase, light_dir, f_light, pdf_light, 1u);
   } else {
     p.w *= sigma_n / (sigma_bar * (1.0 - p_a - p_s));
   }
-  return max3(p.w) <= 0.0 ? ray_ends(p) : false;
+  return max3(p.w) <= 0.0 ? ray_ends(p, rng) : false;
 }
 
 // A camera ray through pixel `pixel` for sample `k`, with that sample's random stream.
@@ -693,6 +745,9 @@ PathState camera_path(uvec2 pixel, uint k, out uint rng) {
   p.next_ends = true;
   p.next_o = p.next_d = p.next_w = vec3(0.0);
   p.next_pdf_dir = p.next_p_light = 0.0;
+  p.lights_left = 0u;
+  p.vertex_w = p.vertex_n = p.vertex_albedo = vec3(0.0);
+  p.vertex_norm = vec4(0.0);
   return p;
 }
 

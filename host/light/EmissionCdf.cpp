@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
 #include <unordered_map>
 
 #include "color/Blackbody.h"
@@ -213,12 +214,15 @@ EmissionCdf EmissionCdf::blocks(int b) const {
 
 EmissionCdf EmissionCdf::build_light(const Medium& m, const StoredVolume& vol) {
   const EmissionCdf cells = build(m, vol);
-  return cells.blocks(light_block(cells.cells()));
+  const EmissionCdf blocks = cells.blocks(light_block(cells.cells()));
+  return blocks.clustered(light_cluster(blocks.cells()));
 }
 
-int EmissionCdf::light_block(const glm::ivec3& cells) {
+int EmissionCdf::light_block(const glm::ivec3& cells) { return light_block(cells, kLightBlocksPerAxis); }
+
+int EmissionCdf::light_block(const glm::ivec3& cells, int per_axis) {
   const int longest = std::max(cells.x, std::max(cells.y, cells.z));
-  return std::max(1, (longest + kLightBlocksPerAxis - 1) / kLightBlocksPerAxis);
+  return std::max(1, (longest + per_axis - 1) / per_axis);
 }
 
 double EmissionCdf::cell_weight(const glm::ivec3& c) const {
@@ -256,8 +260,8 @@ double EmissionCdf::pdf(const glm::dvec3& p) const {
   return double(pmf_[size_t(linear_cell(glm::ivec3(f)))]) / cell_volume_;
 }
 
-double EmissionCdf::direction_pdf(const glm::dvec3& o, const glm::dvec3& w) const {
-  if (empty()) return 0.0;
+template <class F>
+void EmissionCdf::walk_cells(const glm::dvec3& o, const glm::dvec3& w, F f) const {
   // The map to cell coordinates is affine, so the ray keeps its parameter t
   // (world distance, w unit length) there: c(t) = co + t·cw.
   const glm::dvec3 co = world_to_cell(o);
@@ -266,16 +270,15 @@ double EmissionCdf::direction_pdf(const glm::dvec3& o, const glm::dvec3& w) cons
   double t0 = 0.0, t1 = std::numeric_limits<double>::infinity();
   for (int a = 0; a < 3; ++a) {
     if (cw[a] == 0.0) {
-      if (co[a] < 0.0 || co[a] >= n[a]) return 0.0;
+      if (co[a] < 0.0 || co[a] >= n[a]) return;
       continue;
     }
     const double ta = -co[a] / cw[a], tb = (n[a] - co[a]) / cw[a];
     t0 = std::max(t0, std::min(ta, tb));
     t1 = std::min(t1, std::max(ta, tb));
   }
-  if (!(t0 < t1)) return 0.0;
-  // 3D DDA (Amanatides & Woo 1987) over the cells the ray crosses; in each the
-  // volume pdf is constant, and ∫ t² dt over [ta, tb] is (tb³ − ta³)/3.
+  if (!(t0 < t1)) return;
+  // 3D DDA (Amanatides & Woo 1987) over the cells the ray crosses.
   glm::ivec3 cell = glm::clamp(glm::ivec3(glm::floor(co + cw * t0)), glm::ivec3(0), cells_ - 1);
   glm::ivec3 step(0);
   glm::dvec3 t_next(std::numeric_limits<double>::infinity()), t_delta(std::numeric_limits<double>::infinity());
@@ -290,20 +293,180 @@ double EmissionCdf::direction_pdf(const glm::dvec3& o, const glm::dvec3& w) cons
       t_delta[a] = -1.0 / cw[a];
     }
   }
-  double sum = 0.0, t = t0;
+  double t = t0;
   while (t < t1) {
     const int a = t_next.x <= t_next.y ? (t_next.x <= t_next.z ? 0 : 2) : (t_next.y <= t_next.z ? 1 : 2);
     const double tb = std::min(t_next[a], t1);
-    sum += double(pmf_[size_t(linear_cell(cell))]) * (tb - t) * (tb * tb + tb * t + t * t);  // tb³ − t³
+    f(cell, t, tb);
     t = tb;
     cell[a] += step[a];
     if (cell[a] < 0 || cell[a] >= cells_[a]) break;
     t_next[a] += t_delta[a];
   }
-  return sum / (3.0 * cell_volume_);
 }
 
-gpu::GpuEmissionCdf EmissionCdf::gpu_header(uint32_t entry_offset, uint32_t pmf_offset) const {
+double EmissionCdf::direction_pdf(const glm::dvec3& o, double norm, const glm::dvec3& w) const {
+  if (empty() || !(norm > 0.0)) return 0.0;
+  // In each cell the volume pdf is constant, and ∫ t² dt over [ta, tb] is (tb³ − ta³)/3.
+  double sum = 0.0;
+  if (!is_clustered()) {
+    walk_cells(o, w, [&](const glm::ivec3& c, double ta, double tb) {
+      sum += double(pmf_[size_t(linear_cell(c))]) * (tb - ta) * (tb * tb + tb * ta + ta * ta);  // tb³ − ta³
+    });
+    return sum / (3.0 * cell_volume_);
+  }
+  size_t last = clusters_.size();
+  double importance = 0.0;
+  walk_cells(o, w, [&](const glm::ivec3& c, double ta, double tb) {
+    const float q = local_pmf_[size_t(linear_cell(c))];
+    if (!(q > 0.0f)) return;
+    const size_t s = cluster_of(c);
+    if (s != last) importance = cluster_importance(o, last = s);
+    sum += importance * double(q) * (tb - ta) * (tb * tb + tb * ta + ta * ta);
+  });
+  return sum / (3.0 * cell_volume_ * norm);
+}
+
+size_t EmissionCdf::cluster_of(const glm::ivec3& cell) const {
+  const glm::ivec3 s = cell / cluster_k_;
+  return (size_t(s.z) * cluster_dims_.y + s.y) * cluster_dims_.x + s.x;
+}
+
+double EmissionCdf::cluster_importance(const glm::dvec3& o, size_t s) const {
+  const Cluster& c = clusters_[s];
+  const glm::dvec3 d = o - c.centre;
+  return c.power / std::max(glm::dot(d, d), c.radius2);
+}
+
+double EmissionCdf::receiver_norm(const glm::dvec3& o) const {
+  if (!is_clustered()) return empty() ? 0.0 : 1.0;
+  double z = 0.0;
+  for (size_t s = 0; s < clusters_.size(); ++s)
+    if (clusters_[s].power > 0.0) z += cluster_importance(o, s);
+  return z;
+}
+
+EmissionSample EmissionCdf::sample_from(const glm::dvec3& o, double norm, double u, double u_cell,
+                                        const glm::dvec3& u3) const {
+  if (!is_clustered()) return sample(u_cell, u3);
+  EmissionSample s;
+  if (empty() || !(norm > 0.0)) return s;
+  // The cluster: the first whose running sum of I_s exceeds u·norm (the last
+  // nonempty one if rounding leaves none), then u_cell the cell (lights.glsl
+  // emission_sample: the same searches).
+  const double target = u * norm;
+  double acc = 0.0, share = 0.0;
+  size_t pick = clusters_.size();
+  for (size_t k = 0; k < clusters_.size(); ++k) {
+    if (!(clusters_[k].power > 0.0)) continue;
+    const double i = cluster_importance(o, k);
+    pick = k;
+    share = i;
+    acc += i;
+    if (target < acc) break;
+  }
+  const Cluster& c = clusters_[pick];
+  uint32_t lo = c.first, hi = c.first + c.count - 1;
+  while (lo < hi) {
+    const uint32_t mid = (lo + hi) / 2;
+    if (double(local_cdf_[mid]) <= u_cell)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  const uint32_t cell = entries_[lo];
+  const int X = cells_.x, Y = cells_.y;
+  const glm::ivec3 ci(int(cell % uint32_t(X)), int((cell / uint32_t(X)) % uint32_t(Y)), int(cell / (uint32_t(X) * Y)));
+  s.cell = cell;
+  s.p = cell_to_world(glm::dvec3(ci) + u3);
+  s.pdf = share / norm * double(local_pmf_[cell]) / cell_volume_;
+  return s;
+}
+
+double EmissionCdf::pdf_from(const glm::dvec3& o, double norm, const glm::dvec3& p) const {
+  if (!is_clustered()) return pdf(p);
+  const glm::dvec3 f = glm::floor(world_to_cell(p));
+  if (f.x < 0 || f.y < 0 || f.z < 0 || f.x >= cells_.x || f.y >= cells_.y || f.z >= cells_.z) return 0.0;
+  const glm::ivec3 c(f);
+  const double q = local_pmf_[size_t(linear_cell(c))];
+  if (!(q > 0.0) || !(norm > 0.0)) return 0.0;
+  return cluster_importance(o, cluster_of(c)) / norm * q / cell_volume_;
+}
+
+EmissionCdf EmissionCdf::clustered(int k) const {
+  if (empty()) return *this;
+  EmissionCdf e = *this;
+  k = std::max(k, 1);
+  e.cluster_k_ = k;
+  e.cluster_dims_ = (cells_ + (k - 1)) / k;
+  const size_t n = size_t(e.cluster_dims_.x) * e.cluster_dims_.y * e.cluster_dims_.z;
+  e.clusters_.assign(n, Cluster{});
+  // Entries grouped by cluster, ascending cells inside (a stable sort of the
+  // ascending entries); the static CDF is rebuilt in that order.
+  std::vector<uint32_t> order = entries_;
+  auto cell_coords = [&](uint32_t cell) {
+    const int X = cells_.x, Y = cells_.y;
+    return glm::ivec3(int(cell % uint32_t(X)), int((cell / uint32_t(X)) % uint32_t(Y)), int(cell / (uint32_t(X) * Y)));
+  };
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    return e.cluster_of(cell_coords(a)) < e.cluster_of(cell_coords(b));
+  });
+  e.entries_ = order;
+  std::vector<double> w(order.size());
+  double total = 0.0;
+  for (size_t j = 0; j < order.size(); ++j) total += w[j] = double(weight_[order[j]]);
+  e.set_distribution(w);
+  e.local_cdf_.assign(order.size(), 0.0f);
+  e.local_pmf_.assign(cell_count(), 0.0f);
+  std::vector<float> cdf;
+  for (size_t j = 0; j < order.size();) {
+    const size_t s = e.cluster_of(cell_coords(order[j]));
+    size_t end = j;
+    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+    double sum = 0.0;
+    while (end < order.size() && e.cluster_of(cell_coords(order[end])) == s) {
+      const glm::dvec3 c(cell_coords(order[end]));
+      lo = glm::min(lo, c);
+      hi = glm::max(hi, c + 1.0);
+      sum += w[end];
+      ++end;
+    }
+    Cluster& cl = e.clusters_[s];
+    cl.first = uint32_t(j);
+    cl.count = uint32_t(end - j);
+    cl.power = sum / total;
+    // Bounding sphere of the box [lo, hi] in world space (the map is affine,
+    // so the box's image is a parallelepiped whose corners bound it).
+    cl.centre = cell_to_world(0.5 * (lo + hi));
+    for (int corner = 0; corner < 8; ++corner) {
+      const glm::dvec3 p = cell_to_world({corner & 1 ? hi.x : lo.x, corner & 2 ? hi.y : lo.y, corner & 4 ? hi.z : lo.z});
+      cl.radius2 = std::max(cl.radius2, glm::dot(p - cl.centre, p - cl.centre));
+    }
+    const int m = int(end - j);
+    cdf.assign(size_t(m) + 1, 0.0f);
+    build_cdf(w.data() + j, m, cdf.data());
+    for (int i = 0; i < m; ++i) {
+      e.local_cdf_[j + size_t(i)] = cdf[size_t(i) + 1];
+      e.local_pmf_[order[j + size_t(i)]] = float(bin_probability(cdf.data(), i));
+    }
+    j = end;
+  }
+  return e;
+}
+
+std::vector<gpu::GpuEmissionCluster> EmissionCdf::gpu_clusters() const {
+  std::vector<gpu::GpuEmissionCluster> out(clusters_.size());
+  for (size_t s = 0; s < clusters_.size(); ++s) {
+    const Cluster& c = clusters_[s];
+    out[s].sphere = gpu::vec4(float(c.centre.x), float(c.centre.y), float(c.centre.z), float(c.radius2));
+    out[s].power = gpu::vec4(float(c.power), 0.0f, 0.0f, 0.0f);
+    out[s].entries = gpu::uvec4(c.first, c.count, 0u, 0u);
+  }
+  return out;
+}
+
+gpu::GpuEmissionCdf EmissionCdf::gpu_header(uint32_t entry_offset, uint32_t pmf_offset, uint32_t cluster_offset) const {
+  if (!empty() && !is_clustered()) throw std::logic_error("EmissionCdf::gpu_header: the GPU needs a clustered() distribution");
   gpu::GpuEmissionCdf g{};
   auto row = [](const glm::dmat4& m, int r) {
     return gpu::vec4(float(m[0][r]), float(m[1][r]), float(m[2][r]), float(m[3][r]));
@@ -315,7 +478,9 @@ gpu::GpuEmissionCdf EmissionCdf::gpu_header(uint32_t entry_offset, uint32_t pmf_
   g.cell_to_world_row1 = row(cell_to_world_, 1);
   g.cell_to_world_row2 = row(cell_to_world_, 2);
   g.cells = gpu::uvec4(uint32_t(cells_.x), uint32_t(cells_.y), uint32_t(cells_.z), uint32_t(cdf_.size()));
-  g.offsets = gpu::uvec4(entry_offset, pmf_offset, 0u, 0u);
+  g.offsets = gpu::uvec4(entry_offset, pmf_offset, cluster_offset, 0u);
+  g.clusters = gpu::uvec4(uint32_t(cluster_dims_.x), uint32_t(cluster_dims_.y), uint32_t(cluster_dims_.z),
+                          uint32_t(cluster_k_));
   g.measure = gpu::vec4(float(cell_volume_), cell_volume_ > 0.0 ? float(1.0 / cell_volume_) : 0.0f, float(power_), 0.0f);
   return g;
 }

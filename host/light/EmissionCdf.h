@@ -92,9 +92,23 @@ class EmissionCdf {
   // short (docs/mis.md).
   EmissionCdf blocks(int b) const;
   static constexpr int kLightBlocksPerAxis = 24;
-  // What both renderers sample: build(m, vol).blocks(light_block(...)).
+  // The same distribution seen from a receiver o (docs/mis.md "Seen from the
+  // receiver"): the cells are grouped into clusters of k³ cells, and a
+  // cluster s is chosen with probability ∝ I_s(o) = Φ_s / max(|o − c_s|², r_s²)
+  // (Φ_s its share of the distribution above, c_s and r_s the world-space
+  // bounding sphere of its cells of weight > 0), then a cell inside it by its
+  // share of Φ_s. A cluster's light falls off as 1/distance² from the
+  // receiver; the bound r_s keeps I_s finite inside. Applies to sample_from,
+  // pdf_from and direction_pdf.
+  EmissionCdf clustered(int k) const;
+  static constexpr int kLightClustersPerAxis = 6;
+  // What both renderers sample:
+  // build(m, vol).blocks(light_block(...)).clustered(light_cluster(...)).
   static EmissionCdf build_light(const Medium& m, const StoredVolume& vol);
   static int light_block(const glm::ivec3& cells);
+  static int light_cluster(const glm::ivec3& cells) { return light_block(cells, kLightClustersPerAxis); }
+  static int light_block(const glm::ivec3& cells, int per_axis);
+  bool is_clustered() const { return !clusters_.empty(); }
 
   // The unnormalised weight w of a cell and its probability (as stored, float).
   double cell_weight(const glm::ivec3& c) const;
@@ -111,21 +125,46 @@ class EmissionCdf {
   EmissionSample sample(double u, const glm::dvec3& u3) const;
   // The volume pdf of the cell containing world point p (0 outside every cell).
   double pdf(const glm::dvec3& p) const;
+  // Seen from receiver o: the same as sample() and pdf() unless clustered.
+  // norm: receiver_norm(o), which a caller asking several times from one o
+  // may compute once.
+  double receiver_norm(const glm::dvec3& o) const;
+  // u picks the cluster, u_cell the cell inside it (like sample()'s u), u3 the point.
+  EmissionSample sample_from(const glm::dvec3& o, double u, double u_cell, const glm::dvec3& u3) const {
+    return sample_from(o, receiver_norm(o), u, u_cell, u3);
+  }
+  EmissionSample sample_from(const glm::dvec3& o, double norm, double u, double u_cell, const glm::dvec3& u3) const;
+  double pdf_from(const glm::dvec3& o, const glm::dvec3& p) const { return pdf_from(o, receiver_norm(o), p); }
+  double pdf_from(const glm::dvec3& o, double norm, const glm::dvec3& p) const;
   // The solid-angle pdf at o of direction w (unit) toward a point drawn by
-  // sample(): ∫₀^∞ pdf(o + t·w) t² dt, exactly, over the cells the ray crosses.
-  double direction_pdf(const glm::dvec3& o, const glm::dvec3& w) const;
+  // sample_from(o, …): ∫₀^∞ pdf_from(o, o + t·w) t² dt, exactly, over the
+  // cells the ray crosses.
+  double direction_pdf(const glm::dvec3& o, const glm::dvec3& w) const {
+    return direction_pdf(o, receiver_norm(o), w);
+  }
+  double direction_pdf(const glm::dvec3& o, double norm, const glm::dvec3& w) const;
 
   // ---- what the GPU reads (shaders/shared/light_types.h, shaders/lights.glsl) ----
-  const std::vector<float>& gpu_cdf() const { return cdf_; }          // inclusive, last = 1
-  const std::vector<uint32_t>& gpu_cells() const { return entries_; }  // ascending linear cell indices
-  const std::vector<float>& gpu_pmf() const { return pmf_; }          // one per cell
-  // entry_offset / pmf_offset: where this medium's arrays start when several
-  // media share the buffers.
-  gpu::GpuEmissionCdf gpu_header(uint32_t entry_offset = 0, uint32_t pmf_offset = 0) const;
+  // The GPU samples only from a receiver: a clustered() distribution (or an
+  // empty one); gpu_header throws std::logic_error for any other.
+  const std::vector<float>& gpu_cdf() const { return local_cdf_; }    // inclusive within each cluster
+  const std::vector<uint32_t>& gpu_cells() const { return entries_; }  // grouped by cluster
+  const std::vector<float>& gpu_pmf() const { return local_pmf_; }    // one per cell, within its cluster
+  std::vector<gpu::GpuEmissionCluster> gpu_clusters() const;          // one per cluster
+  // entry_offset / pmf_offset / cluster_offset: where this medium's arrays
+  // start when several media share the buffers.
+  gpu::GpuEmissionCdf gpu_header(uint32_t entry_offset = 0, uint32_t pmf_offset = 0,
+                                 uint32_t cluster_offset = 0) const;
 
  private:
   // The float CDF over entries_ (weights w, one per entry) and the per-cell pmf.
   void set_distribution(const std::vector<double>& w);
+  // I_s(o) of cluster s; and the cluster of a cell (clustered only).
+  double cluster_importance(const glm::dvec3& o, size_t s) const;
+  size_t cluster_of(const glm::ivec3& cell) const;
+  // Visits the cells the ray o + t·w (w unit) crosses, by 3D DDA: f(cell, t0, t1).
+  template <class F>
+  void walk_cells(const glm::dvec3& o, const glm::dvec3& w, F f) const;
 
   glm::ivec3 cells_{0};
   glm::dmat4 cell_to_world_{1.0}, world_to_cell_{1.0};
@@ -136,6 +175,19 @@ class EmissionCdf {
   std::vector<float> pmf_;        // per cell
   std::vector<float> cdf_;        // per entry
   std::vector<uint32_t> entries_; // per entry
+
+  // clustered(): entries_ are grouped by cluster (then ascending).
+  struct Cluster {
+    glm::dvec3 centre{0.0};   // world-space bounding sphere of its cells of weight > 0
+    double radius2 = 0.0;
+    double power = 0.0;       // Φ_s: Σ of its cells' weights / Σ of all (0: empty)
+    uint32_t first = 0, count = 0;  // its entries
+  };
+  int cluster_k_ = 0;              // cells per cluster per axis
+  glm::ivec3 cluster_dims_{0};
+  std::vector<Cluster> clusters_;  // dense over the cluster grid, linear like cells
+  std::vector<float> local_cdf_;   // per entry: inclusive CDF within its cluster
+  std::vector<float> local_pmf_;   // per cell: probability within its cluster
 };
 
 }  // namespace pyrolume

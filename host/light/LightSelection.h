@@ -34,6 +34,10 @@ struct LightSelection {
   // is drawn from its own lobe; otherwise from the lights, by the same
   // distribution as next-event estimation (docs/mis.md "Guided continuation").
   double p_continue_own = 1.0;
+  // Next-event samples at each surface vertex (integrator.surface_light_samples;
+  // medium vertices take one). MIS weighs their n·p_light against the
+  // continuation's pdf (docs/mis.md "Several light samples").
+  int surface_light_samples = 1;
 
   bool any() const;
   // The continuation's solid-angle pdf of a direction that the vertex's lobe

@@ -38,6 +38,7 @@ PYRO_CONST uint BINDING_EMISSION_CDF = 17;     // readonly buffer float[]: every
 PYRO_CONST uint BINDING_EMISSION_CELLS = 18;   // readonly buffer uint[]: the cells of its entries
 PYRO_CONST uint BINDING_EMISSION_PMF = 19;     // readonly buffer float[]: per-cell probabilities
 PYRO_CONST uint BINDING_EMISSION_HEADERS = 20; // uniform GpuEmissionCdf[MAX_GRIDS], by grid slot
+PYRO_CONST uint BINDING_EMISSION_CLUSTERS = 22; // readonly buffer GpuEmissionCluster[]: their clusters
 PYRO_CONST uint BINDING_PASS_STATUS = 21;      // buffer PassStatus: what the pass could not finish
 
 // Specialisation constants of render.comp: a scene pays only for what it uses.
@@ -110,7 +111,8 @@ struct FrameConstants {
   vec4 lights;           // x: probability that next-event estimation picks the environment
                          // (each emissive grid's is its GpuEmissionCdf measure.w); y: probability
                          // that a vertex's continuation comes from its own lobe (LightSelection
-                         // p_continue_own); zw: unused
+                         // p_continue_own); z: next-event samples per surface vertex
+                         // (LightSelection surface_light_samples); w: unused
 };
 
 // Per-pass values (push constants).

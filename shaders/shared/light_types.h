@@ -26,16 +26,22 @@ struct GpuEnvironment {
   uvec4 size;      // x: width W, y: height H, z: 1 if it can be sampled (else pdf 0), w: 0
 };
 
-// An emissive grid medium's emission CDF (144 bytes). Cells are the dual cells
-// of the density texture: cell (i, j, k) spans cell coordinates [i, i+1) × … ,
-// where cell coordinate c = index − origin, so texel i's centre is at c = i and
-// a cell's 8 corners are the 8 texels its trilinear lookups blend.
+// An emissive grid medium's emission CDF as seen from a receiver (160 bytes;
+// host/light/EmissionCdf clustered()). Cells are the dual cells of the
+// density texture: cell (i, j, k) spans cell coordinates [i, i+1) × … , where
+// cell coordinate c = index − origin, so texel i's centre is at c = i and a
+// cell's 8 corners are the 8 texels its trilinear lookups blend. Clusters of
+// k³ cells: from receiver o, cluster s is chosen with probability
+// I_s(o) / Σ I, I_s(o) = power_s / max(|o − centre_s|², radius_s²), then a
+// cell by its probability within the cluster.
 // Buffers (names the includer declares, see lights.glsl):
-//   emission_cdf[entry]:   inclusive CDF over the cells of weight > 0 (last = 1)
-//   emission_cells[entry]: linear index x + X·(y + Y·z) of that cell (ascending)
-//   emission_pmf[cell]:    probability of EVERY cell (0 for cells never chosen)
-// Several media may share the buffers: entries [offsets.x, offsets.x + cells.w)
-// and cells [offsets.y, offsets.y + X·Y·Z) belong to this medium.
+//   emission_cdf[entry]:      inclusive CDF within the entry's cluster (last of each = 1)
+//   emission_cells[entry]:    linear index x + X·(y + Y·z) of that cell (grouped by cluster)
+//   emission_pmf[cell]:       probability of EVERY cell within its cluster (0: never chosen)
+//   emission_clusters[s]:     GpuEmissionCluster, linear over the cluster grid like cells
+// Several media may share the buffers: entries [offsets.x, offsets.x + cells.w),
+// cells [offsets.y, offsets.y + X·Y·Z) and clusters [offsets.z, offsets.z + CX·CY·CZ)
+// belong to this medium.
 struct GpuEmissionCdf {
   vec4 world_to_cell_row0;  // c = (dot(row0, p1), dot(row1, p1), dot(row2, p1)), p1 = (p, 1)
   vec4 world_to_cell_row1;
@@ -44,17 +50,27 @@ struct GpuEmissionCdf {
   vec4 cell_to_world_row1;
   vec4 cell_to_world_row2;
   uvec4 cells;    // xyz: cells per axis (= density dims − 1); w: entry count (cells of weight > 0)
-  uvec4 offsets;  // x: first entry in emission_cdf / emission_cells; y: first cell in emission_pmf; zw: 0
+  uvec4 offsets;  // x: first entry in emission_cdf / emission_cells; y: first cell in emission_pmf;
+                  // z: first cluster in emission_clusters; w: 0
+  uvec4 clusters; // xyz: clusters per axis; w: k, cells per cluster per axis
   vec4 measure;   // x: cell volume |det| (world units³); y: 1 / volume; z: power ∫ w dV;
                   // w: probability that next-event estimation picks this light (render.comp)
 };
 
+// One cluster of an emission CDF (48 bytes).
+struct GpuEmissionCluster {
+  vec4 sphere;     // xyz: world-space centre of the bounding sphere of its cells of weight > 0; w: radius²
+  vec4 power;      // x: its share of the emission (0: empty); yzw: 0
+  uvec4 entries;   // x: its first entry (relative to offsets.x); y: its entry count; zw: 0
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(GpuEmissionCluster) == 48);
 static_assert(sizeof(GpuEnvironment) == 32);
 static_assert(offsetof(GpuEnvironment, size) == 16);
-static_assert(sizeof(GpuEmissionCdf) == 144);
+static_assert(sizeof(GpuEmissionCdf) == 160);
 static_assert(offsetof(GpuEmissionCdf, cells) == 96);
-static_assert(offsetof(GpuEmissionCdf, measure) == 128);
+static_assert(offsetof(GpuEmissionCdf, measure) == 144);
 }  // namespace pyrolume::gpu
 #endif
 #endif

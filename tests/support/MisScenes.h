@@ -97,14 +97,23 @@ inline void expect_same_image(const RenderResult& a, const RenderResult& b, doub
 
 // On the fire over a plane under a sky (every strategy has finite variance
 // there), MIS at 256 spp and light sampling only at 256 spp converge to BSDF
-// sampling only at bsdf_spp. render(scene) is one backend's render; `who`
-// prefixes the reports.
+// sampling only at bsdf_spp, with one next-event sample per surface vertex
+// and with three (their MIS weights count the samples). render(scene) is one
+// backend's render; `who` prefixes the reports.
 template <class Render>
 void expect_strategies_agree(Render render, const std::filesystem::path& dir, int bsdf_spp, const std::string& who) {
-  auto scene = [&](Strategy k, int spp) { return fire_over_plane_scene(dir, k, true, false, 24, 18, spp); };
-  const RenderResult bsdf = render(scene(Strategy::Bsdf, bsdf_spp));
-  expect_same_image(render(scene(Strategy::Mis, 256)), bsdf, 0.02, (who + "MIS vs BSDF only").c_str());
-  expect_same_image(render(scene(Strategy::LightOnly, 256)), bsdf, 0.02, (who + "light only vs BSDF only").c_str());
+  auto scene = [&](Strategy k, int spp, int light_samples) {
+    Scene s = fire_over_plane_scene(dir, k, true, false, 24, 18, spp);
+    s.integrator.surface_light_samples = light_samples;
+    return s;
+  };
+  const RenderResult bsdf = render(scene(Strategy::Bsdf, bsdf_spp, 1));
+  for (int n : {1, 3}) {
+    const std::string samples = n == 1 ? "" : ", " + std::to_string(n) + " light samples";
+    expect_same_image(render(scene(Strategy::Mis, 256, n)), bsdf, 0.02, (who + "MIS vs BSDF only" + samples).c_str());
+    expect_same_image(render(scene(Strategy::LightOnly, 256, n)), bsdf, 0.02,
+                      (who + "light only vs BSDF only" + samples).c_str());
+  }
 }
 
 // Σ over the pixel-channels of the rows from `first_row` down of the

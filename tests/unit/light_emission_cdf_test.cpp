@@ -378,10 +378,11 @@ namespace {
 double direction_pdf_by_quadrature(const EmissionCdf& cdf, const glm::dvec3& o, const glm::dvec3& w, double t_max,
                                    int steps) {
   const double dt = t_max / steps;
+  const double norm = cdf.receiver_norm(o);
   double sum = 0.0;
   for (int k = 0; k < steps; ++k) {
     const double t = (k + 0.5) * dt;
-    sum += cdf.pdf(o + t * w) * t * t;
+    sum += cdf.pdf_from(o, norm, o + t * w) * t * t;
   }
   return sum * dt;
 }
@@ -441,7 +442,7 @@ TEST(EmissionCdf, DirectionPdfIsTheIntegralAlongTheRay) {
   DenseGrid d = random_density(14);
   DenseGrid t = random_temperature(d, 15);
   const EmissionCdf fine = EmissionCdf::build(d, &t, temperature_params());
-  for (const EmissionCdf& cdf : {fine, fine.blocks(2)}) {
+  for (const EmissionCdf& cdf : {fine, fine.blocks(2), fine.blocks(2).clustered(2)}) {
     std::mt19937_64 rng(16);
     std::uniform_real_distribution<double> U(0.0, 1.0);
     const glm::dvec3 lo = cdf.cell_to_world(glm::dvec3(0.0)), hi = cdf.cell_to_world(glm::dvec3(cdf.cells()));
@@ -453,7 +454,7 @@ TEST(EmissionCdf, DirectionPdfIsTheIntegralAlongTheRay) {
       const glm::dvec3 w = uniform_direction(rng);
       const glm::dvec3 o = n % 2 ? s.p : s.p - 1.5 * extent * w;
       const double dda = cdf.direction_pdf(o, w);
-      const double quad = direction_pdf_by_quadrature(cdf, o, w, 3.0 * extent, 200000);
+      const double quad = direction_pdf_by_quadrature(cdf, o, w, 3.0 * extent, 1000000);
       EXPECT_NEAR(dda, quad, 2e-3 * quad + 1e-9) << n;
       nonzero += dda > 0.0;
     }
@@ -466,7 +467,8 @@ TEST(EmissionCdf, DirectionPdfIntegratesToOneOverTheSphere) {
   DenseGrid t = random_temperature(d, 18);
   const EmissionCdf fine = EmissionCdf::build(d, &t, temperature_params());
   const EmissionCdf blocks = fine.blocks(3);
-  for (const EmissionCdf* cdf : {&fine, &blocks}) {
+  const EmissionCdf clusters = fine.clustered(3);
+  for (const EmissionCdf* cdf : {&fine, &blocks, &clusters}) {
     const glm::dvec3 centre = cdf->cell_to_world(glm::dvec3(cdf->cells()) * 0.5);
     double radius = 0.0;  // of a sphere around the blocks
     for (int c = 0; c < 8; ++c)
@@ -500,5 +502,65 @@ TEST(EmissionCdf, DirectionPdfIntegratesToOneOverTheSphere) {
       EXPECT_LT(std::abs(mean - 1.0), 4.0 * se + 1e-6);
       EXPECT_LT(se, 0.02);  // the test has the power to see a 10 % error
     }
+  }
+}
+
+// Seen from a receiver (clustered): the sampler follows pdf_from (chi-square
+// over the cells), pdf_from integrates to 1, nearby clusters gain, and from far
+// away the distribution tends to the static one (all clusters at about the
+// same distance).
+TEST(EmissionCdf, ClustersSeenFromAReceiver) {
+  DenseGrid d = random_density(21);
+  DenseGrid t = random_temperature(d, 22);
+  const EmissionCdf fine = EmissionCdf::build(d, &t, temperature_params());
+  const EmissionCdf cdf = fine.clustered(3);
+  ASSERT_TRUE(cdf.is_clustered());
+  ASSERT_FALSE(fine.is_clustered());
+  const glm::ivec3 C = cdf.cells();
+  const glm::dvec3 corner = cdf.cell_to_world(glm::dvec3(0.0)), centre = cdf.cell_to_world(glm::dvec3(C) * 0.5);
+  const double extent = glm::length(cdf.cell_to_world(glm::dvec3(C)) - corner);
+  auto cell_centre = [&](int64_t c) {
+    return cdf.cell_to_world(glm::dvec3(c % C.x, (c / C.x) % C.y, c / (int64_t(C.x) * C.y)) + 0.5);
+  };
+  for (const glm::dvec3& o : {corner, centre, centre + glm::dvec3(0.3, -0.2, 1.1) * extent}) {
+    // Σ pdf_from · volume = 1 over the cells.
+    std::vector<double> p(cdf.cell_count());
+    double total = 0.0;
+    for (size_t c = 0; c < p.size(); ++c) total += p[c] = cdf.pdf_from(o, cell_centre(int64_t(c))) * cdf.cell_volume();
+    EXPECT_NEAR(total, 1.0, 1e-5);
+    // The sampled cells follow p; each sample's pdf is pdf_from of its point.
+    std::mt19937_64 rng(23);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    const int n = 200000;
+    std::vector<double> observed(p.size(), 0.0), expected(p.size());
+    for (size_t c = 0; c < p.size(); ++c) expected[c] = n * p[c];
+    const double norm = cdf.receiver_norm(o);
+    for (int k = 0; k < n; ++k) {
+      const EmissionSample s = cdf.sample_from(o, norm, U(rng), U(rng), {U(rng), U(rng), U(rng)});
+      ASSERT_GT(s.pdf, 0.0);
+      ASSERT_NEAR(s.pdf, cdf.pdf_from(o, s.p), 1e-9 * s.pdf) << k;
+      observed[size_t(s.cell)] += 1.0;
+    }
+    const test::ChiSquareResult r = test::chi_square(observed, expected);
+    std::printf("clustered emission CDF chi-square: %s\n", r.summary().c_str());
+    EXPECT_GT(r.p_value, 0.01) << r.summary();
+  }
+  // Next to a corner, the cells there are likelier than in the static distribution.
+  const glm::dvec3 near_corner = cdf.cell_to_world(glm::dvec3(0.5));
+  double near_static = 0.0, near_receiver = 0.0;
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) {
+        const glm::dvec3 x = cdf.cell_to_world(glm::dvec3(i, j, k) + 0.5);
+        near_static += fine.pdf(x);
+        near_receiver += cdf.pdf_from(near_corner, x);
+      }
+  ASSERT_GT(near_static, 0.0);
+  EXPECT_GT(near_receiver, 2.0 * near_static);
+  // Far away, pdf_from / pdf → 1 (to within the spread of 1/d² over the grid).
+  const glm::dvec3 far = centre + glm::dvec3(0.0, 0.0, 1000.0 * extent);
+  for (size_t c = 0; c < cdf.cell_count(); ++c) {
+    const glm::dvec3 x = cell_centre(int64_t(c));
+    if (fine.pdf(x) > 0.0) EXPECT_NEAR(cdf.pdf_from(far, x) / fine.pdf(x), 1.0, 1e-2) << c;
   }
 }

@@ -132,6 +132,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"estimator", R"({"integrator": {"emission_estimator": "track"}})", "integrator.emission_estimator"},
         BadCase{"light_only", R"({"integrator": {"light_only": "yes"}})", "integrator.light_only"},
         BadCase{"max_depth", R"({"integrator": {"max_depth": -1}})", "integrator.max_depth"},
+        BadCase{"surface_light_samples 0", R"({"integrator": {"surface_light_samples": 0}})",
+                "integrator.surface_light_samples: must be in [1, 64]"},
+        BadCase{"surface_light_samples fraction", R"({"integrator": {"surface_light_samples": 2.5}})",
+                "integrator.surface_light_samples: expected an integer"},
         BadCase{"background", R"({"background": {"rgb": [0, 0, -1]}})", "background.rgb"},
         BadCase{"duplicate names",
                 R"({"media": [{"name": "a", "type": "homogeneous", "bounds": {"sphere": {"center": [0,0,0], "radius": 1}}},
@@ -149,3 +153,8 @@ INSTANTIATE_TEST_SUITE_P(
         if (!isalnum(static_cast<unsigned char>(ch))) ch = '_';
       return n;
     });
+
+TEST(Scene, SurfaceLightSamples) {
+  EXPECT_EQ(parse_scene("{}", "a.json").integrator.surface_light_samples, 1);
+  EXPECT_EQ(parse_scene(R"({"integrator": {"surface_light_samples": 4}})", "a.json").integrator.surface_light_samples, 4);
+}

@@ -65,14 +65,26 @@ TEST_F(VulkanMis, StrategiesAgreeOnGpu) {
 
 TEST_F(VulkanMis, FurnaceSphereIsOneWithSkyAsLight) {
   const auto dir = test::temp_dir("vk_mis_furnace");
-  Scene s = test::analytic_base_scene(16, 16, 64);
-  s.integrator.max_depth = 64;
-  s.shapes.push_back(test::sphere_shape({0, 0, 0}, 1.0, glm::dvec3(1.0)));
-  s.environment = Environment{test::write_uniform_sky(dir, glm::vec3(1.0f)), 1.0, 0.0};
-  test::set_strategy(s, Strategy::Mis);
-  ZTestReport z = test::ztest_against_exact(gpu(s), [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
-  EXPECT_TRUE(z.ok) << z.summary();
-  std::printf("GPU furnace: %s\n", z.summary().c_str());
+  for (int n : {1, 3}) {  // next-event samples per surface vertex
+    Scene s = test::analytic_base_scene(16, 16, 64);
+    s.integrator.max_depth = 64;
+    s.integrator.surface_light_samples = n;
+    s.shapes.push_back(test::sphere_shape({0, 0, 0}, 1.0, glm::dvec3(1.0)));
+    s.environment = Environment{test::write_uniform_sky(dir, glm::vec3(1.0f)), 1.0, 0.0};
+    test::set_strategy(s, Strategy::Mis);
+    ZTestReport z = test::ztest_against_exact(gpu(s), [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
+    EXPECT_TRUE(z.ok) << n << " light samples: " << z.summary();
+    std::printf("GPU furnace, %d light samples: %s\n", n, z.summary().c_str());
+  }
+}
+
+// Several next-event samples per surface vertex: the GPU's light-ray
+// sequence and its MIS weights against the CPU reference's.
+TEST_F(VulkanMis, SurfaceLightSamplesMatchCpu) {
+  const auto dir = test::temp_dir("vk_mis_plane");
+  Scene s = test::fire_over_plane_scene(dir, Strategy::Mis, true, true, 24, 18, 256);
+  s.integrator.surface_light_samples = 3;
+  test::expect_same_image(gpu(s), cpu(s, 256), 0.02, "GPU vs CPU, MIS, 3 light samples per surface vertex");
 }
 
 TEST_F(VulkanMis, MisLowersVarianceOnLitPlane) {

@@ -112,7 +112,8 @@ double emitted_at(const MediaData& md, int c, const glm::dvec3& x, Scratch& s) {
 // The MIS state of the ray being tracked (docs/mis.md): the solid-angle pdf
 // with which its direction was sampled at its vertex (0 for the camera ray and
 // for light rays, whose radiance is never weighted), and the solid-angle pdf
-// with which next-event estimation at that vertex picks the same direction.
+// with which next-event estimation at that vertex picks the same direction,
+// times its number of samples there.
 struct RayMis {
   double pdf_dir = 0.0;
   double p_light = 0.0;
@@ -174,7 +175,7 @@ bool light_direction(const WalkScene& ws, const glm::dvec3& o, Pcg32& rng, glm::
     u -= p;
   }
   if (j < 0) return false;
-  const EmissionSample es = lights.cdf[j]->sample(u_env, u3);
+  const EmissionSample es = lights.cdf[j]->sample_from(o, u_env, v_env, u3);
   if (!(es.pdf > 0.0)) return false;
   const glm::dvec3 v = es.p - o;
   const double r = glm::length(v);
@@ -183,38 +184,43 @@ bool light_direction(const WalkScene& ws, const glm::dvec3& o, Pcg32& rng, glm::
   return true;
 }
 
-// One next-event estimate from vertex o (the offset origin the continuing ray
-// also uses), a direction from the lights (light_direction). The radiance
-// arriving along it before anything scatters it is estimated by a light ray:
-// the walk itself with max_depth 0. Weighted by the power heuristic against
-// the continuation's pdf for the same direction, both in solid angle.
-// Returns the radiance times f / pdf, without the path weight β.
+// Next-event estimation from vertex o (the offset origin the continuing ray
+// also uses): n directions from the lights (light_direction). The radiance
+// arriving along each before anything scatters it is estimated by a light
+// ray: the walk itself with max_depth 0. Each is weighted by the power
+// heuristic for n samples of pdf p_light against the continuation's one
+// sample of pdf p_m for the same direction, both in solid angle (Veach 1997
+// eq. 9.13 with sample counts; docs/mis.md "Several light samples").
+// Returns the sum of radiance · f · w / (n · p_light), without the path weight β.
 template <class Lobe>
-double next_event(const WalkScene& ws, int c, const glm::dvec3& o, Lobe lobe, Pcg32& rng, ThreadCounters& cnt,
+double next_event(const WalkScene& ws, int c, const glm::dvec3& o, Lobe lobe, int n, Pcg32& rng, ThreadCounters& cnt,
                   Scratch& s) {
   const WalkLights& lights = ws.lights;
-  glm::dvec3 dir;
-  if (!light_direction(ws, o, rng, dir)) return 0.0;
-  const VertexLobe l = lobe(dir);
-  if (!(l.f > 0.0)) return 0.0;
-  const double p_light = light_direction_pdf(ws, o, dir);
-  if (!(p_light > 0.0)) return 0.0;
-  const double radiance = walk_channel(ws, c, o, dir, rng, cnt, s.light_ray(), 0);
-  // Against the continuation's mixture pdf for the same direction.
-  const double w = lights.selection.strategy == LightStrategy::LightOnly
-                       ? 1.0
-                       : power_heuristic(p_light, lights.selection.continuation_pdf(l.pdf, p_light));
-  return l.f * radiance * w / p_light;
+  double sum = 0.0;
+  for (int k = 0; k < n; ++k) {
+    glm::dvec3 dir;
+    if (!light_direction(ws, o, rng, dir)) continue;
+    const VertexLobe l = lobe(dir);
+    if (!(l.f > 0.0)) continue;
+    const double p_light = light_direction_pdf(ws, o, dir);
+    if (!(p_light > 0.0)) continue;
+    const double radiance = walk_channel(ws, c, o, dir, rng, cnt, s.light_ray(), 0);
+    const double w = lights.selection.strategy == LightStrategy::LightOnly
+                         ? 1.0
+                         : power_heuristic(n * p_light, lights.selection.continuation_pdf(l.pdf, p_light));
+    sum += l.f * radiance * w / (n * p_light);
+  }
+  return sum;
 }
 
 // The direction the path leaves vertex o by: with lights, from the mixture
 // p_m = c·p_vertex + (1 − c)·p_light (c = selection.p_continue_own), else from
 // the vertex's own sampling (sample_own). weight = f/p_m; mis records p_m and
-// p_light for the weights of what the ray finds. false: the direction carries
-// nothing (below a surface).
+// n·p_light (n: the vertex's next-event samples) for the weights of what the
+// ray finds. false: the direction carries nothing (below a surface).
 template <class Lobe, class Own>
-bool continue_from(const WalkScene& ws, const glm::dvec3& o, Lobe& lobe, Own sample_own, Pcg32& rng, glm::dvec3& d,
-                   double& weight, RayMis& mis) {
+bool continue_from(const WalkScene& ws, const glm::dvec3& o, Lobe& lobe, Own sample_own, int n, Pcg32& rng,
+                   glm::dvec3& d, double& weight, RayMis& mis) {
   if (!ws.lights.active()) {
     d = sample_own();
     const VertexLobe l = lobe(d);
@@ -232,7 +238,7 @@ bool continue_from(const WalkScene& ws, const glm::dvec3& o, Lobe& lobe, Own sam
   const double p_light = light_direction_pdf(ws, o, d);
   const double p_m = ws.lights.selection.continuation_pdf(l.pdf, p_light);
   weight = l.f / p_m;
-  mis = RayMis{p_m, p_light};
+  mis = RayMis{p_m, n * p_light};
   return true;
 }
 
@@ -296,6 +302,8 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
   double beta = 1.0;  // path weight: product of the albedos of the surface bounces so far
   double L = 0.0;     // the collision estimator's running sum
   RayMis mis;         // the camera ray: never MIS-weighted
+  const int n_surface = lights.selection.surface_light_samples;  // next-event samples per vertex
+  const int n_medium = 1;
   for (;;) {
     // The closest surface bounds this segment.
     geometry::SurfaceHit hit;
@@ -346,7 +354,7 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
           for (size_t l = 0; l < s.lobe_w.size(); ++l) p += s.lobe_w[l] * hg_pdf(glm::dot(d_in, w), s.lobe_g[l]);
           return VertexLobe{p, p};  // sampled exactly: pdf = value
         };
-        if (lights.active()) L += beta * next_event(ws, c, x, phase, rng, cnt, s);
+        if (lights.active()) L += beta * next_event(ws, c, x, phase, n_medium, rng, cnt, s);
         // Given a scattering, u − σa is uniform on [0, σs): reuse it to pick the lobe.
         double pick = (u - sigma_a) / sigma_s, g = 0.0;
         for (size_t l = 0; l < s.lobe_w.size(); ++l) {
@@ -357,7 +365,7 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
         o = x;
         double weight;
         if (!continue_from(ws, o, phase, [&] { return sample_hg(d_in, g, {rng.uniform(), rng.uniform()}).direction; },
-                           rng, d, weight, mis))
+                           n_medium, rng, d, weight, mis))
           return L;
         beta *= weight;
         scattered = true;
@@ -379,11 +387,11 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
       const double cos_theta = std::max(0.0, glm::dot(n_f, w));
       return VertexLobe{albedo * cos_theta / std::numbers::pi, cos_theta / std::numbers::pi};
     };
-    if (lights.active()) L += beta * next_event(ws, c, o, lambert, rng, cnt, s);
+    if (lights.active()) L += beta * next_event(ws, c, o, lambert, n_surface, rng, cnt, s);
     double weight;
     if (!continue_from(ws, o, lambert,
-                       [&] { return sample_cosine_hemisphere(n_f, {rng.uniform(), rng.uniform()}).direction; }, rng, d,
-                       weight, mis))
+                       [&] { return sample_cosine_hemisphere(n_f, {rng.uniform(), rng.uniform()}).direction; },
+                       n_surface, rng, d, weight, mis))
       return L;
     beta *= weight;
   }

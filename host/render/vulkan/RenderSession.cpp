@@ -96,6 +96,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                         {gpu::BINDING_EMISSION_CDF, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_EMISSION_CELLS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_EMISSION_PMF, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_EMISSION_CLUSTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_EMISSION_HEADERS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
                         {gpu::BINDING_PASS_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
                     uint32_t(sizeof(gpu::PassConstants)), spec_, "render");
@@ -159,6 +160,7 @@ void RenderSession::write_grid_descriptors() {
   set_->write_buffer(gpu::BINDING_EMISSION_CDF, emission_cdf_);
   set_->write_buffer(gpu::BINDING_EMISSION_CELLS, emission_cells_);
   set_->write_buffer(gpu::BINDING_EMISSION_PMF, emission_pmf_);
+  set_->write_buffer(gpu::BINDING_EMISSION_CLUSTERS, emission_clusters_);
   set_->write_buffer(gpu::BINDING_EMISSION_HEADERS, emission_headers_);
   // textures_3d_[0] / textures_1d_[0] are 1-texel placeholders for unused slots.
   for (uint32_t slot = 0; slot < gpu::MAX_GRIDS; ++slot) {
@@ -360,12 +362,14 @@ RenderSession::EmissionLights RenderSession::build_emission_lights(
     const size_t i = g.grid_sources[slot].medium;
     if (!by_medium[i] || !(out.selection.p_medium[i] > 0.0)) continue;
     const EmissionCdf& c = *by_medium[i];
-    gpu::GpuEmissionCdf h = c.gpu_header(uint32_t(out.cdf.size()), uint32_t(out.pmf.size()));
+    gpu::GpuEmissionCdf h = c.gpu_header(uint32_t(out.cdf.size()), uint32_t(out.pmf.size()), uint32_t(out.clusters.size()));
     h.measure.w = float(out.selection.p_medium[i]);
     out.headers[slot] = h;
     out.cdf.insert(out.cdf.end(), c.gpu_cdf().begin(), c.gpu_cdf().end());
     out.cells.insert(out.cells.end(), c.gpu_cells().begin(), c.gpu_cells().end());
     out.pmf.insert(out.pmf.end(), c.gpu_pmf().begin(), c.gpu_pmf().end());
+    const std::vector<gpu::GpuEmissionCluster> clusters = c.gpu_clusters();
+    out.clusters.insert(out.clusters.end(), clusters.begin(), clusters.end());
   }
   return out;
 }
@@ -375,6 +379,7 @@ void RenderSession::upload_emission_lights(const EmissionLights& lights) {
   emission_cdf_ = storage_buffer(ctx_, lights.cdf, "emission cdf");
   emission_cells_ = storage_buffer(ctx_, lights.cells, "emission cells");
   emission_pmf_ = storage_buffer(ctx_, lights.pmf, "emission pmf");
+  emission_clusters_ = storage_buffer(ctx_, lights.clusters, "emission clusters");
   emission_headers_.upload(ctx_, lights.headers.data(), lights.headers.size() * sizeof(gpu::GpuEmissionCdf));
 }
 
@@ -386,6 +391,7 @@ void RenderSession::upload_constants(const Scene& scene) {
   gpu::FrameConstants frame = build_frame_constants(scene, settings_, uint32_t(now.media.size()));
   frame.lights.x = float(light_selection_.p_env);
   frame.lights.y = float(light_selection_.p_continue_own);
+  frame.lights.z = float(light_selection_.surface_light_samples);
   frame_buffer_.upload(ctx_, &frame, sizeof frame);
   if (!now.media.empty()) media_buffer_.upload(ctx_, now.media.data(), now.media.size() * sizeof(gpu::GpuMedium));
   if (!now.grids.empty()) grid_buffer_.upload(ctx_, now.grids.data(), now.grids.size() * sizeof(gpu::GpuGrid));

@@ -53,6 +53,11 @@ class RenderSession {
   int max_pass_spp() const { return max_pass_spp_; }
   // Next-event estimation is on: every vertex sends a light ray too.
   bool next_event_estimation() const { return light_selection_.strategy != LightStrategy::Bsdf; }
+  // Rays a vertex may send: its continuation, and with next-event estimation
+  // up to surface_light_samples light rays (VulkanRenderer::spp_per_pass).
+  int rays_per_vertex() const {
+    return next_event_estimation() ? 1 + light_selection_.surface_light_samples : 1;
+  }
   uint64_t dropped_samples() const { return dropped_samples_; }
   int width() const { return settings_.width; }
   int height() const { return settings_.height; }
@@ -82,6 +87,7 @@ class RenderSession {
     LightSelection selection;
     std::vector<float> cdf, pmf;
     std::vector<uint32_t> cells;
+    std::vector<gpu::GpuEmissionCluster> clusters;
     std::vector<gpu::GpuEmissionCdf> headers;  // per grid slot (MAX_GRIDS)
   };
   EmissionLights build_emission_lights(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes,
@@ -108,7 +114,7 @@ class RenderSession {
   vk::Buffer env_texels_, env_cdf_, env_header_;
   std::optional<EnvironmentMap> environment_;
   // The emissive grids as lights: CDF entries, their cells, per-cell pmf, headers.
-  vk::Buffer emission_cdf_, emission_cells_, emission_pmf_, emission_headers_;
+  vk::Buffer emission_cdf_, emission_cells_, emission_pmf_, emission_clusters_, emission_headers_;
   LightSelection light_selection_;
   std::optional<vk::ComputePipeline> pipeline_;
   std::optional<vk::DescriptorSet> set_;

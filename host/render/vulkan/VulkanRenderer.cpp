@@ -39,8 +39,8 @@ int VulkanRenderer::spp_per_pass(int width, int height, int spp, int rays_per_ve
   // About 2^19 paths per dispatch: tens of milliseconds on lavapipe for simple
   // scenes, far below any GPU watchdog, and large enough that per-dispatch
   // overhead (~1.3 ms on lavapipe, LAVAPIPE.md) stays small. With next-event
-  // estimation each vertex also sends a light ray: half as many paths, which
-  // also keeps passes within llvmpipe's loop budget (PassStatus; a pass that
+  // estimation each vertex also sends light rays (up to rays_per_vertex − 1):
+  // proportionally fewer paths, which also keeps passes within llvmpipe's loop budget (PassStatus; a pass that
   // overruns it is redone in halves, wasting it: terrain_explosion at 160×90
   // overran it at 36 spp per pass).
   const double paths_per_pass = 524288.0 / std::max(1, rays_per_vertex);
@@ -81,7 +81,7 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
   auto render_start = Clock::now();
   const uint64_t dropped_before = session.dropped_samples();  // a kept session counts across frames
   const int per_pass =
-      spp_per_pass(settings.width, settings.height, settings.spp, session.next_event_estimation() ? 2 : 1);
+      spp_per_pass(settings.width, settings.height, settings.spp, session.rays_per_vertex());
   AccumulationState saved;
   if (control.resume) saved = *control.resume;  // a failure in the first pass still has the resumed samples
   double save_interval = 0.0;
