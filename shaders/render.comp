@@ -440,9 +440,10 @@ struct PathState {
   float next_pdf_dir, next_p_light;
   // A surface vertex sends integrator.surface_light_samples light rays, one
   // after another: how many are still to come, and what their weights need
-  // (the path weight at the vertex, the normal on the incident side, the albedo).
+  // (the path weight times the albedo at the vertex, the normal on the incident side).
   uint lights_left;
-  vec3 vertex_w, vertex_n, vertex_albedo;
+  bool light_pending;  // a light ray ended and lights_left > 0: draw the next one
+  vec3 vertex_wa, vertex_n;
   vec4 vertex_norm;  // light_norms at the current vertex, by grid slot (MAX_GRIDS = 4)
 };
 
@@ -472,37 +473,47 @@ float continuation_pdf(float pdf_own, float p_light) {
 }
 
 // The next of a surface vertex's light rays (docs/mis.md "Several light
-// samples"): a light direction from the vertex, its weight w·f·MIS weight /
-// (n·p_light) for the n = frame.lights.z samples. false: none is left.
-bool next_surface_light_ray(inout PathState p, inout uint rng) {
+// samples"), drawn at the top of path_step: a light direction from the vertex,
+// its weight w·f·MIS weight / (n·p_light) for the n = frame.lights.z samples;
+// weight 0 when no light direction was found (the ray then ends at once).
+// One draw per call and no loop: Mesa 22.3's llvmpipe returned false from a
+// `return true` inside this function's former retry loop for some lanes of a
+// SIMD group (measured: 46 % of the found light rays lost, the furnace 2 % dark).
+void next_surface_light_ray(inout PathState p, inout uint rng) {
   const float n = frame.lights.z;
-  while (p.lights_left > 0u) {
-    --p.lights_left;
-    vec3 dir;
-    if (!sample_light_direction(p.next_o, p.vertex_norm, rng, dir)) continue;
+  --p.lights_left;
+  vec3 dir;
+  vec3 w = vec3(0.0);
+  if (sample_light_direction(p.next_o, p.vertex_norm, rng, dir)) {
     const float pdf_own = max(dot(p.vertex_n, dir), 0.0) * (1.0 / PI);
     const float p_l = pdf_own > 0.0 ? light_direction_pdf(p.next_o, p.vertex_norm, dir) : 0.0;
-    if (!(p_l > 0.0)) continue;
-    const vec3 w = p.vertex_w * p.vertex_albedo * pdf_own *
-                   (light_weight(n * p_l, continuation_pdf(pdf_own, p_l)) / (n * p_l));
-    if (max3(w) <= 0.0) continue;
-    p.w = w;
-    new_ray(p, p.next_o, dir, 0.0, 0.0);
-    return true;
+    if (p_l > 0.0) w = p.vertex_wa * pdf_own * (light_weight(n * p_l, continuation_pdf(pdf_own, p_l)) / (n * p_l));
   }
-  return false;
+  p.w = w;
+  new_ray(p, p.next_o, dir, 0.0, 0.0);
 }
 
 // The current ray ends. A light ray hands over to the vertex's next light ray
 // or to the continuation it sampled; returns true when the path has ended.
-bool ray_ends(inout PathState p, inout uint rng) {
-  if (!NEE || !p.light_ray) return true;
-  if (next_surface_light_ray(p, rng)) return false;
+// The vertex's light rays are done: the continuation starts (true: the path has ended).
+bool hand_over(inout PathState p) {
   p.light_ray = false;
   if (p.next_ends) return true;
   p.w = p.next_w;
   new_ray(p, p.next_o, p.next_d, p.next_pdf_dir, p.next_p_light);
   return false;
+}
+
+// The next light ray is drawn at the top of path_step (light_pending), in one
+// place: inlined at each of ray_ends' call sites, the light sampling code made
+// the shader 2× slower on llvmpipe.
+bool ray_ends(inout PathState p, inout uint rng) {
+  if (!NEE || !p.light_ray) return true;
+  if (p.lights_left > 0u) {
+    p.light_pending = true;
+    return false;
+  }
+  return hand_over(p);
 }
 
 // Whether a vertex draws its continuation from the lights (with next-event
@@ -518,12 +529,13 @@ bool continue_toward_light(vec3 o, vec4 norm, inout uint rng, out vec3 dir, out 
 
 // Leave vertex o along d, which the vertex's lobe weights by f with pdf
 // pdf_own (the continuation's pdf is the mixture with the lights'). With
-// next-event estimation, first the vertex's n_light light rays, the first
-// along light_dir, which the lobe weights by f_light with pdf pdf_light (0: no
-// light direction; the others: next_surface_light_ray), and the continuation
-// waits. Returns true when the path has ended.
+// next-event estimation, first the vertex's light rays, and the continuation
+// waits: a medium vertex's one along light_dir, which the lobe weights by
+// f_light with pdf pdf_light (0: none); a surface vertex's lights_after, all
+// drawn by next_surface_light_ray. n_light: the vertex's number of light
+// samples, for the MIS weights (eq. 6). Returns true when the path has ended.
 bool leave_vertex(inout PathState p, inout uint rng, vec3 o, vec3 d, vec3 f, float pdf_own, vec3 light_dir,
-                  vec3 f_light, float pdf_light, uint n_light) {
+                  vec3 f_light, float pdf_light, uint n_light, uint lights_after) {
   // "<= 0", not "!(> 0)": a NaN weight goes on and is counted (nonfinite_samples).
   if (!NEE) {
     p.w *= f / pdf_own;
@@ -545,8 +557,7 @@ bool leave_vertex(inout PathState p, inout uint rng, vec3 o, vec3 d, vec3 f, flo
   p.next_w = w;
   p.next_pdf_dir = p_mix;
   p.next_p_light = n * p_light_d;
-  p.lights_left = n_light - 1u;
-  p.vertex_w = p.w;
+  p.lights_left = lights_after;
   p.light_ray = true;
   if (max3(w_light) <= 0.0) return ray_ends(p, rng);  // the next light ray, or the continuation
   p.w = w_light;
@@ -567,21 +578,18 @@ bool surface_bounce(inout PathState p, inout uint rng, inout PathStats stats) {
   if (m.info.x != NO_TEXTURE) albedo *= albedo_texture_at(m.info.x, vec2(si.uv.x, 1.0 - si.uv.y));  // OBJ v=0 at the bottom
   vec3 n = dot(si.normal, p.d) < 0.0 ? si.normal : -si.normal;
   vec3 o = offset_ray_origin(si.position, n);
-  // Next-event estimation: f·cos = albedo·cos/π, BSDF pdf cos/π.
-  vec3 light_dir = vec3(0.0);
-  float pdf_light = 0.0;
+  // Next-event estimation: f·cos = albedo·cos/π, BSDF pdf cos/π; its light
+  // rays are all drawn by next_surface_light_ray (one copy of the sampling code).
   if (NEE) light_norms(o, p.vertex_norm);
-  if (NEE && max3(p.w * albedo) > 0.0 && sample_light_direction(o, p.vertex_norm, rng, light_dir))
-    pdf_light = max(dot(n, light_dir), 0.0) * (1.0 / PI);
   vec3 d;
   bool none;
   if (!continue_toward_light(o, p.vertex_norm, rng, d, none))
     d = sample_cosine_hemisphere(n, vec2(rng_next(rng), rng_next(rng)));
   const float pdf_own = none ? 0.0 : max(dot(n, d), 0.0) * (1.0 / PI);
   p.vertex_n = n;
-  p.vertex_albedo = albedo;
-  const uint n_light = NEE && max3(p.w * albedo) > 0.0 ? uint(frame.lights.z) : 1u;
-  return leave_vertex(p, rng, o, d, albedo * pdf_own, pdf_own, light_dir, albedo * pdf_light, pdf_light, n_light);
+  p.vertex_wa = p.w * albedo;
+  const uint n_light = NEE && max3(p.w * albedo) > 0.0 ? uint(frame.lights.z) : 0u;
+  return leave_vertex(p, rng, o, d, albedo * pdf_own, pdf_own, vec3(0.0), vec3(0.0), 0.0, max(n_light, 1u), n_light);
 }
 
 // The phase function of a scattering mixture from d_in toward w: its value
@@ -609,6 +617,11 @@ void phase_mixture(vec3 d_in, vec3 w, vec3 share[MEDIA_N], float q[MEDIA_N], out
 // path weight w then picks up sigma_x / (sigma_bar·P_x) per channel. For grey
 // media every factor is 1 and this is plain delta tracking.
 bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inout PathStats stats) {
+  if (NEE && p.light_pending) {
+    p.light_pending = false;
+    next_surface_light_ray(p, rng);
+    if (max3(p.w) <= 0.0) return ray_ends(p, rng);  // no light this time: the next one, or the continuation
+  }
   if (p.fresh) {
     bool any_hit;
     media_spans(p.o, p.d, span, any_hit);
@@ -712,7 +725,7 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     float pdf_phase;
     phase_mixture(p.d, d, share, q, f, pdf_phase);
     if (none) f = vec3(0.0);
-    return leave_vertex(p, rng, x, d, f, pdf_phase, light_dir, f_light, pdf_light, 1u);
+    return leave_vertex(p, rng, x, d, f, pdf_phase, light_dir, f_light, pdf_light, 1u, 0u);
   } else {
     p.w *= sigma_n / (sigma_bar * (1.0 - p_a - p_s));
   }
@@ -746,7 +759,8 @@ PathState camera_path(uvec2 pixel, uint k, out uint rng) {
   p.next_o = p.next_d = p.next_w = vec3(0.0);
   p.next_pdf_dir = p.next_p_light = 0.0;
   p.lights_left = 0u;
-  p.vertex_w = p.vertex_n = p.vertex_albedo = vec3(0.0);
+  p.vertex_wa = p.vertex_n = vec3(0.0);
+  p.light_pending = false;
   p.vertex_norm = vec4(0.0);
   return p;
 }
