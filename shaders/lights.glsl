@@ -129,14 +129,17 @@ float emission_cluster_importance(uint s, vec3 o) {
   return emission_clusters[s].power.x / max(dot(d, d), emission_clusters[s].sphere.w);
 }
 
+// The absolute index of the first of the copies of the nonempty clusters
+// (after the grid of clusters; EmissionCdf::gpu_clusters).
+uint emission_nonempty_clusters(GpuEmissionCdf e) { return e.offsets.z + e.clusters.x * e.clusters.y * e.clusters.z; }
+
 // Σ_s I_s(o): the normaliser of the distribution seen from o; one per vertex,
 // passed to the functions below as `norm`.
 float emission_receiver_norm(GpuEmissionCdf e, vec3 o) {
   if (e.cells.w == 0u) return 0.0;
   float z = 0.0;
-  uint n = e.clusters.x * e.clusters.y * e.clusters.z;
-  for (uint s = 0u; s < n; ++s)
-    if (emission_clusters[e.offsets.z + s].power.x > 0.0) z += emission_cluster_importance(e.offsets.z + s, o);
+  const uint first = emission_nonempty_clusters(e);
+  for (uint s = 0u; s < e.offsets.w; ++s) z += emission_cluster_importance(first + s, o);
   return z;
 }
 
@@ -161,10 +164,9 @@ EmissionSample emission_sample(GpuEmissionCdf e, vec3 o, float norm, float u, fl
   if (e.cells.w == 0u || !(norm > 0.0)) return s;
   float target = u * norm, acc = 0.0, share = 0.0;
   uint pick = 0xffffffffu;
-  uint n = e.clusters.x * e.clusters.y * e.clusters.z;
-  for (uint k = 0u; k < n; ++k) {
-    uint c = e.offsets.z + k;
-    if (!(emission_clusters[c].power.x > 0.0)) continue;
+  const uint first = emission_nonempty_clusters(e);
+  for (uint k = 0u; k < e.offsets.w; ++k) {
+    uint c = first + k;
     float i = emission_cluster_importance(c, o);
     pick = c;
     share = i;

@@ -150,7 +150,8 @@ class EmissionCdf {
   const std::vector<float>& gpu_cdf() const { return local_cdf_; }    // inclusive within each cluster
   const std::vector<uint32_t>& gpu_cells() const { return entries_; }  // grouped by cluster
   const std::vector<float>& gpu_pmf() const { return local_pmf_; }    // one per cell, within its cluster
-  std::vector<gpu::GpuEmissionCluster> gpu_clusters() const;          // one per cluster
+  std::vector<gpu::GpuEmissionCluster> gpu_clusters() const;  // one per cluster, then the nonempty ones again
+  size_t nonempty_clusters() const;                            // clusters with cells of weight > 0
   // entry_offset / pmf_offset / cluster_offset: where this medium's arrays
   // start when several media share the buffers.
   gpu::GpuEmissionCdf gpu_header(uint32_t entry_offset = 0, uint32_t pmf_offset = 0,

@@ -51,7 +51,8 @@ struct GpuEmissionCdf {
   vec4 cell_to_world_row2;
   uvec4 cells;    // xyz: cells per axis (= density dims − 1); w: entry count (cells of weight > 0)
   uvec4 offsets;  // x: first entry in emission_cdf / emission_cells; y: first cell in emission_pmf;
-                  // z: first cluster in emission_clusters; w: 0
+                  // z: first cluster in emission_clusters (the grid of clusters, then copies
+                  // of the nonempty ones, which the loops over clusters read); w: their count
   uvec4 clusters; // xyz: clusters per axis; w: k, cells per cluster per axis
   vec4 measure;   // x: cell volume |det| (world units³); y: 1 / volume; z: power ∫ w dV;
                   // w: probability that next-event estimation picks this light (render.comp)
