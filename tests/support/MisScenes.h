@@ -78,6 +78,18 @@ inline Scene scattering_fire_scene(const std::filesystem::path& dir, Strategy k,
   return s;
 }
 
+// The furnace: a white diffuse sphere (albedo 1) in a uniform white sky, n
+// next-event samples per surface vertex; exactly 1 everywhere.
+inline Scene furnace_sphere_scene(const std::filesystem::path& dir, Strategy k, int surface_light_samples) {
+  Scene s = analytic_base_scene(16, 16, 64);
+  s.integrator.max_depth = 64;
+  s.integrator.surface_light_samples = surface_light_samples;
+  s.shapes.push_back(sphere_shape({0, 0, 0}, 1.0, glm::dvec3(1.0)));
+  s.environment = Environment{write_uniform_sky(dir, glm::vec3(1.0f)), 1.0, 0.0};
+  set_strategy(s, k);
+  return s;
+}
+
 // --------------------------------------------------------------- checks ----
 
 inline ZTestOptions mis_pooled(double tolerance) {

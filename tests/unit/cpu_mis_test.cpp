@@ -73,13 +73,7 @@ TEST(CpuMis, FurnaceSphereIsOneWithSkyAsLight) {
   const auto dir = test::temp_dir("cpu_mis_furnace");
   for (Strategy k : {Strategy::Mis, Strategy::LightOnly})
     for (int n : {1, 3}) {  // next-event samples per surface vertex
-      Scene s = test::analytic_base_scene(16, 16, 64);
-      s.integrator.max_depth = 64;
-      s.integrator.surface_light_samples = n;
-      s.shapes.push_back(test::sphere_shape({0, 0, 0}, 1.0, glm::dvec3(1.0)));
-      s.environment = Environment{test::write_uniform_sky(dir, glm::vec3(1.0f)), 1.0, 0.0};
-      test::set_strategy(s, k);
-      RenderResult r = render(s);
+      RenderResult r = render(test::furnace_sphere_scene(dir, k, n));
       ZTestReport z = test::ztest_against_exact(r, [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
       EXPECT_TRUE(z.ok) << n << " light samples: " << z.summary();
       std::printf("furnace, %d light samples: %s\n", n, z.summary().c_str());

@@ -69,15 +69,9 @@ TEST_F(VulkanMis, FurnaceSphereIsOneWithSkyAsLight) {
   // next_surface_light_ray) darkens it about 5x more than it darkens MIS.
   for (int n : {1, 3}) {  // next-event samples per surface vertex
     for (Strategy st : {Strategy::Mis, Strategy::LightOnly}) {
-      Scene s = test::analytic_base_scene(16, 16, 64);
-      s.integrator.max_depth = 64;
-      s.integrator.surface_light_samples = n;
-      s.shapes.push_back(test::sphere_shape({0, 0, 0}, 1.0, glm::dvec3(1.0)));
-      s.environment = Environment{test::write_uniform_sky(dir, glm::vec3(1.0f)), 1.0, 0.0};
-      test::set_strategy(s, st);
       const char* name = st == Strategy::Mis ? "MIS" : "light only";
-      ZTestReport z =
-          test::ztest_against_exact(gpu(s), [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
+      ZTestReport z = test::ztest_against_exact(gpu(test::furnace_sphere_scene(dir, st, n)),
+                                                [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
       EXPECT_TRUE(z.ok) << n << " light samples, " << name << ": " << z.summary();
       std::printf("GPU furnace, %d light samples, %s: %s\n", n, name, z.summary().c_str());
     }
