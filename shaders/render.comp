@@ -493,8 +493,6 @@ void next_surface_light_ray(inout PathState p, inout uint rng) {
   new_ray(p, p.next_o, dir, 0.0, 0.0);
 }
 
-// The current ray ends. A light ray hands over to the vertex's next light ray
-// or to the continuation it sampled; returns true when the path has ended.
 // The vertex's light rays are done: the continuation starts (true: the path has ended).
 bool hand_over(inout PathState p) {
   p.light_ray = false;
@@ -504,10 +502,12 @@ bool hand_over(inout PathState p) {
   return false;
 }
 
-// The next light ray is drawn at the top of path_step (light_pending), in one
+// The current ray ends. A light ray hands over to the vertex's next light ray
+// or to the continuation it sampled; returns true when the path has ended. The
+// next light ray is drawn at the top of path_step (light_pending), in one
 // place: inlined at each of ray_ends' call sites, the light sampling code made
 // the shader 2× slower on llvmpipe.
-bool ray_ends(inout PathState p, inout uint rng) {
+bool ray_ends(inout PathState p) {
   if (!NEE || !p.light_ray) return true;
   if (p.lights_left > 0u) {
     p.light_pending = true;
@@ -534,7 +534,7 @@ bool continue_toward_light(vec3 o, vec4 norm, inout uint rng, out vec3 dir, out 
 // f_light with pdf pdf_light (0: none); a surface vertex's lights_after, all
 // drawn by next_surface_light_ray. n_light: the vertex's number of light
 // samples, for the MIS weights (eq. 6). Returns true when the path has ended.
-bool leave_vertex(inout PathState p, inout uint rng, vec3 o, vec3 d, vec3 f, float pdf_own, vec3 light_dir,
+bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 f, float pdf_own, vec3 light_dir,
                   vec3 f_light, float pdf_light, uint n_light, uint lights_after) {
   // "<= 0", not "!(> 0)": a NaN weight goes on and is counted (nonfinite_samples).
   if (!NEE) {
@@ -559,7 +559,7 @@ bool leave_vertex(inout PathState p, inout uint rng, vec3 o, vec3 d, vec3 f, flo
   p.next_p_light = n * p_light_d;
   p.lights_left = lights_after;
   p.light_ray = true;
-  if (max3(w_light) <= 0.0) return ray_ends(p, rng);  // the next light ray, or the continuation
+  if (max3(w_light) <= 0.0) return ray_ends(p);  // the next light ray, or the continuation
   p.w = w_light;
   new_ray(p, o, light_dir, 0.0, 0.0);
   return false;
@@ -589,7 +589,7 @@ bool surface_bounce(inout PathState p, inout uint rng, inout PathStats stats) {
   p.vertex_n = n;
   p.vertex_wa = p.w * albedo;
   const uint n_light = NEE && max3(p.w * albedo) > 0.0 ? uint(frame.lights.z) : 0u;
-  return leave_vertex(p, rng, o, d, albedo * pdf_own, pdf_own, vec3(0.0), vec3(0.0), 0.0, max(n_light, 1u), n_light);
+  return leave_vertex(p, o, d, albedo * pdf_own, pdf_own, vec3(0.0), vec3(0.0), 0.0, max(n_light, 1u), n_light);
 }
 
 // The phase function of a scattering mixture from d_in toward w: its value
@@ -620,7 +620,7 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   if (NEE && p.light_pending) {
     p.light_pending = false;
     next_surface_light_ray(p, rng);
-    if (max3(p.w) <= 0.0) return ray_ends(p, rng);  // no light this time: the next one, or the continuation
+    if (max3(p.w) <= 0.0) return ray_ends(p);  // no light this time: the next one, or the continuation
   }
   if (p.fresh) {
     bool any_hit;
@@ -630,7 +630,7 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     p.t = 0.0;
     if (!any_hit && !p.has_hit) {
       escape(p);
-      return ray_ends(p, rng);
+      return ray_ends(p);
     }
     // Move the origin to the first thing the ray reaches, so every later
     // position o + t·d is computed with a small t: from a camera 1e4 units
@@ -654,12 +654,12 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   const float t_surface = p.has_hit ? p.hit.t : INF;
   if (isinf(t_next) && !p.has_hit) {
     escape(p);
-    return ray_ends(p, rng);
+    return ray_ends(p);
   }
   const float t_end = min(t_next, t_surface);
   float dt = sigma_bar > 0.0 ? sample_free_flight(sigma_bar, rng_next(rng)) : INF;
   if (p.t + dt >= t_end) {
-    if (p.has_hit && t_surface <= t_next) return NEE && p.light_ray ? ray_ends(p, rng) : surface_bounce(p, rng, stats);
+    if (p.has_hit && t_surface <= t_next) return NEE && p.light_ray ? ray_ends(p) : surface_bounce(p, rng, stats);
     p.t = t_next;
     return false;
   }
@@ -684,10 +684,10 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     // Absorbed: the absorption estimator collects sigma_a·Le / (sigma_bar·P_a).
     stats.events += 1.0;
     if (HAS_EMISSION && !COLLISION_ESTIMATOR) p.L += p.w * emission_at(x, p.t, span, rho) / (sigma_bar * p_a);
-    return ray_ends(p, rng);
+    return ray_ends(p);
   } else if (HAS_SCATTERING && u < p_a + p_s) {
     stats.events += 1.0;
-    if (NEE && p.light_ray) return ray_ends(p, rng);  // a light ray ends at its first real event
+    if (NEE && p.light_ray) return ray_ends(p);  // a light ray ends at its first real event
     if (p.depth >= frame.image.w) return true;  // max_depth reached
     ++p.depth;
     p.w *= sigma_s / (sigma_bar * p_s);
@@ -725,11 +725,11 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     float pdf_phase;
     phase_mixture(p.d, d, share, q, f, pdf_phase);
     if (none) f = vec3(0.0);
-    return leave_vertex(p, rng, x, d, f, pdf_phase, light_dir, f_light, pdf_light, 1u, 0u);
+    return leave_vertex(p, x, d, f, pdf_phase, light_dir, f_light, pdf_light, 1u, 0u);
   } else {
     p.w *= sigma_n / (sigma_bar * (1.0 - p_a - p_s));
   }
-  return max3(p.w) <= 0.0 ? ray_ends(p, rng) : false;
+  return max3(p.w) <= 0.0 ? ray_ends(p) : false;
 }
 
 // A camera ray through pixel `pixel` for sample `k`, with that sample's random stream.
