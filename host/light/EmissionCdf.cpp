@@ -231,23 +231,28 @@ double EmissionCdf::cell_weight(const glm::ivec3& c) const {
   return weight_[size_t(linear_cell(c))];
 }
 
-EmissionSample EmissionCdf::sample(double u, const glm::dvec3& u3) const {
-  EmissionSample s;
-  if (empty()) return s;
-  // The first entry whose inclusive CDF exceeds u (lights.glsl emission_sample).
-  int lo = 0, hi = int(cdf_.size()) - 1;
+glm::ivec3 EmissionCdf::cell_coords(uint32_t cell) const {
+  const uint32_t X = uint32_t(cells_.x), Y = uint32_t(cells_.y);
+  return glm::ivec3(int(cell % X), int((cell / X) % Y), int(cell / (X * Y)));
+}
+
+uint32_t EmissionCdf::first_above(const std::vector<float>& cdf, uint32_t lo, uint32_t hi, double u) {
   while (lo < hi) {
-    const int mid = (lo + hi) / 2;
-    if (double(cdf_[mid]) <= u)
+    const uint32_t mid = (lo + hi) / 2;
+    if (double(cdf[mid]) <= u)
       lo = mid + 1;
     else
       hi = mid;
   }
-  const uint32_t cell = entries_[lo];
-  const int X = cells_.x, Y = cells_.y;
-  const glm::ivec3 c(int(cell % uint32_t(X)), int((cell / uint32_t(X)) % uint32_t(Y)), int(cell / (uint32_t(X) * Y)));
+  return lo;
+}
+
+EmissionSample EmissionCdf::sample(double u, const glm::dvec3& u3) const {
+  EmissionSample s;
+  if (empty()) return s;
+  const uint32_t cell = entries_[first_above(cdf_, 0u, uint32_t(cdf_.size()) - 1u, u)];
   s.cell = cell;
-  s.p = cell_to_world(glm::dvec3(c) + u3);
+  s.p = cell_to_world(glm::dvec3(cell_coords(cell)) + u3);
   s.pdf = double(pmf_[cell]) / cell_volume_;
   return s;
 }
@@ -366,19 +371,9 @@ EmissionSample EmissionCdf::sample_from(const glm::dvec3& o, double norm, double
     if (target < acc) break;
   }
   const Cluster& c = clusters_[pick];
-  uint32_t lo = c.first, hi = c.first + c.count - 1;
-  while (lo < hi) {
-    const uint32_t mid = (lo + hi) / 2;
-    if (double(local_cdf_[mid]) <= u_cell)
-      lo = mid + 1;
-    else
-      hi = mid;
-  }
-  const uint32_t cell = entries_[lo];
-  const int X = cells_.x, Y = cells_.y;
-  const glm::ivec3 ci(int(cell % uint32_t(X)), int((cell / uint32_t(X)) % uint32_t(Y)), int(cell / (uint32_t(X) * Y)));
+  const uint32_t cell = entries_[first_above(local_cdf_, c.first, c.first + c.count - 1u, u_cell)];
   s.cell = cell;
-  s.p = cell_to_world(glm::dvec3(ci) + u3);
+  s.p = cell_to_world(glm::dvec3(cell_coords(cell)) + u3);
   s.pdf = share / norm * double(local_pmf_[cell]) / cell_volume_;
   return s;
 }
@@ -404,10 +399,6 @@ EmissionCdf EmissionCdf::clustered(int k) const {
   // Entries grouped by cluster, ascending cells inside (a stable sort of the
   // ascending entries); the static CDF is rebuilt in that order.
   std::vector<uint32_t> order = entries_;
-  auto cell_coords = [&](uint32_t cell) {
-    const int X = cells_.x, Y = cells_.y;
-    return glm::ivec3(int(cell % uint32_t(X)), int((cell / uint32_t(X)) % uint32_t(Y)), int(cell / (uint32_t(X) * Y)));
-  };
   std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
     return e.cluster_of(cell_coords(a)) < e.cluster_of(cell_coords(b));
   });

@@ -163,6 +163,11 @@ class EmissionCdf {
   // I_s(o) of cluster s; and the cluster of a cell (clustered only).
   double cluster_importance(const glm::dvec3& o, size_t s) const;
   size_t cluster_of(const glm::ivec3& cell) const;
+  // The cell coordinates of a linear cell index.
+  glm::ivec3 cell_coords(uint32_t cell) const;
+  // The first index in [lo, hi] whose inclusive CDF exceeds u (hi if none):
+  // the search lights.glsl's emission_sample does.
+  static uint32_t first_above(const std::vector<float>& cdf, uint32_t lo, uint32_t hi, double u);
   // Visits the cells the ray o + t·w (w unit) crosses, by 3D DDA: f(cell, t0, t1).
   template <class F>
   void walk_cells(const glm::dvec3& o, const glm::dvec3& w, F f) const;
