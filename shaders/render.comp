@@ -646,90 +646,117 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
       if (p.has_hit) p.hit.t -= t0;
     }
   }
-  float t_next;
-  bool any_ahead;
-  float sigma_bar = majorant_at(p.o, p.d, p.t, span, t_next, any_ahead);
-  if (!any_ahead) t_next = INF;
-  // Media beyond the closest surface do not matter: free flights end there.
-  const float t_surface = p.has_hit ? p.hit.t : INF;
-  if (isinf(t_next) && !p.has_hit) {
+  // Free flights, until the ray meets what needs more than a density lookup:
+  // a surface, a real event, the end of the media, a light ray's lost
+  // roulette. The cheap steps loop here and the event code below runs once per
+  // event: llvmpipe runs every branch for the whole SIMD group (masked), so
+  // with one step per path_step call each null collision also paid for the
+  // vertex code (while-while, Aila & Laine 2009). No return inside the loop
+  // (docs/mis.md: llvmpipe lost returns from inside loops).
+  const uint EVENT_NONE = 0u, EVENT_ESCAPE = 1u, EVENT_SURFACE = 2u, EVENT_ABSORB = 3u, EVENT_SCATTER = 4u,
+             EVENT_END = 5u;
+  uint event = EVENT_NONE;
+  float sigma_bar = 0.0, p_a = 0.0, p_s = 0.0;
+  vec3 x = vec3(0.0), sigma_a = vec3(0.0), sigma_s = vec3(0.0);
+  float rho[MEDIA_N];
+  while (event == EVENT_NONE) {
+    float t_next;
+    bool any_ahead;
+    sigma_bar = majorant_at(p.o, p.d, p.t, span, t_next, any_ahead);
+    if (!any_ahead) t_next = INF;
+    // Media beyond the closest surface do not matter: free flights end there.
+    const float t_surface = p.has_hit ? p.hit.t : INF;
+    if (isinf(t_next) && !p.has_hit) {
+      event = EVENT_ESCAPE;
+      break;
+    }
+    const float t_end = min(t_next, t_surface);
+    float dt = sigma_bar > 0.0 ? sample_free_flight(sigma_bar, rng_next(rng)) : INF;
+    if (p.t + dt >= t_end) {
+      if (p.has_hit && t_surface <= t_next) {
+        event = EVENT_SURFACE;
+        break;
+      }
+      p.t = t_next;
+      continue;
+    }
+    p.t += dt;
+    x = p.o + p.t * p.d;
+    coefficients_at(x, p.t, span, sigma_a, sigma_s, rho, stats);
+    if (HAS_EMISSION && COLLISION_ESTIMATOR) {
+      // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.
+      // With next-event estimation the ray's own MIS weight (light rays: 1).
+      vec3 e = emission_at(x, p.t, span, rho);
+      if (max3(e) > 0.0) p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_bar) * p.w * e;
+    }
+    vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
+    float c = sigma_bar * avg3(p.w);
+    p_a = avg3(sigma_a * p.w) / c;
+    p_s = HAS_SCATTERING ? avg3(sigma_s * p.w) / c : 0.0;
+    float u = rng_next(rng);
+    if (u < p_a) {
+      event = EVENT_ABSORB;
+      break;
+    }
+    if (HAS_SCATTERING && u < p_a + p_s) {
+      event = EVENT_SCATTER;
+      break;
+    }
+    p.w *= sigma_n / (sigma_bar * (1.0 - p_a - p_s));
+    if (max3(p.w) <= 0.0) event = EVENT_END;
+  }
+  if (event == EVENT_ESCAPE) {
     escape(p);
     return ray_ends(p);
   }
-  const float t_end = min(t_next, t_surface);
-  float dt = sigma_bar > 0.0 ? sample_free_flight(sigma_bar, rng_next(rng)) : INF;
-  if (p.t + dt >= t_end) {
-    if (p.has_hit && t_surface <= t_next) return NEE && p.light_ray ? ray_ends(p) : surface_bounce(p, rng, stats);
-    p.t = t_next;
-    return false;
-  }
-  p.t += dt;
-  vec3 x = p.o + p.t * p.d;
-
-  vec3 sigma_a, sigma_s;
-  float rho[MEDIA_N];
-  coefficients_at(x, p.t, span, sigma_a, sigma_s, rho, stats);
-  if (HAS_EMISSION && COLLISION_ESTIMATOR) {
-    // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.
-    // With next-event estimation the ray's own MIS weight (light rays: 1).
-    vec3 e = emission_at(x, p.t, span, rho);
-    if (max3(e) > 0.0) p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_bar) * p.w * e;
-  }
-  vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
-  float c = sigma_bar * avg3(p.w);
-  float p_a = avg3(sigma_a * p.w) / c;
-  float p_s = HAS_SCATTERING ? avg3(sigma_s * p.w) / c : 0.0;
-  float u = rng_next(rng);
-  if (u < p_a) {
+  if (event == EVENT_SURFACE) return NEE && p.light_ray ? ray_ends(p) : surface_bounce(p, rng, stats);
+  if (event == EVENT_END) return ray_ends(p);
+  stats.events += 1.0;
+  if (event == EVENT_ABSORB) {
     // Absorbed: the absorption estimator collects sigma_a·Le / (sigma_bar·P_a).
-    stats.events += 1.0;
     if (HAS_EMISSION && !COLLISION_ESTIMATOR) p.L += p.w * emission_at(x, p.t, span, rho) / (sigma_bar * p_a);
     return ray_ends(p);
-  } else if (HAS_SCATTERING && u < p_a + p_s) {
-    stats.events += 1.0;
-    if (NEE && p.light_ray) return ray_ends(p);  // a light ray ends at its first real event
-    if (p.depth >= frame.image.w) return true;  // max_depth reached
-    ++p.depth;
-    p.w *= sigma_s / (sigma_bar * p_s);
-    // Phase function of the mixture f = Σ_i share_i·HG_i, share_i = σs_i/σs (per
-    // channel): sample lobe i with q_i ∝ avg(share_i ⊙ w); the direction's pdf
-    // is the mixture's, Σ_i q_i·HG_i, and the weight f/pdf.
-    vec3 inv_sigma_s = 1.0 / max(sigma_s, vec3(1e-30));
-    vec3 share[MEDIA_N];
-    float q[MEDIA_N];
-    float total = 0.0;
-    for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-      share[i] = rho[i] * media[i].sigma_s.rgb * inv_sigma_s;
-      q[i] = avg3(share[i] * p.w);
-      total += q[i];
-    }
-    for (uint i = 0u; i < MEDIUM_COUNT; ++i) q[i] /= total;
-    vec3 light_dir = vec3(0.0), f_light = vec3(0.0);
-    float pdf_light = 0.0;
-    if (NEE) light_norms(x, p.vertex_norm);
-    if (NEE && sample_light_direction(x, p.vertex_norm, rng, light_dir))
-      phase_mixture(p.d, light_dir, share, q, f_light, pdf_light);
-    vec3 d;
-    bool none;
-    if (!continue_toward_light(x, p.vertex_norm, rng, d, none)) {
-      float pick = rng_next(rng), acc = 0.0, g = 0.0;
-      for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-        if (q[i] <= 0.0) continue;
-        acc += q[i];
-        g = media[i].sigma_s.w;
-        if (pick < acc) break;
-      }
-      d = sample_hg(p.d, g, vec2(rng_next(rng), rng_next(rng)));
-    }
-    vec3 f;
-    float pdf_phase;
-    phase_mixture(p.d, d, share, q, f, pdf_phase);
-    if (none) f = vec3(0.0);
-    return leave_vertex(p, x, d, f, pdf_phase, light_dir, f_light, pdf_light, 1u, 0u);
-  } else {
-    p.w *= sigma_n / (sigma_bar * (1.0 - p_a - p_s));
   }
-  return max3(p.w) <= 0.0 ? ray_ends(p) : false;
+  // Scattered.
+  if (NEE && p.light_ray) return ray_ends(p);  // a light ray ends at its first real event
+  if (p.depth >= frame.image.w) return true;  // max_depth reached
+  ++p.depth;
+  p.w *= sigma_s / (sigma_bar * p_s);
+  // Phase function of the mixture f = Σ_i share_i·HG_i, share_i = σs_i/σs (per
+  // channel): sample lobe i with q_i ∝ avg(share_i ⊙ w); the direction's pdf
+  // is the mixture's, Σ_i q_i·HG_i, and the weight f/pdf.
+  vec3 inv_sigma_s = 1.0 / max(sigma_s, vec3(1e-30));
+  vec3 share[MEDIA_N];
+  float q[MEDIA_N];
+  float total = 0.0;
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+    share[i] = rho[i] * media[i].sigma_s.rgb * inv_sigma_s;
+    q[i] = avg3(share[i] * p.w);
+    total += q[i];
+  }
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) q[i] /= total;
+  vec3 light_dir = vec3(0.0), f_light = vec3(0.0);
+  float pdf_light = 0.0;
+  if (NEE) light_norms(x, p.vertex_norm);
+  if (NEE && sample_light_direction(x, p.vertex_norm, rng, light_dir))
+    phase_mixture(p.d, light_dir, share, q, f_light, pdf_light);
+  vec3 d;
+  bool none;
+  if (!continue_toward_light(x, p.vertex_norm, rng, d, none)) {
+    float pick = rng_next(rng), acc = 0.0, g = 0.0;
+    for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+      if (q[i] <= 0.0) continue;
+      acc += q[i];
+      g = media[i].sigma_s.w;
+      if (pick < acc) break;
+    }
+    d = sample_hg(p.d, g, vec2(rng_next(rng), rng_next(rng)));
+  }
+  vec3 f;
+  float pdf_phase;
+  phase_mixture(p.d, d, share, q, f, pdf_phase);
+  if (none) f = vec3(0.0);
+  return leave_vertex(p, x, d, f, pdf_phase, light_dir, f_light, pdf_light, 1u, 0u);
 }
 
 // A camera ray through pixel `pixel` for sample `k`, with that sample's random stream.
