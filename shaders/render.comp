@@ -435,6 +435,7 @@ struct PathState {
   // with the continuation sampled at the vertex (next_*), one tracking step
   // per loop iteration like any other ray (LAVAPIPE.md: divergence).
   bool light_ray;
+  float light_T;  // a light ray's ratio-tracking transmittance (max channel) since its last roulette
   bool next_ends;  // the continuation has no weight or depth left
   vec3 next_o, next_d, next_w;
   float next_pdf_dir, next_p_light;
@@ -463,6 +464,7 @@ void new_ray(inout PathState p, vec3 o, vec3 d, float pdf_dir, float p_light) {
   p.fresh = true;
   p.pdf_dir = pdf_dir;
   p.p_light = p_light;
+  p.light_T = 1.0;
 }
 
 // The continuation's solid-angle pdf of a direction that the vertex's lobe
@@ -690,6 +692,23 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
       if (max3(e) > 0.0) p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_bar) * p.w * e;
     }
     vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
+    if (NEE && p.light_ray) {
+      // Light rays: ratio tracking (docs/mis.md "Light rays"): no event is
+      // chosen, the weight takes the null fraction, Russian roulette once the
+      // ray's transmittance estimate is below 0.1.
+      const vec3 null_fraction = sigma_n / sigma_bar;
+      p.w *= null_fraction;
+      p.light_T *= max3(null_fraction);
+      if (p.light_T < 0.1) {
+        if (rng_next(rng) >= p.light_T) {
+          event = EVENT_END;
+          break;
+        }
+        p.w /= p.light_T;
+        p.light_T = 1.0;
+      }
+      continue;
+    }
     float c = sigma_bar * avg3(p.w);
     p_a = avg3(sigma_a * p.w) / c;
     p_s = HAS_SCATTERING ? avg3(sigma_s * p.w) / c : 0.0;
@@ -718,7 +737,6 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     return ray_ends(p);
   }
   // Scattered.
-  if (NEE && p.light_ray) return ray_ends(p);  // a light ray ends at its first real event
   if (p.depth >= frame.image.w) return true;  // max_depth reached
   ++p.depth;
   p.w *= sigma_s / (sigma_bar * p_s);
@@ -782,6 +800,7 @@ PathState camera_path(uvec2 pixel, uint k, out uint rng) {
   p.pdf_dir = 0.0;
   p.p_light = 0.0;
   p.light_ray = false;
+  p.light_T = 1.0;
   p.next_ends = true;
   p.next_o = p.next_d = p.next_w = vec3(0.0);
   p.next_pdf_dir = p.next_p_light = 0.0;

@@ -149,8 +149,11 @@ struct VertexLobe {
   double f = 0.0, pdf = 0.0;
 };
 
+// A light ray (next_event) or a path: how the walk treats tentative collisions.
+enum class WalkRole { Path, LightRay };
+
 double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
-                    Scratch& s, int max_depth);
+                    Scratch& s, int max_depth, WalkRole role = WalkRole::Path);
 
 // One light direction from vertex o, drawn from the mixture of eq. (3) of
 // docs/mis.md: the environment map's 2D CDF, or a point from an emissive
@@ -187,7 +190,7 @@ bool light_direction(const WalkScene& ws, const glm::dvec3& o, Pcg32& rng, glm::
 // Next-event estimation from vertex o (the offset origin the continuing ray
 // also uses): n directions from the lights (light_direction). The radiance
 // arriving along each before anything scatters it is estimated by a light
-// ray: the walk itself with max_depth 0. Each is weighted by the power
+// ray: the walk itself with max_depth 0, by ratio tracking. Each is weighted by the power
 // heuristic for n samples of pdf p_light against the continuation's one
 // sample of pdf p_m for the same direction, both in solid angle (Veach 1997
 // eq. 9.13 with sample counts; docs/mis.md "Several light samples").
@@ -204,7 +207,7 @@ double next_event(const WalkScene& ws, int c, const glm::dvec3& o, Lobe lobe, in
     if (!(l.f > 0.0)) continue;
     const double p_light = light_direction_pdf(ws, o, dir);
     if (!(p_light > 0.0)) continue;
-    const double radiance = walk_channel(ws, c, o, dir, rng, cnt, s.light_ray(), 0);
+    const double radiance = walk_channel(ws, c, o, dir, rng, cnt, s.light_ray(), 0, WalkRole::LightRay);
     const double w = lights.selection.strategy == LightStrategy::LightOnly
                          ? 1.0
                          : power_heuristic(n * p_light, lights.selection.continuation_pdf(l.pdf, p_light));
@@ -292,8 +295,17 @@ bool continue_from(const WalkScene& ws, const glm::dvec3& o, Lobe& lobe, Own sam
 // (continue_from), and what its ray finds before the next real event (emission
 // at tentative collisions, the environment on escape) is weighted by the power
 // heuristic of the two direction pdfs (unidirectional_weight).
+//
+// Light rays (role LightRay, max_depth 0) estimate the same integral
+// I(y, ω) = ∫ T σa Le dt + T(∞) L_env by ratio tracking instead (Novák et al.
+// 2014, with the collision estimator's terms): no event is chosen at a
+// tentative collision, β is multiplied by its expectation there, the null
+// fraction 1 − σt/σ̄, and Russian roulette ends the ray once β < 0.1
+// (survive with probability β, then β = 1). E[Σ_k β_k σa Le(x_k)/σ̄] is the
+// same integral as delta tracking's, without the noise of where the first
+// real event falls (docs/mis.md "Light rays").
 double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
-                    Scratch& s, int max_depth) {
+                    Scratch& s, int max_depth, WalkRole role) {
   const MediaData& md = ws.md;
   const WalkLights& lights = ws.lights;
   const bool collision_estimator = ws.collision_estimator;
@@ -328,6 +340,14 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
         coefficients_at(md, c, x, s, cnt, sigma_a, sigma_s);
         if (exceeds_majorant(sigma_a + sigma_s, sigma_maj)) ++cnt.majorant_violations;
         if (collision_estimator && sigma_a > 0.0) L += beta * w_ray * emitted_at(md, c, x, s) / sigma_maj;
+        if (role == WalkRole::LightRay) {
+          beta *= std::max(0.0, 1.0 - (sigma_a + sigma_s) / sigma_maj);
+          if (beta < 0.1) {
+            if (!(rng.uniform() < beta)) return L;
+            beta = 1.0;
+          }
+          continue;
+        }
 
         const double u = rng.uniform() * sigma_maj;
         if (u < sigma_a) {
