@@ -436,6 +436,11 @@ struct PathState {
   // per loop iteration like any other ray (LAVAPIPE.md: divergence).
   bool light_ray;
   float light_T;  // a light ray's ratio-tracking transmittance (max channel) since its last roulette
+  // Ratio-tracked continuation (docs/mis.md): 1 while the surface vertex's
+  // ray along the continuation is still to come, 2 once it has run; the
+  // continuation then collects nothing on its first segment (skip_segment).
+  uint continuation_ray;
+  bool skip_segment;
   bool next_ends;  // the continuation has no weight or depth left
   vec3 next_o, next_d, next_w;
   float next_pdf_dir, next_p_light;
@@ -454,7 +459,7 @@ vec3 escaped_radiance(vec3 d) { return HAS_ENVIRONMENT ? env_radiance(environmen
 
 // The ray leaves the scene: add what it sees, MIS-weighted.
 void escape(inout PathState p) {
-  p.L += unidirectional_weight(p.pdf_dir, p.p_light) * p.w * escaped_radiance(p.d);
+  if (!p.skip_segment) p.L += unidirectional_weight(p.pdf_dir, p.p_light) * p.w * escaped_radiance(p.d);
 }
 
 // Start a new ray at a vertex, its direction sampled with solid-angle pdf pdf_dir.
@@ -465,6 +470,7 @@ void new_ray(inout PathState p, vec3 o, vec3 d, float pdf_dir, float p_light) {
   p.pdf_dir = pdf_dir;
   p.p_light = p_light;
   p.light_T = 1.0;
+  p.skip_segment = false;
 }
 
 // The continuation's solid-angle pdf of a direction that the vertex's lobe
@@ -495,12 +501,26 @@ void next_surface_light_ray(inout PathState p, inout uint rng) {
   new_ray(p, p.next_o, dir, 0.0, 0.0);
 }
 
-// The vertex's light rays are done: the continuation starts (true: the path has ended).
+// The vertex's light rays are done: the continuation starts (true: the path
+// has ended). With a ratio-tracked continuation, first one more light ray
+// along the continuation's direction, with its weight and MIS weight: it
+// collects the continuation's first segment, which the path then skips.
 bool hand_over(inout PathState p) {
+  if (p.next_ends) {
+    p.light_ray = false;
+    return true;
+  }
+  if (p.continuation_ray == 1u) {
+    p.continuation_ray = 2u;
+    p.w = p.next_w * unidirectional_weight(p.next_pdf_dir, p.next_p_light);
+    new_ray(p, p.next_o, p.next_d, 0.0, 0.0);
+    return false;
+  }
   p.light_ray = false;
-  if (p.next_ends) return true;
   p.w = p.next_w;
   new_ray(p, p.next_o, p.next_d, p.next_pdf_dir, p.next_p_light);
+  p.skip_segment = p.continuation_ray == 2u;
+  p.continuation_ray = 0u;
   return false;
 }
 
@@ -560,6 +580,7 @@ bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 f, float pdf_own, vec3
   p.next_pdf_dir = p_mix;
   p.next_p_light = n * p_light_d;
   p.lights_left = lights_after;
+  p.continuation_ray = frame.lights.w > 0.0 && lights_after > 0u ? 1u : 0u;  // surface vertices
   p.light_ray = true;
   if (max3(w_light) <= 0.0) return ray_ends(p);  // the next light ray, or the continuation
   p.w = w_light;
@@ -689,7 +710,7 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
       // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.
       // With next-event estimation the ray's own MIS weight (light rays: 1).
       vec3 e = emission_at(x, p.t, span, rho);
-      if (max3(e) > 0.0) p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_bar) * p.w * e;
+      if (max3(e) > 0.0 && !p.skip_segment) p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_bar) * p.w * e;
     }
     vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
     if (NEE && p.light_ray) {
@@ -801,6 +822,8 @@ PathState camera_path(uvec2 pixel, uint k, out uint rng) {
   p.p_light = 0.0;
   p.light_ray = false;
   p.light_T = 1.0;
+  p.continuation_ray = 0u;
+  p.skip_segment = false;
   p.next_ends = true;
   p.next_o = p.next_d = p.next_w = vec3(0.0);
   p.next_pdf_dir = p.next_p_light = 0.0;

@@ -41,6 +41,7 @@ LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, cons
   s.strategy = !eligible ? LightStrategy::Bsdf : (in.light_only ? LightStrategy::LightOnly : LightStrategy::Mis);
   s.p_continue_own = s.strategy == LightStrategy::Bsdf ? 1.0 : kContinueOwn;
   s.surface_light_samples = s.strategy == LightStrategy::Bsdf ? 1 : in.surface_light_samples;
+  s.ratio_tracked_continuation = s.strategy != LightStrategy::Bsdf && in.ratio_tracked_continuation;
   return s;
 }
 

@@ -38,6 +38,11 @@ struct LightSelection {
   // medium vertices take one). MIS weighs their n·p_light against the
   // continuation's pdf (docs/mis.md "Several light samples").
   int surface_light_samples = 1;
+  // At each surface vertex, what the continuation finds before its first real
+  // event is collected by a ratio-tracked ray along the same direction instead
+  // of by the path (integrator.ratio_tracked_continuation; docs/mis.md
+  // "Ratio-tracked continuation").
+  bool ratio_tracked_continuation = false;
 
   bool any() const;
   // The continuation's solid-angle pdf of a direction that the vertex's lobe

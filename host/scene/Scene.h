@@ -55,6 +55,8 @@ struct Integrator {
   bool mis = true;  // next-event estimation + MIS (needs the collision estimator; docs/mis.md)
   bool mis_in_file = false;  // the scene file says "mis" (the warning about MIS's needs is for those who asked)
   int surface_light_samples = 1;  // next-event samples per surface vertex (with MIS; docs/mis.md)
+  // With MIS: a surface vertex's continuation collects its first segment by a ratio-tracked ray (docs/mis.md)
+  bool ratio_tracked_continuation = false;
   bool light_only = false;  // debug: next-event estimation only, no BSDF/phase-found light (docs/mis.md)
   std::string emission_estimator = "absorption";  // "absorption" | "collision"
   std::string majorant = "grid";                  // "grid" | "global"

@@ -368,6 +368,8 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
     s.integrator.light_only = i.boolean("light_only", s.integrator.light_only);
     s.integrator.surface_light_samples =
         i.integer("surface_light_samples", s.integrator.surface_light_samples, 1, 64);
+    s.integrator.ratio_tracked_continuation =
+        i.boolean("ratio_tracked_continuation", s.integrator.ratio_tracked_continuation);
     s.integrator.emission_estimator = i.choice("emission_estimator", "absorption", {"absorption", "collision"});
     s.integrator.majorant = i.choice("majorant", "grid", {"grid", "global"});
     if (i.has("majorant_grid")) {

@@ -112,7 +112,8 @@ struct FrameConstants {
                          // (each emissive grid's is its GpuEmissionCdf measure.w); y: probability
                          // that a vertex's continuation comes from its own lobe (LightSelection
                          // p_continue_own); z: next-event samples per surface vertex
-                         // (LightSelection surface_light_samples); w: unused
+                         // (LightSelection surface_light_samples); w: 1 when a surface vertex's
+                         // continuation is collected by a ratio-tracked ray (ratio_tracked_continuation)
 };
 
 // Per-pass values (push constants).

@@ -79,12 +79,32 @@ inline Scene scattering_fire_scene(const std::filesystem::path& dir, Strategy k,
 }
 
 // The furnace: a white diffuse sphere (albedo 1) in a uniform white sky, n
-// next-event samples per surface vertex; exactly 1 everywhere.
-inline Scene furnace_sphere_scene(const std::filesystem::path& dir, Strategy k, int surface_light_samples) {
+// next-event samples per surface vertex, optionally the ratio-tracked
+// continuation; exactly 1 everywhere.
+inline Scene furnace_sphere_scene(const std::filesystem::path& dir, Strategy k, int surface_light_samples,
+                                  bool ratio_tracked_continuation = false) {
   Scene s = analytic_base_scene(16, 16, 64);
   s.integrator.max_depth = 64;
   s.integrator.surface_light_samples = surface_light_samples;
+  s.integrator.ratio_tracked_continuation = ratio_tracked_continuation;
   s.shapes.push_back(sphere_shape({0, 0, 0}, 1.0, glm::dvec3(1.0)));
+  s.environment = Environment{write_uniform_sky(dir, glm::vec3(1.0f)), 1.0, 0.0};
+  set_strategy(s, k);
+  return s;
+}
+
+// The furnace with a medium around the surface: a white diffuse sphere
+// (albedo 1, radius 0.6) inside a purely scattering smoke sphere (σa = 0,
+// radius 1) in a uniform white sky, 3 next-event samples per surface vertex
+// and the ratio-tracked continuation on or off: energy is conserved, L = 1
+// everywhere, and the continuation's rays are tracked through the smoke.
+inline Scene smoky_furnace_scene(const std::filesystem::path& dir, Strategy k, bool ratio_tracked_continuation) {
+  Scene s = analytic_base_scene(16, 16, 64);
+  s.integrator.max_depth = 1000;
+  s.integrator.surface_light_samples = 3;
+  s.integrator.ratio_tracked_continuation = ratio_tracked_continuation;
+  s.shapes.push_back(sphere_shape({0, 0, 0}, 0.6, glm::dvec3(1.0)));
+  s.media.push_back(homogeneous_sphere("smoke", {0, 0, 0}, 1.0, glm::dvec3(0.0), glm::dvec3(2.0), 0.3, std::nullopt));
   s.environment = Environment{write_uniform_sky(dir, glm::vec3(1.0f)), 1.0, 0.0};
   set_strategy(s, k);
   return s;
@@ -110,18 +130,19 @@ inline void expect_same_image(const RenderResult& a, const RenderResult& b, doub
 // On the fire over a plane under a sky (every strategy has finite variance
 // there), MIS at 256 spp and light sampling only at 256 spp converge to BSDF
 // sampling only at bsdf_spp, with one next-event sample per surface vertex
-// and with three (their MIS weights count the samples). render(scene) is one
-// backend's render; `who` prefixes the reports.
+// and with three (their MIS weights count the samples) and the ratio-tracked
+// continuation. render(scene) is one backend's render; `who` prefixes the reports.
 template <class Render>
 void expect_strategies_agree(Render render, const std::filesystem::path& dir, int bsdf_spp, const std::string& who) {
   auto scene = [&](Strategy k, int spp, int light_samples) {
     Scene s = fire_over_plane_scene(dir, k, true, false, 24, 18, spp);
     s.integrator.surface_light_samples = light_samples;
+    s.integrator.ratio_tracked_continuation = light_samples > 1;
     return s;
   };
   const RenderResult bsdf = render(scene(Strategy::Bsdf, bsdf_spp, 1));
   for (int n : {1, 3}) {
-    const std::string samples = n == 1 ? "" : ", " + std::to_string(n) + " light samples";
+    const std::string samples = n == 1 ? "" : ", " + std::to_string(n) + " light samples, ratio-tracked continuation";
     expect_same_image(render(scene(Strategy::Mis, 256, n)), bsdf, 0.02, (who + "MIS vs BSDF only" + samples).c_str());
     expect_same_image(render(scene(Strategy::LightOnly, 256, n)), bsdf, 0.02,
                       (who + "light only vs BSDF only" + samples).c_str());

@@ -72,11 +72,13 @@ TEST(CpuMis, MisLowersVarianceOnLitPlane) {
 TEST(CpuMis, FurnaceSphereIsOneWithSkyAsLight) {
   const auto dir = test::temp_dir("cpu_mis_furnace");
   for (Strategy k : {Strategy::Mis, Strategy::LightOnly})
-    for (int n : {1, 3}) {  // next-event samples per surface vertex
-      RenderResult r = render(test::furnace_sphere_scene(dir, k, n));
+    // n next-event samples per surface vertex; the last with the ratio-tracked continuation.
+    for (auto [n, ratio] : {std::pair{1, false}, std::pair{3, false}, std::pair{3, true}}) {
+      RenderResult r = render(test::furnace_sphere_scene(dir, k, n, ratio));
       ZTestReport z = test::ztest_against_exact(r, [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
-      EXPECT_TRUE(z.ok) << n << " light samples: " << z.summary();
-      std::printf("furnace, %d light samples: %s\n", n, z.summary().c_str());
+      EXPECT_TRUE(z.ok) << n << " light samples" << (ratio ? ", ratio-tracked continuation: " : ": ") << z.summary();
+      std::printf("furnace, %d light samples%s: %s\n", n, ratio ? ", ratio-tracked continuation" : "",
+                  z.summary().c_str());
     }
 }
 
@@ -93,6 +95,18 @@ TEST(CpuMis, ScatteringFurnaceIsOneWithSkyAsLight) {
   RenderResult r = render(s);
   ZTestReport z = test::ztest_against_exact(r, [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
   EXPECT_TRUE(z.ok) << z.summary();
+}
+
+// The furnace with smoke around the sphere (test::smoky_furnace_scene): the
+// ratio-tracked continuation's rays cross the smoke before they reach the sky.
+TEST(CpuMis, SmokyFurnaceIsOneWithRatioTrackedContinuation) {
+  const auto dir = test::temp_dir("cpu_mis_furnace");
+  for (bool ratio : {false, true}) {
+    ZTestReport z = test::ztest_against_exact(render(test::smoky_furnace_scene(dir, Strategy::Mis, ratio)),
+                                              [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
+    EXPECT_TRUE(z.ok) << (ratio ? "ratio-tracked continuation: " : "path continuation: ") << z.summary();
+    std::printf("smoky furnace%s: %s\n", ratio ? ", ratio-tracked continuation" : "", z.summary().c_str());
+  }
 }
 
 // Light choice and strategy rules (host/light/LightSelection.h).

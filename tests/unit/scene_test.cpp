@@ -136,6 +136,8 @@ INSTANTIATE_TEST_SUITE_P(
                 "integrator.surface_light_samples: must be in [1, 64]"},
         BadCase{"surface_light_samples fraction", R"({"integrator": {"surface_light_samples": 2.5}})",
                 "integrator.surface_light_samples: expected an integer"},
+        BadCase{"ratio_tracked_continuation not bool", R"({"integrator": {"ratio_tracked_continuation": 1}})",
+                "integrator.ratio_tracked_continuation: expected"},
         BadCase{"background", R"({"background": {"rgb": [0, 0, -1]}})", "background.rgb"},
         BadCase{"duplicate names",
                 R"({"media": [{"name": "a", "type": "homogeneous", "bounds": {"sphere": {"center": [0,0,0], "radius": 1}}},
@@ -157,4 +159,10 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(Scene, SurfaceLightSamples) {
   EXPECT_EQ(parse_scene("{}", "a.json").integrator.surface_light_samples, 1);
   EXPECT_EQ(parse_scene(R"({"integrator": {"surface_light_samples": 4}})", "a.json").integrator.surface_light_samples, 4);
+}
+
+TEST(Scene, RatioTrackedContinuation) {
+  EXPECT_FALSE(parse_scene("{}", "a.json").integrator.ratio_tracked_continuation);
+  EXPECT_TRUE(parse_scene(R"({"integrator": {"ratio_tracked_continuation": true}})", "a.json")
+                  .integrator.ratio_tracked_continuation);
 }

@@ -67,14 +67,30 @@ TEST_F(VulkanMis, FurnaceSphereIsOneWithSkyAsLight) {
   const auto dir = test::temp_dir("vk_mis_furnace");
   // Light only as well: a light ray lost on its way (as on llvmpipe once, see
   // next_surface_light_ray) darkens it about 5x more than it darkens MIS.
-  for (int n : {1, 3}) {  // next-event samples per surface vertex
+  // n next-event samples per surface vertex; the last with the ratio-tracked continuation.
+  for (auto [n, ratio] : {std::pair{1, false}, std::pair{3, false}, std::pair{3, true}}) {
     for (Strategy st : {Strategy::Mis, Strategy::LightOnly}) {
       const char* name = st == Strategy::Mis ? "MIS" : "light only";
-      ZTestReport z = test::ztest_against_exact(gpu(test::furnace_sphere_scene(dir, st, n)),
+      ZTestReport z = test::ztest_against_exact(gpu(test::furnace_sphere_scene(dir, st, n, ratio)),
                                                 [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
-      EXPECT_TRUE(z.ok) << n << " light samples, " << name << ": " << z.summary();
-      std::printf("GPU furnace, %d light samples, %s: %s\n", n, name, z.summary().c_str());
+      EXPECT_TRUE(z.ok) << n << " light samples" << (ratio ? ", ratio-tracked continuation, " : ", ") << name << ": "
+                        << z.summary();
+      std::printf("GPU furnace, %d light samples%s, %s: %s\n", n, ratio ? ", ratio-tracked continuation" : "", name,
+                  z.summary().c_str());
     }
+  }
+}
+
+// The furnace with smoke around the sphere (test::smoky_furnace_scene), MIS
+// and light only, with the ratio-tracked continuation.
+TEST_F(VulkanMis, SmokyFurnaceIsOneWithRatioTrackedContinuation) {
+  const auto dir = test::temp_dir("vk_mis_furnace");
+  for (Strategy st : {Strategy::Mis, Strategy::LightOnly}) {
+    const char* name = st == Strategy::Mis ? "MIS" : "light only";
+    ZTestReport z = test::ztest_against_exact(gpu(test::smoky_furnace_scene(dir, st, true)),
+                                              [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
+    EXPECT_TRUE(z.ok) << name << ": " << z.summary();
+    std::printf("GPU smoky furnace, ratio-tracked continuation, %s: %s\n", name, z.summary().c_str());
   }
 }
 
@@ -85,6 +101,16 @@ TEST_F(VulkanMis, SurfaceLightSamplesMatchCpu) {
   Scene s = test::fire_over_plane_scene(dir, Strategy::Mis, true, true, 24, 18, 256);
   s.integrator.surface_light_samples = 3;
   test::expect_same_image(gpu(s), cpu(s, 256), 0.02, "GPU vs CPU, MIS, 3 light samples per surface vertex");
+}
+
+// The ratio-tracked continuation (a light ray along the continuation, which
+// then skips its first segment) on the scattering fire over a plane: GPU
+// against the CPU reference.
+TEST_F(VulkanMis, RatioTrackedContinuationMatchesCpu) {
+  const auto dir = test::temp_dir("vk_mis_plane");
+  Scene s = test::fire_over_plane_scene(dir, Strategy::Mis, true, true, 24, 18, 256);
+  s.integrator.ratio_tracked_continuation = true;
+  test::expect_same_image(gpu(s), cpu(s, 256), 0.02, "GPU vs CPU, MIS, ratio-tracked continuation");
 }
 
 TEST_F(VulkanMis, MisLowersVarianceOnLitPlane) {

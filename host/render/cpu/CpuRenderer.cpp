@@ -316,6 +316,8 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
   RayMis mis;         // the camera ray: never MIS-weighted
   const int n_surface = lights.selection.surface_light_samples;  // next-event samples per vertex
   const int n_medium = 1;
+  // This segment was already collected by a ratio-tracked ray (ratio_tracked_continuation, below).
+  bool skip_segment = false;
   for (;;) {
     // The closest surface bounds this segment.
     geometry::SurfaceHit hit;
@@ -323,7 +325,9 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
                                                                  std::numeric_limits<double>::infinity(), hit);
     const double t_surf = hit_surface ? hit.t : std::numeric_limits<double>::infinity();
 
-    const double w_ray = unidirectional_weight(lights, mis);  // what this ray finds before its next event
+    // The weight of what this ray finds before its next event.
+    const double w_ray = skip_segment ? 0.0 : unidirectional_weight(lights, mis);
+    skip_segment = false;
     ray_spans(md, o, d, s.spans, s.cuts);
     bool scattered = false;
     for (size_t k = 0; k + 1 < s.cuts.size() && !scattered; ++k) {
@@ -414,6 +418,15 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
                        n_surface, rng, d, weight, mis))
       return L;
     beta *= weight;
+    if (lights.active() && lights.selection.ratio_tracked_continuation) {
+      // docs/mis.md "Ratio-tracked continuation": what this ray would collect
+      // before its next real event, I(o, d), comes from a light ray along d
+      // with the continuation's weight and MIS weight; the path collects
+      // nothing on that segment (emission or sky) and goes on as before.
+      L += beta * unidirectional_weight(lights, mis) *
+           walk_channel(ws, c, o, d, rng, cnt, s.light_ray(), 0, WalkRole::LightRay);
+      skip_segment = true;
+    }
   }
 }
 

@@ -392,6 +392,7 @@ void RenderSession::upload_constants(const Scene& scene) {
   frame.lights.x = float(light_selection_.p_env);
   frame.lights.y = float(light_selection_.p_continue_own);
   frame.lights.z = float(light_selection_.surface_light_samples);
+  frame.lights.w = light_selection_.ratio_tracked_continuation ? 1.0f : 0.0f;
   frame_buffer_.upload(ctx_, &frame, sizeof frame);
   if (!now.media.empty()) media_buffer_.upload(ctx_, now.media.data(), now.media.size() * sizeof(gpu::GpuMedium));
   if (!now.grids.empty()) grid_buffer_.upload(ctx_, now.grids.data(), now.grids.size() * sizeof(gpu::GpuGrid));

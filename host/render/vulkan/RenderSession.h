@@ -54,9 +54,12 @@ class RenderSession {
   // Next-event estimation is on: every vertex sends a light ray too.
   bool next_event_estimation() const { return light_selection_.strategy != LightStrategy::Bsdf; }
   // Rays a vertex may send: its continuation, and with next-event estimation
-  // up to surface_light_samples light rays (VulkanRenderer::spp_per_pass).
+  // up to surface_light_samples light rays and the ratio-tracked
+  // continuation's ray (VulkanRenderer::spp_per_pass).
   int rays_per_vertex() const {
-    return next_event_estimation() ? 1 + light_selection_.surface_light_samples : 1;
+    return next_event_estimation()
+               ? 1 + light_selection_.surface_light_samples + (light_selection_.ratio_tracked_continuation ? 1 : 0)
+               : 1;
   }
   uint64_t dropped_samples() const { return dropped_samples_; }
   int width() const { return settings_.width; }
