@@ -19,6 +19,11 @@
 // environment, background 1 and max_depth 0 is 0 there) and whose camera ray
 // meets no medium before it (a render with the media as pure absorbers, no
 // surfaces, background 1 is 1 there): both to within 1e-3 at mask-spp.
+// BENCH_MIS_MAPS=DIR also renders each strategy once more (seed 7) and writes
+// DIR/sd_{mis,bsdf}.png (per-pixel standard deviation of one sample, terrain
+// tinted blue) and DIR/var_{mis,bsdf}.f32 (raw float32, width × height × 3:
+// per-sample variance averaged over the channels, mean, terrain mask), for
+// finding the pixels that hold the variance.
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -28,6 +33,7 @@
 #include <vector>
 
 #include <filesystem>
+#include <fstream>
 
 #include <unistd.h>
 
@@ -138,6 +144,16 @@ int main(int argc, char** argv) try {
         const double m = r.sum[i] / r.spp;
         img.rgb[i] = float(std::sqrt(std::max(0.0, (r.sum_sq[i] - r.spp * m * m) / (r.spp - 1))));
       }
+      // Raw float32 figures for analysis (width × height × 3): per-sample variance (channel mean), mean, terrain mask.
+      Image raw = make_image(o.width, o.height);
+      for (size_t p = 0; p < pixels; ++p)
+        for (int c = 0; c < 3; ++c) {
+          raw.rgb[p * 3] += img.rgb[p * 3 + c] * img.rgb[p * 3 + c] / 3.0f;
+          raw.rgb[p * 3 + 1] += float(r.sum[p * 3 + c] / r.spp / 3.0);
+        }
+      for (size_t p : terrain) raw.rgb[p * 3 + 2] = 1.0f;
+      std::ofstream(std::string(maps) + (mis ? "/var_mis.f32" : "/var_bsdf.f32"), std::ios::binary)
+          .write(reinterpret_cast<const char*>(raw.rgb.data()), std::streamsize(raw.rgb.size() * sizeof(float)));
       for (size_t p : terrain) img.rgb[p * 3 + 2] += 0.05f;
       write_image(std::string(maps) + (mis ? "/sd_mis.png" : "/sd_bsdf.png"), img);
     }
