@@ -309,6 +309,10 @@ float majorant_at(vec3 o, vec3 d, float t, vec2 span[MEDIA_N], out float t_next,
   return sigma_bar;
 }
 
+// Below this running transmittance estimate, ratio tracking plays Russian
+// roulette (transmittance() and light rays).
+const float RATIO_TRACKING_ROULETTE_BELOW = 0.1;
+
 // Transmittance along a ray to infinity, per channel. Ratio tracking (Novák et
 // al. 2014): multiply by the null fraction sigma_n/sigma_bar at every tentative
 // collision, with Russian roulette once the estimate is small. Delta tracking
@@ -335,7 +339,7 @@ vec3 transmittance(vec3 o, vec3 d, bool ratio, inout uint rng, inout PathStats s
     if (ratio) {
       T *= sigma_n / sigma_bar;
       float q = max3(T);
-      if (q < 0.1) {  // Russian roulette: survive with probability q, reweight by 1/q
+      if (q < RATIO_TRACKING_ROULETTE_BELOW) {  // Russian roulette: survive with probability q, reweight by 1/q
         if (rng_next(rng) >= q) return vec3(0.0);
         T /= q;
       }
@@ -430,10 +434,12 @@ struct PathState {
   bool has_hit;     // a surface lies ahead on the current ray
   SurfaceHit hit;   // the closest one (t = its distance)
   // Next-event estimation runs as a light ray in this same state: it collects
-  // what arrives along the light direction until its first real event
-  // (weight w = path weight · f · MIS weight / p_light), then the path goes on
-  // with the continuation sampled at the vertex (next_*), one tracking step
-  // per loop iteration like any other ray (LAVAPIPE.md: divergence).
+  // what arrives along the light direction by ratio tracking until it leaves
+  // the scene, hits a surface or loses the roulette (weight w = path weight ·
+  // f · MIS weight / p_light), then the path goes on
+  // with the continuation sampled at the vertex (next_*), one ray segment
+  // (free flights up to its event) per path_step like any other ray
+  // (LAVAPIPE.md: divergence).
   bool light_ray;
   float light_T;  // a light ray's ratio-tracking transmittance (max channel) since its last roulette
   // Ratio-tracked continuation (docs/mis.md): 1 while the surface vertex's
@@ -706,21 +712,22 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     p.t += dt;
     x = p.o + p.t * p.d;
     coefficients_at(x, p.t, span, sigma_a, sigma_s, rho, stats);
-    if (HAS_EMISSION && COLLISION_ESTIMATOR) {
+    if (HAS_EMISSION && COLLISION_ESTIMATOR && !p.skip_segment) {
       // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.
-      // With next-event estimation the ray's own MIS weight (light rays: 1).
+      // With next-event estimation the ray's own MIS weight (light rays: 1). A skipped
+      // segment (ratio-tracked continuation) was already collected: no lookup.
       vec3 e = emission_at(x, p.t, span, rho);
-      if (max3(e) > 0.0 && !p.skip_segment) p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_bar) * p.w * e;
+      if (max3(e) > 0.0) p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_bar) * p.w * e;
     }
     vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
     if (NEE && p.light_ray) {
       // Light rays: ratio tracking (docs/mis.md "Light rays"): no event is
       // chosen, the weight takes the null fraction, Russian roulette once the
-      // ray's transmittance estimate is below 0.1.
+      // ray's transmittance estimate is below RATIO_TRACKING_ROULETTE_BELOW.
       const vec3 null_fraction = sigma_n / sigma_bar;
       p.w *= null_fraction;
       p.light_T *= max3(null_fraction);
-      if (p.light_T < 0.1) {
+      if (p.light_T < RATIO_TRACKING_ROULETTE_BELOW) {
         if (rng_next(rng) >= p.light_T) {
           event = EVENT_END;
           break;

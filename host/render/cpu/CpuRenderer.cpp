@@ -300,8 +300,9 @@ bool continue_from(const WalkScene& ws, const glm::dvec3& o, Lobe& lobe, Own sam
 // I(y, ω) = ∫ T σa Le dt + T(∞) L_env by ratio tracking instead (Novák et al.
 // 2014, with the collision estimator's terms): no event is chosen at a
 // tentative collision, β is multiplied by its expectation there, the null
-// fraction 1 − σt/σ̄, and Russian roulette ends the ray once β < 0.1
-// (survive with probability β, then β = 1). E[Σ_k β_k σa Le(x_k)/σ̄] is the
+// fraction 1 − σt/σ̄, and Russian roulette ends the ray once
+// β < kRatioTrackingRouletteBelow (survive with probability β, then β = 1), as
+// in ratio_tracking_transmittance (Transmittance.h). E[Σ_k β_k σa Le(x_k)/σ̄] is the
 // same integral as delta tracking's, without the noise of where the first
 // real event falls (docs/mis.md "Light rays").
 double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
@@ -346,7 +347,7 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
         if (collision_estimator && sigma_a > 0.0) L += beta * w_ray * emitted_at(md, c, x, s) / sigma_maj;
         if (role == WalkRole::LightRay) {
           beta *= std::max(0.0, 1.0 - (sigma_a + sigma_s) / sigma_maj);
-          if (beta < 0.1) {
+          if (beta < kRatioTrackingRouletteBelow) {
             if (!(rng.uniform() < beta)) return L;
             beta = 1.0;
           }
