@@ -1,7 +1,8 @@
 #pragma once
-// Small VDB files for tests, written with the OpenVDB API, scenes around them,
-// and closed forms for the constant-box grid (header-only; shared by the CPU
-// reference tests and the GPU tests).
+// Small VDB files for tests, scenes around them, and closed forms for the
+// constant-box grid (shared by the CPU reference tests and the GPU tests). The
+// files are written with the OpenVDB API in VdbScenes.cpp, compiled once into
+// pyrolume_test_support: OpenVDB's templates cost ~11 s per translation unit.
 //
 // Conventions (docs/volumes.md, host/volume/VdbLoader.cpp): a `Lattice` maps
 // voxel index ijk to world  offset + voxel · ijk  (OpenVDB's linear transform:
@@ -24,8 +25,6 @@
 #include <vector>
 
 #include <glm/glm.hpp>
-#include <openvdb/io/File.h>
-#include <openvdb/openvdb.h>
 
 #include "scene/Scene.h"
 #include "support/AnalyticScenes.h"
@@ -70,47 +69,39 @@ inline Bounds support_box(const Lattice& l, const VoxelBox& b) {
 
 // ------------------------------------------------------------- writing ----
 
-inline void ensure_openvdb() {
-  static const bool once = [] {
-    openvdb::initialize();
-    return true;
-  }();
-  (void)once;
-}
-
 using VoxelFn = std::function<float(int i, int j, int k)>;
 
-// A float grid with every voxel of `box` active and set to value(i, j, k)
-// (zeros included, so the active bbox is exactly `box`). NaN/Inf are written
-// as they are (the loader must turn them into 0).
-inline openvdb::FloatGrid::Ptr make_float_grid(const std::string& name, const Lattice& l, const VoxelBox& box,
-                                               const VoxelFn& value) {
-  ensure_openvdb();
-  auto g = openvdb::FloatGrid::create(0.0f);
-  g->setName(name);
-  auto xf = openvdb::math::Transform::createLinearTransform(l.voxel);
-  xf->postTranslate(openvdb::Vec3d(l.offset.x, l.offset.y, l.offset.z));
-  g->setTransform(xf);
-  g->setGridClass(openvdb::GRID_FOG_VOLUME);
-  auto acc = g->getAccessor();
-  for (int k = box.lo.z; k <= box.hi.z; ++k)
-    for (int j = box.lo.y; j <= box.hi.y; ++j)
-      for (int i = box.lo.x; i <= box.hi.x; ++i) acc.setValueOn(openvdb::Coord(i, j, k), value(i, j, k));
-  return g;
+// A float grid to write: every voxel of `box` active and set to value(i, j, k)
+// (zeros included, so the active bbox is exactly `box`), grid class fog
+// volume. NaN/Inf are written as they are (the loader must turn them into 0).
+// value is called by write_vdb, within the statement that writes the file.
+struct FloatGridSpec {
+  std::string name;
+  Lattice lattice;
+  VoxelBox box;
+  VoxelFn value;
+};
+
+inline FloatGridSpec make_float_grid(const std::string& name, const Lattice& l, const VoxelBox& box,
+                                     const VoxelFn& value) {
+  return FloatGridSpec{name, l, box, value};
 }
 
 // A grid with no active voxels at all.
-inline openvdb::FloatGrid::Ptr make_empty_grid(const std::string& name, const Lattice& l = {}) {
+inline FloatGridSpec make_empty_grid(const std::string& name, const Lattice& l = {}) {
   return make_float_grid(name, l, VoxelBox{{0, 0, 0}, {-1, -1, -1}}, [](int, int, int) { return 0.0f; });
 }
 
-inline std::filesystem::path write_vdb(const std::filesystem::path& file, const openvdb::GridPtrVec& grids) {
-  ensure_openvdb();
-  openvdb::io::File f(file.string());
-  f.write(grids);
-  f.close();
-  return file;
-}
+// Writes the grids, in order, to one .vdb file; returns `file`.
+std::filesystem::path write_vdb(const std::filesystem::path& file, const std::vector<FloatGridSpec>& grids);
+
+// "density" with two active voxels of value 1, at index (0, 0, 0) and at
+// `far`, on OpenVDB's default unit transform: a tiny sparse grid whose dense
+// box spans far + 1 voxels per axis.
+std::filesystem::path write_two_voxels_vdb(const std::filesystem::path& file, const glm::ivec3& far);
+
+// Converts every grid of a .vdb file to one .nvdb file (NanoVDB, uncompressed).
+void write_nanovdb_copy(const std::filesystem::path& vdb, const std::filesystem::path& nvdb);
 
 // A second grid for emission, on its own lattice (voxel size and offset may
 // differ from the density's).
@@ -125,7 +116,7 @@ struct TemperatureBox {
 inline std::filesystem::path write_constant_box_vdb(const std::filesystem::path& file, const Lattice& l,
                                                     const VoxelBox& box, float c,
                                                     const std::optional<TemperatureBox>& temperature = {}) {
-  openvdb::GridPtrVec grids{make_float_grid("density", l, box, [c](int, int, int) { return c; })};
+  std::vector<FloatGridSpec> grids{make_float_grid("density", l, box, [c](int, int, int) { return c; })};
   if (temperature)
     grids.push_back(make_float_grid(temperature->name, temperature->lattice, temperature->box,
                                     [v = temperature->value](int, int, int) { return v; }));
@@ -159,33 +150,10 @@ inline std::filesystem::path write_empty_vdb(const std::filesystem::path& file) 
 // while the dense box is mostly empty) with a hot inner rim ("temperature" in
 // kelvin, from t_outer_k at the outer surface to t_inner_k at the inner one),
 // centred on the lattice origin. Radii in voxels.
-inline std::filesystem::path write_explosion_shell_vdb(const std::filesystem::path& file, const Lattice& l,
-                                                       double r_inner = 9.0, double r_outer = 14.0,
-                                                       float peak_density = 1.0f, float t_inner_k = 3000.0f,
-                                                       float t_outer_k = 600.0f) {
-  ensure_openvdb();
-  auto make = [&](const std::string& name, bool temperature) {
-    auto g = openvdb::FloatGrid::create(0.0f);
-    g->setName(name);
-    auto xf = openvdb::math::Transform::createLinearTransform(l.voxel);
-    xf->postTranslate(openvdb::Vec3d(l.offset.x, l.offset.y, l.offset.z));
-    g->setTransform(xf);
-    auto acc = g->getAccessor();
-    const int R = int(std::ceil(r_outer));
-    for (int k = -R; k <= R; ++k)
-      for (int j = -R; j <= R; ++j)
-        for (int i = -R; i <= R; ++i) {
-          const double r = std::sqrt(double(i * i + j * j + k * k));
-          if (r < r_inner || r > r_outer) continue;
-          const double s = (r - r_inner) / (r_outer - r_inner);  // 0 inner .. 1 outer
-          const float v = temperature ? float(t_inner_k + (t_outer_k - t_inner_k) * s)
-                                      : float(peak_density * std::sin(3.14159265358979 * s));
-          acc.setValueOn(openvdb::Coord(i, j, k), v);
-        }
-    return g;
-  };
-  return write_vdb(file, {make("density", false), make("temperature", true)});
-}
+std::filesystem::path write_explosion_shell_vdb(const std::filesystem::path& file, const Lattice& l,
+                                                double r_inner = 9.0, double r_outer = 14.0,
+                                                float peak_density = 1.0f, float t_inner_k = 3000.0f,
+                                                float t_outer_k = 600.0f);
 
 // -------------------------------------------------------------- scenes ----
 

@@ -10,17 +10,6 @@
 namespace pyrolume {
 namespace {
 
-// Two active voxels, at the origin and at `far`: a tiny sparse grid whose
-// dense box spans far + 1 voxels per axis (+ 2 padding texels).
-std::filesystem::path write_two_voxels(const std::filesystem::path& file, openvdb::Coord far) {
-  test::ensure_openvdb();
-  auto g = openvdb::FloatGrid::create(0.0f);
-  g->setName("density");
-  g->tree().setValueOn(openvdb::Coord(0, 0, 0), 1.0f);
-  g->tree().setValueOn(far, 1.0f);
-  return test::write_vdb(file, {g});
-}
-
 std::string load_error(const Medium& m, const DenseLimits& limits) {
   try {
     load_volume(m, false, limits);
@@ -33,7 +22,7 @@ std::string load_error(const Medium& m, const DenseLimits& limits) {
 TEST(VolumeLimits, GridPastTheDeviceDimensionIsRefusedBeforeAllocating) {
   auto dir = test::temp_dir("vol-limits");
   // 4503 × 5 × 5 texels: past 4096 along x.
-  const auto file = write_two_voxels(dir / "wide.vdb", openvdb::Coord(4500, 2, 2));
+  const auto file = test::write_two_voxels_vdb(dir / "wide.vdb", {4500, 2, 2});
   Medium m = test::vdb_medium("wide", file, {1, 1, 1}, {0, 0, 0});
   const std::string err = load_error(m, DenseLimits{4096, 0});
   EXPECT_NE(err.find(file.string() + ": "), std::string::npos) << err;
@@ -51,7 +40,7 @@ TEST(VolumeLimits, GridPastTheDeviceDimensionIsRefusedBeforeAllocating) {
 
 TEST(VolumeLimits, GridPastTheAllocationLimitIsRefused) {
   auto dir = test::temp_dir("vol-bytes");
-  const auto file = write_two_voxels(dir / "cube.vdb", openvdb::Coord(199, 199, 199));  // 202³ texels
+  const auto file = test::write_two_voxels_vdb(dir / "cube.vdb", {199, 199, 199});  // 202³ texels
   Medium m = test::vdb_medium("cube", file, {1, 1, 1}, {0, 0, 0});
   const std::string err = load_error(m, DenseLimits{0, uint64_t(1) << 20});  // 1 MiB
   EXPECT_NE(err.find("202x202x202 texels (with downsample 1) exceed what this device allows in one allocation (1 MiB"),

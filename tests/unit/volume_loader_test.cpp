@@ -7,13 +7,12 @@
 #include <sstream>
 
 #include <glm/gtc/matrix_transform.hpp>
-#include <nanovdb/util/IO.h>
-#include <nanovdb/util/OpenToNanoVDB.h>
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
 
 #include "support/TestSupport.h"
+#include "support/VdbScenes.h"
 #include "util/Error.h"
 #include "volume/VdbInfo.h"
 #include "volume/VdbLoader.h"
@@ -426,13 +425,8 @@ TEST_F(VolumeLoader, MediumTransformGoesOnTopOfTheGridMap) {
 
 TEST_F(VolumeLoader, NanoVdbLoadsToTheSameTexturesAsOpenVdb) {
   const fs::path vdb = write_mismatched_pair();
-  openvdb::io::File f(vdb.string());
-  f.open(false);
-  std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> handles;
-  for (const char* name : {"density", "temperature"})
-    handles.push_back(nanovdb::openToNanoVDB(f.readGrid(name)));
   const fs::path nvdb = dir / "pair.nvdb";
-  nanovdb::io::writeGrids<nanovdb::HostBuffer, std::vector>(nvdb.string(), handles);
+  test::write_nanovdb_copy(vdb, nvdb);  // both grids, density and temperature
 
   Medium mv = vdb_medium(vdb), mn = vdb_medium(nvdb);
   mv.transform.translate = mn.transform.translate = {0.5, 1, 2};

@@ -112,12 +112,7 @@ TEST(CliLimitsVulkan, AccumulationLargerThanTheDeviceAllowsIsBadInput) {
 // before its dense array exists, naming the grid and the downsample that fits.
 TEST(CliLimitsVulkan, GridPastTheDevicesTextureLimitIsBadInput) {
   auto dir = temp_dir("cli-wide");
-  ensure_openvdb();
-  auto g = openvdb::FloatGrid::create(0.0f);
-  g->setName("density");
-  g->tree().setValueOn(openvdb::Coord(0, 0, 0), 1.0f);
-  g->tree().setValueOn(openvdb::Coord(20000, 1, 1), 1.0f);  // past any GPU's 3D limit (16384 at most today)
-  write_vdb(dir / "wide.vdb", {g});
+  write_two_voxels_vdb(dir / "wide.vdb", {20000, 1, 1});  // past any GPU's 3D limit (16384 at most today)
   write_file(dir / "s.json", R"({"film": {"width": 4, "height": 4, "spp": 1},
     "media": [{"name": "wide", "type": "vdb", "file": "wide.vdb", "sigma_a": [1, 1, 1], "sigma_s": [0, 0, 0]}]})");
   CliResult r = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "o.exr"));

@@ -1,0 +1,101 @@
+// The OpenVDB (and NanoVDB) writing half of VdbScenes.h, in one translation
+// unit so that the tests which only need small .vdb files do not instantiate
+// OpenVDB's tree templates each (openToNanoVDB alone is ~37 s of g++).
+#include "support/VdbScenes.h"
+
+#include <nanovdb/util/IO.h>
+#include <nanovdb/util/OpenToNanoVDB.h>
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+
+namespace pyrolume::test {
+namespace {
+
+void ensure_openvdb() {
+  static const bool once = [] {
+    openvdb::initialize();
+    return true;
+  }();
+  (void)once;
+}
+
+openvdb::math::Transform::Ptr lattice_transform(const Lattice& l) {
+  auto xf = openvdb::math::Transform::createLinearTransform(l.voxel);
+  xf->postTranslate(openvdb::Vec3d(l.offset.x, l.offset.y, l.offset.z));
+  return xf;
+}
+
+openvdb::FloatGrid::Ptr build(const FloatGridSpec& spec) {
+  auto g = openvdb::FloatGrid::create(0.0f);
+  g->setName(spec.name);
+  g->setTransform(lattice_transform(spec.lattice));
+  g->setGridClass(openvdb::GRID_FOG_VOLUME);
+  auto acc = g->getAccessor();
+  const VoxelBox& box = spec.box;
+  for (int k = box.lo.z; k <= box.hi.z; ++k)
+    for (int j = box.lo.y; j <= box.hi.y; ++j)
+      for (int i = box.lo.x; i <= box.hi.x; ++i) acc.setValueOn(openvdb::Coord(i, j, k), spec.value(i, j, k));
+  return g;
+}
+
+std::filesystem::path write_grids(const std::filesystem::path& file, const openvdb::GridPtrVec& grids) {
+  openvdb::io::File f(file.string());
+  f.write(grids);
+  f.close();
+  return file;
+}
+
+}  // namespace
+
+std::filesystem::path write_vdb(const std::filesystem::path& file, const std::vector<FloatGridSpec>& grids) {
+  ensure_openvdb();
+  openvdb::GridPtrVec out;
+  for (const FloatGridSpec& spec : grids) out.push_back(build(spec));
+  return write_grids(file, out);
+}
+
+std::filesystem::path write_two_voxels_vdb(const std::filesystem::path& file, const glm::ivec3& far) {
+  ensure_openvdb();
+  auto g = openvdb::FloatGrid::create(0.0f);
+  g->setName("density");
+  g->tree().setValueOn(openvdb::Coord(0, 0, 0), 1.0f);
+  g->tree().setValueOn(openvdb::Coord(far.x, far.y, far.z), 1.0f);
+  return write_grids(file, {g});
+}
+
+void write_nanovdb_copy(const std::filesystem::path& vdb, const std::filesystem::path& nvdb) {
+  ensure_openvdb();
+  openvdb::io::File f(vdb.string());
+  f.open(false);
+  std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> handles;
+  for (auto it = f.beginName(); it != f.endName(); ++it) handles.push_back(nanovdb::openToNanoVDB(f.readGrid(*it)));
+  f.close();
+  nanovdb::io::writeGrids<nanovdb::HostBuffer, std::vector>(nvdb.string(), handles);
+}
+
+std::filesystem::path write_explosion_shell_vdb(const std::filesystem::path& file, const Lattice& l, double r_inner,
+                                                double r_outer, float peak_density, float t_inner_k,
+                                                float t_outer_k) {
+  ensure_openvdb();
+  auto make = [&](const std::string& name, bool temperature) {
+    auto g = openvdb::FloatGrid::create(0.0f);
+    g->setName(name);
+    g->setTransform(lattice_transform(l));
+    auto acc = g->getAccessor();
+    const int R = int(std::ceil(r_outer));
+    for (int k = -R; k <= R; ++k)
+      for (int j = -R; j <= R; ++j)
+        for (int i = -R; i <= R; ++i) {
+          const double r = std::sqrt(double(i * i + j * j + k * k));
+          if (r < r_inner || r > r_outer) continue;
+          const double s = (r - r_inner) / (r_outer - r_inner);  // 0 inner .. 1 outer
+          const float v = temperature ? float(t_inner_k + (t_outer_k - t_inner_k) * s)
+                                      : float(peak_density * std::sin(3.14159265358979 * s));
+          acc.setValueOn(openvdb::Coord(i, j, k), v);
+        }
+    return g;
+  };
+  return write_grids(file, {make("density", false), make("temperature", true)});
+}
+
+}  // namespace pyrolume::test
