@@ -436,10 +436,9 @@ struct PathState {
   // Next-event estimation runs as a light ray in this same state: it collects
   // what arrives along the light direction by ratio tracking until it leaves
   // the scene, hits a surface or loses the roulette (weight w = path weight ·
-  // f · MIS weight / p_light), then the path goes on
-  // with the continuation sampled at the vertex (next_*), one ray segment
-  // (free flights up to its event) per path_step like any other ray
-  // (LAVAPIPE.md: divergence).
+  // f · MIS weight / p_light), then the path goes on with the continuation
+  // sampled at the vertex (next_*), one ray segment (free flights up to its
+  // event) per path_step like any other ray (LAVAPIPE.md: divergence).
   bool light_ray;
   float light_T;  // a light ray's ratio-tracking transmittance (max channel) since its last roulette
   // Ratio-tracked continuation (docs/mis.md): 1 while the surface vertex's
