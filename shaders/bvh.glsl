@@ -97,56 +97,74 @@ vec3 bvh_safe_inverse(vec3 d) {
   return 1.0 / mix(s, d, greaterThan(abs(d), vec3(1e-30)));
 }
 
-bool bvh_hits_box(GpuBvhNode n, vec3 o, vec3 inv_d, float t_max) {
-  vec3 ta = (n.bounds_min.xyz - o) * inv_d, tb = (n.bounds_max.xyz - o) * inv_d;
-  vec3 tmin = min(ta, tb), tmax = max(ta, tb);
-  float t0 = max(max(tmin.x, tmin.y), max(tmin.z, 0.0));
-  // Widened by 1 + 2γ(3) so float rounding never drops a box whose triangle is
-  // hit (pbrt-v4 Bounds3::IntersectP).
-  float t1 = min(min(tmax.x, tmax.y), min(tmax.z, t_max)) * 1.0000004;
-  return t0 <= t1;
-}
-
 // Closest triangle with 0 < t < t_max; on success overwrites `hit`.
-// any_hit = true returns at the first triangle found (shadow rays).
+// any_hit = true stops at the first triangle found (shadow rays).
+//
+// Each node holds its two children's boxes (GpuBvhNode): one iteration tests
+// both, runs the triangles of the hit leaf children (one loop for both, so
+// the triangle test is one copy of code), descends into the nearer interior
+// child and pushes the other with its entry distance; a popped entry that
+// lies beyond the closest hit found since is skipped. llvmpipe runs every
+// iteration for the whole SIMD group, so iterations are what cost: this
+// visits half the nodes of a one-box-per-node traversal. No return inside
+// the loop (docs/mis.md: llvmpipe lost returns from inside loops).
 bool bvh_traverse(vec3 o, vec3 d, float t_max, bool any_hit, inout SurfaceHit hit) {
   TriangleRay r = make_triangle_ray(o, d);
   vec3 inv_d = bvh_safe_inverse(d);
-  bvec3 neg = lessThan(d, vec3(0.0));
   // The builder caps the leaf depth at BVH_STACK_SIZE − 1 and each level
   // pushes at most one node, so the stack cannot overflow.
-  uint stack[BVH_STACK_SIZE];
+  uint stack_node[BVH_STACK_SIZE];
+  float stack_t[BVH_STACK_SIZE];
   uint sp = 0u, node = 0u;
   float t_closest = t_max;
   bool found = false;
   for (;;) {
     GpuBvhNode n = bvh_nodes[node];
-    if (bvh_hits_box(n, o, inv_d, t_closest)) {
-      if (n.info.z == BVH_LEAF) {
-        for (uint i = n.info.x; i < n.info.x + n.info.y; ++i) {
-          float t;
-          vec2 bary;
-          if (intersect_triangle(r, i, t_closest, t, bary)) {
-            t_closest = t;
-            found = true;
-            hit.t = t;
-            hit.kind = SURFACE_HIT_TRIANGLE;
-            hit.primitive = i;
-            hit.bary = bary;
-            if (any_hit) return true;
-          }
-        }
-        if (sp == 0u) break;
-        node = stack[--sp];
-      } else {
-        // Near child first: the one on the ray's side of the split plane.
-        bool far_first = neg[n.info.z];
-        stack[sp++] = far_first ? node + 1u : n.info.x;
-        node = far_first ? n.info.x : node + 1u;
+    // Slab test of both boxes; the exit distance widened by 1 + 2γ(3) so float
+    // rounding never drops a box whose triangle is hit (pbrt-v4 Bounds3::IntersectP).
+    vec4 tx = (n.x - o.x) * inv_d.x, ty = (n.y - o.y) * inv_d.y, tz = (n.z - o.z) * inv_d.z;
+    vec2 t_in = max(max(min(tx.xy, tx.zw), min(ty.xy, ty.zw)), max(min(tz.xy, tz.zw), vec2(0.0)));
+    vec2 t_out = min(min(max(tx.xy, tx.zw), max(ty.xy, ty.zw)), min(max(tz.xy, tz.zw), vec2(t_closest))) * 1.0000004;
+    bvec2 enter = lessThanEqual(t_in, t_out);
+    uvec4 c = n.children;
+    // The hit leaf children's triangles: child 0's, then child 1's.
+    uint count0 = enter.x && c.z != BVH_INTERIOR_CHILD ? c.z : 0u;
+    uint count1 = enter.y && c.w != BVH_INTERIOR_CHILD ? c.w : 0u;
+    for (uint k = 0u; k < count0 + count1; ++k) {
+      uint i = k < count0 ? c.x + k : c.y + (k - count0);
+      float t;
+      vec2 bary;
+      if (intersect_triangle(r, i, t_closest, t, bary)) {
+        t_closest = t;
+        found = true;
+        hit.t = t;
+        hit.kind = SURFACE_HIT_TRIANGLE;
+        hit.primitive = i;
+        hit.bary = bary;
+        if (any_hit) break;
       }
+    }
+    if (any_hit && found) break;
+    // Interior children still in reach (a leaf's hit may have moved t_closest).
+    float t_reach = t_closest * 1.0000004;
+    bool in0 = enter.x && c.z == BVH_INTERIOR_CHILD && t_in.x <= t_reach;
+    bool in1 = enter.y && c.w == BVH_INTERIOR_CHILD && t_in.y <= t_reach;
+    if (in0 && in1) {
+      bool near1 = t_in.y < t_in.x;
+      stack_node[sp] = near1 ? c.x : c.y;
+      stack_t[sp] = near1 ? t_in.x : t_in.y;
+      ++sp;
+      node = near1 ? c.y : c.x;
+    } else if (in0 || in1) {
+      node = in0 ? c.x : c.y;
     } else {
-      if (sp == 0u) break;
-      node = stack[--sp];
+      bool popped = false;
+      while (sp > 0u && !popped) {
+        --sp;
+        popped = stack_t[sp] <= t_closest * 1.0000004;
+        node = stack_node[sp];
+      }
+      if (!popped) break;
     }
   }
   return found;

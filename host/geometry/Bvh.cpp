@@ -61,7 +61,7 @@ class Builder {
   void run(Bvh& bvh) {
     if (index_.empty()) {  // the empty BVH: one leaf without triangles
       BvhNode leaf;
-      leaf.axis = gpu::BVH_LEAF;
+      leaf.axis = BvhNode::kLeaf;
       nodes_.push_back(leaf);
     } else {
       build(0, uint32_t(index_.size()), 0);
@@ -94,7 +94,7 @@ class Builder {
     auto make_leaf = [&] {
       nodes_[node].offset = begin;
       nodes_[node].count = n;
-      nodes_[node].axis = gpu::BVH_LEAF;
+      nodes_[node].axis = BvhNode::kLeaf;
       return node;
     };
     // Depth kMaxDepth only ever holds ≤ max_leaf_size triangles (capacity()).

@@ -1,9 +1,9 @@
 #pragma once
 // A bounding volume hierarchy over triangles: binned SAH build (Wald 2007, "On
 // fast Construction of SAH-based Bounding Volume Hierarchies"), flattened in
-// depth-first order exactly as the GPU reads it (GpuBvhNode in
-// shaders/shared/geometry_types.h), and a stack traversal for the CPU
-// reference that mirrors shaders/bvh.glsl.
+// depth-first order, and a plain stack traversal for the CPU reference (the
+// GPU reads the same tree with its leaves folded into their parents:
+// pack_gpu_nodes in Surfaces.h, shaders/bvh.glsl).
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <vector>
@@ -14,11 +14,12 @@
 namespace pyrolume::geometry {
 
 struct BvhNode {
+  static constexpr uint32_t kLeaf = 3;  // `axis` of a leaf
   glm::vec3 bounds_min{0.0f}, bounds_max{0.0f};
   uint32_t offset = 0;  // interior: index of the second child (the first is this + 1); leaf: first triangle
   uint32_t count = 0;   // leaf: triangles (0 only in the empty BVH's root); interior: 0
-  uint32_t axis = 0;    // interior: split axis 0..2; leaf: 3 (= BVH_LEAF)
-  bool is_leaf() const { return axis == 3; }
+  uint32_t axis = 0;    // interior: split axis 0..2; leaf: kLeaf
+  bool is_leaf() const { return axis == kLeaf; }
 };
 
 enum class BvhSplit {

@@ -33,12 +33,39 @@ glm::dvec3 albedo_at(const Surfaces& s, const SurfaceHit& hit) {
 }
 
 std::vector<gpu::GpuBvhNode> pack_gpu_nodes(const Bvh& bvh) {
-  std::vector<gpu::GpuBvhNode> out(bvh.nodes.size());
+  // Interior nodes keep their depth-first order; leaves fold into their parent.
+  std::vector<uint32_t> gpu_index(bvh.nodes.size(), 0u);
+  uint32_t interior = 0;
+  for (size_t i = 0; i < bvh.nodes.size(); ++i)
+    if (!bvh.nodes[i].is_leaf()) gpu_index[i] = interior++;
+  // Child slot k (0, 1) of g: node c's box, and its node index or its triangles.
+  auto set_child = [&](gpu::GpuBvhNode& g, int k, const BvhNode& c) {
+    g.x[k] = c.bounds_min.x;
+    g.y[k] = c.bounds_min.y;
+    g.z[k] = c.bounds_min.z;
+    g.x[2 + k] = c.bounds_max.x;
+    g.y[2 + k] = c.bounds_max.y;
+    g.z[2 + k] = c.bounds_max.z;
+    g.children[k] = c.is_leaf() ? c.offset : gpu_index[size_t(&c - bvh.nodes.data())];
+    g.children[2 + k] = c.is_leaf() ? c.count : gpu::BVH_INTERIOR_CHILD;
+  };
+  if (bvh.nodes.empty() || bvh.nodes[0].is_leaf()) {
+    // A root that is a leaf (or a Bvh never built): its triangles as child 0,
+    // an empty leaf (no triangles to test) as child 1.
+    gpu::GpuBvhNode root{};
+    BvhNode empty;
+    empty.axis = BvhNode::kLeaf;
+    set_child(root, 0, bvh.nodes.empty() ? empty : bvh.nodes[0]);
+    set_child(root, 1, empty);
+    return {root};
+  }
+  std::vector<gpu::GpuBvhNode> out(interior);
   for (size_t i = 0; i < bvh.nodes.size(); ++i) {
     const BvhNode& n = bvh.nodes[i];
-    out[i].bounds_min = glm::vec4(n.bounds_min, 0.0f);
-    out[i].bounds_max = glm::vec4(n.bounds_max, 0.0f);
-    out[i].info = glm::uvec4(n.offset, n.count, n.axis, 0u);
+    if (n.is_leaf()) continue;
+    gpu::GpuBvhNode& g = out[gpu_index[i]];
+    set_child(g, 0, bvh.nodes[i + 1]);
+    set_child(g, 1, bvh.nodes[n.offset]);
   }
   return out;
 }
@@ -60,10 +87,6 @@ gpu::GpuSurfaceShape pack_gpu_shape(const SurfaceShape& s) {
 GpuSurfaces pack_gpu_surfaces(const Surfaces& s) {
   GpuSurfaces g;
   g.nodes = pack_gpu_nodes(s.bvh);
-  if (g.nodes.empty()) {  // a Bvh never built: the empty BVH's single leaf
-    g.nodes.push_back({});
-    g.nodes[0].info = glm::uvec4(0u, 0u, gpu::BVH_LEAF, 0u);
-  }
   g.triangle_count = uint32_t(s.bvh.triangles.size());
   for (const Triangle& t : s.bvh.triangles) {
     gpu::GpuTriangle gt{};

@@ -37,7 +37,7 @@ bool occluded(const Surfaces& surfaces, const Ray& ray, double t_max);
 glm::dvec3 albedo_at(const Surfaces& surfaces, const SurfaceHit& hit);
 
 // The buffers of shaders/bvh.glsl, each at least one element long (Vulkan has
-// no empty buffers): an empty BVH is one leaf with no triangles plus one dummy
+// no empty buffers): an empty BVH is a root with two empty leaves plus one dummy
 // triangle; no shapes gives one dummy shape (SURFACE_SHAPE_COUNT = 0 keeps the
 // shader from reading it); no materials gives one grey material.
 struct GpuSurfaces {

@@ -17,7 +17,9 @@ namespace pyrolume::gpu {
 // leaf depth at BVH_STACK_SIZE - 1 so it can never overflow.
 PYRO_CONST uint BVH_STACK_SIZE = 32;
 PYRO_CONST uint BVH_MAX_LEAF_TRIANGLES = 4;
-PYRO_CONST uint BVH_LEAF = 3;  // GpuBvhNode::info.z of a leaf (interior nodes hold their split axis 0..2)
+// GpuBvhNode::children.z/.w of a child that is an interior node (a leaf child
+// holds its triangle count there, 0..BVH_MAX_LEAF_TRIANGLES).
+PYRO_CONST uint BVH_INTERIOR_CHILD = 0xFFFFFFFFu;
 
 // GpuSurfaceShape::info.x
 PYRO_CONST uint SURFACE_SPHERE = 0;
@@ -30,15 +32,20 @@ PYRO_CONST uint NO_TEXTURE = 0xFFFFFFFFu;
 PYRO_CONST uint TRIANGLE_HAS_NORMALS = 1;
 PYRO_CONST uint TRIANGLE_HAS_UVS = 2;
 
-// One node of the flattened BVH (48 bytes), depth-first order: an interior
-// node's first child is the next node, its second child is at info.x.
+// One interior node of the GPU's BVH (64 bytes), holding the boxes of its two
+// children, so that traversal tests both with one node read and one loop
+// iteration (half the iterations of one box per node: llvmpipe runs each
+// iteration for its whole SIMD group). Rows are (child 0 min, child 1 min,
+// child 0 max, child 1 max) per axis: the slab test of both children is one
+// vec4 expression per axis. Leaves are folded into their parents; node 0 is
+// the root (a BVH that is a single leaf gets a root whose second child is an
+// empty leaf). Depth-first order, so a subtree's nodes sit together.
 struct GpuBvhNode {
-  vec4 bounds_min;  // xyz: the node's box; w: unused
-  vec4 bounds_max;  // xyz; w: unused
-  uvec4 info;       // x: interior: second child; leaf: first triangle
-                    // y: leaf: triangle count (0..BVH_MAX_LEAF_TRIANGLES); interior: 0
-                    // z: interior: split axis 0..2 (near child first by the ray's sign); leaf: BVH_LEAF
-                    // w: unused
+  vec4 x;           // (min0.x, min1.x, max0.x, max1.x)
+  vec4 y;           // (min0.y, min1.y, max0.y, max1.y)
+  vec4 z;           // (min0.z, min1.z, max0.z, max1.z)
+  uvec4 children;   // x, y: child 0, 1: its node index (interior) or first triangle (leaf);
+                    // z, w: child 0, 1: BVH_INTERIOR_CHILD, or the leaf's triangle count
 };
 
 // The positions of one triangle (48 bytes), in BVH order: all traversal reads.
@@ -80,8 +87,8 @@ struct GpuMaterial {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(GpuBvhNode) == 48);
-static_assert(offsetof(GpuBvhNode, info) == 32);
+static_assert(sizeof(GpuBvhNode) == 64);
+static_assert(offsetof(GpuBvhNode, children) == 48);
 static_assert(sizeof(GpuTriangle) == 48);
 static_assert(sizeof(GpuTriangleAttributes) == 96);
 static_assert(offsetof(GpuTriangleAttributes, info) == 80);

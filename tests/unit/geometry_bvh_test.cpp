@@ -199,6 +199,45 @@ TEST(Bvh, ComparisonDetectsABrokenTree) {
   EXPECT_GT(compare_with_brute_force(bvh, rays, t_max).mismatches, 0u);
 }
 
+// pack_gpu_nodes folds the leaves into their parents: each GPU node holds its
+// two children's boxes exactly as the binary tree has them, interior children
+// point at nodes that hold their own children, and every triangle is in
+// exactly one leaf child.
+TEST(Bvh, GpuNodesHoldBothChildrenAndEveryTriangleOnce) {
+  const Bvh bvh = build_bvh(random_soup(3000, 21));
+  const std::vector<gpu::GpuBvhNode> g = pack_gpu_nodes(bvh);
+  size_t interior = 0;
+  for (const BvhNode& n : bvh.nodes) interior += n.is_leaf() ? 0 : 1;
+  ASSERT_EQ(g.size(), interior);
+  std::vector<int> covered(bvh.triangles.size(), 0);
+  // Walk both trees together from their roots.
+  std::vector<std::pair<uint32_t, uint32_t>> todo = {{0u, 0u}};  // (binary node, GPU node)
+  size_t visited = 0;
+  while (!todo.empty()) {
+    const auto [b, k] = todo.back();
+    todo.pop_back();
+    ASSERT_LT(k, g.size());
+    ++visited;
+    const BvhNode& n = bvh.nodes[b];
+    ASSERT_FALSE(n.is_leaf());
+    const uint32_t kids[2] = {b + 1, n.offset};
+    for (int j = 0; j < 2; ++j) {
+      const BvhNode& c = bvh.nodes[kids[j]];
+      EXPECT_EQ(glm::vec3(g[k].x[j], g[k].y[j], g[k].z[j]), c.bounds_min);
+      EXPECT_EQ(glm::vec3(g[k].x[2 + j], g[k].y[2 + j], g[k].z[2 + j]), c.bounds_max);
+      if (c.is_leaf()) {
+        ASSERT_EQ(g[k].children[2 + j], c.count);
+        for (uint32_t i = 0; i < c.count; ++i) ++covered[g[k].children[j] + i];
+      } else {
+        ASSERT_EQ(g[k].children[2 + j], gpu::BVH_INTERIOR_CHILD);
+        todo.push_back({kids[j], g[k].children[j]});
+      }
+    }
+  }
+  EXPECT_EQ(visited, g.size());
+  for (size_t i = 0; i < covered.size(); ++i) ASSERT_EQ(covered[i], 1) << "triangle " << i;
+}
+
 TEST(Bvh, EmptyAndDegenerateInputs) {
   const Bvh empty = build_bvh({});
   ASSERT_EQ(empty.nodes.size(), 1u);
@@ -419,8 +458,8 @@ TEST(Surfaces, ClosestOfTrianglesAndShapesAndAlbedo) {
   EXPECT_FALSE(occluded(s, Ray{{0.5, 0.5, 0}, {0, 0, 1}}, 4.0));
 
   const GpuSurfaces g = pack_gpu_surfaces(s);
-  ASSERT_EQ(g.nodes.size(), s.bvh.nodes.size());
-  EXPECT_EQ(g.nodes[0].info.z, gpu::BVH_LEAF);
+  ASSERT_EQ(g.nodes.size(), 1u);  // the single leaf as the root's child 0, an empty leaf as child 1
+  EXPECT_EQ(g.nodes[0].children, glm::uvec4(0u, 0u, 1u, 0u));
   EXPECT_EQ(g.shape_count, 1u);
   EXPECT_EQ(g.shapes[0].info.x, gpu::SURFACE_SPHERE);
   EXPECT_EQ(g.attributes[0].info.x, 1u);
@@ -429,6 +468,7 @@ TEST(Surfaces, ClosestOfTrianglesAndShapesAndAlbedo) {
   EXPECT_EQ(g.materials[1].info.x, 0u);
   const GpuSurfaces none = pack_gpu_surfaces(Surfaces{});
   EXPECT_EQ(none.nodes.size(), 1u);
+  EXPECT_EQ(none.nodes[0].children, glm::uvec4(0u, 0u, 0u, 0u));  // two empty leaves
   EXPECT_EQ(none.triangles.size(), 1u);  // a dummy: Vulkan buffers cannot be empty
   EXPECT_EQ(none.triangle_count, 0u);
   EXPECT_EQ(none.shape_count, 0u);
