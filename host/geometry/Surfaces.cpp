@@ -38,34 +38,33 @@ std::vector<gpu::GpuBvhNode> pack_gpu_nodes(const Bvh& bvh) {
   uint32_t interior = 0;
   for (size_t i = 0; i < bvh.nodes.size(); ++i)
     if (!bvh.nodes[i].is_leaf()) gpu_index[i] = interior++;
-  // Child slot k (0, 1) of g: node c's box, and its node index or its triangles.
-  auto set_child = [&](gpu::GpuBvhNode& g, int k, const BvhNode& c) {
+  // Child slot k (0, 1) of g: box c, and the GPU node `target` (interior) or c's triangles (leaf).
+  auto set_child = [](gpu::GpuBvhNode& g, int k, const BvhNode& c, uint32_t target) {
     g.x[k] = c.bounds_min.x;
     g.y[k] = c.bounds_min.y;
     g.z[k] = c.bounds_min.z;
     g.x[2 + k] = c.bounds_max.x;
     g.y[2 + k] = c.bounds_max.y;
     g.z[2 + k] = c.bounds_max.z;
-    g.children[k] = c.is_leaf() ? c.offset : gpu_index[size_t(&c - bvh.nodes.data())];
+    g.children[k] = c.is_leaf() ? c.offset : target;
     g.children[2 + k] = c.is_leaf() ? c.count : gpu::BVH_INTERIOR_CHILD;
   };
   if (bvh.nodes.empty() || bvh.nodes[0].is_leaf()) {
     // A root that is a leaf (or a Bvh never built): its triangles as child 0,
     // an empty leaf (no triangles to test) as child 1.
-    gpu::GpuBvhNode root{};
     BvhNode empty;
     empty.axis = BvhNode::kLeaf;
-    set_child(root, 0, bvh.nodes.empty() ? empty : bvh.nodes[0]);
-    set_child(root, 1, empty);
+    gpu::GpuBvhNode root{};
+    set_child(root, 0, bvh.nodes.empty() ? empty : bvh.nodes[0], 0u);
+    set_child(root, 1, empty, 0u);
     return {root};
   }
   std::vector<gpu::GpuBvhNode> out(interior);
   for (size_t i = 0; i < bvh.nodes.size(); ++i) {
-    const BvhNode& n = bvh.nodes[i];
-    if (n.is_leaf()) continue;
-    gpu::GpuBvhNode& g = out[gpu_index[i]];
-    set_child(g, 0, bvh.nodes[i + 1]);
-    set_child(g, 1, bvh.nodes[n.offset]);
+    if (bvh.nodes[i].is_leaf()) continue;
+    const size_t first = i + 1, second = bvh.nodes[i].offset;
+    set_child(out[gpu_index[i]], 0, bvh.nodes[first], gpu_index[first]);
+    set_child(out[gpu_index[i]], 1, bvh.nodes[second], gpu_index[second]);
   }
   return out;
 }
