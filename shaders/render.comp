@@ -364,71 +364,44 @@ void light_norms(vec3 o, out vec4 norm) {
     }
 }
 
-// The light choice seen from vertex o (docs/mis.md "Choosing the light";
-// LightSelection::choice_at on the host): each light's static probability
-// (frame.lights.x, each grid's measure.w) mixed with its estimated irradiance
-// at o over all lights' (light_types.h): the environment's E = ∫ Y(L) dω / 4
-// (transform.w / 4), a grid's E = ∫ w dV (measure.z) · norm. Returns the environment's; p_grid by
-// grid slot. norm: light_norms(o).
-float light_choice(vec4 norm, out vec4 p_grid) {
-  const float a = LIGHT_CHOICE_STATIC_SHARE;
-  const float p_env = HAS_ENVIRONMENT ? frame.lights.x : 0.0;
-  float e_env = p_env > 0.0 ? LIGHT_CHOICE_ENV_IRRADIANCE_PER_POWER * environment.transform.w : 0.0, e_total = e_env;
-  vec4 e = vec4(0.0);
-  p_grid = vec4(0.0);
-  if (HAS_GRIDS && HAS_EMISSION)
-    for (uint s = 0u; s < GRID_COUNT && s < MAX_GRIDS; ++s) {
-      p_grid[s] = emission_lights[s].measure.w;
-      if (p_grid[s] > 0.0) e[s] = emission_lights[s].measure.z * norm[s];
-      e_total += e[s];
-    }
-  if (!(e_total > 0.0) || isinf(e_total)) return p_env;  // nothing to weigh: the static choice
-  p_grid = mix(e / e_total, p_grid, a);
-  return p_env > 0.0 ? mix(e_env / e_total, p_env, a) : 0.0;
-}
-
 // The solid-angle pdf with which next-event estimation at o picks direction
 // d (docs/mis.md): the environment map's, and each emissive grid's pdf of the
 // direction toward a point of its emission CDF seen from o, mixed by the
-// light choice at o. norm: light_norms(o).
+// light choice. norm: light_norms(o).
 float light_direction_pdf(vec3 o, vec4 norm, vec3 d) {
-  vec4 p_grid;
-  const float p_env = light_choice(norm, p_grid);
   float p = 0.0;
-  if (HAS_ENVIRONMENT && p_env > 0.0) p += p_env * env_pdf(environment, d);
+  if (HAS_ENVIRONMENT && frame.lights.x > 0.0) p += frame.lights.x * env_pdf(environment, d);
   if (HAS_GRIDS && HAS_EMISSION)
     for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
       if (uint(media[i].sigma_a.w) != SHAPE_GRID) continue;
-      const uint slot = uint(media[i].bounds0.x);
-      if (p_grid[slot] > 0.0) p += p_grid[slot] * emission_direction_pdf(emission_lights[slot], o, norm[slot], d);
+      GpuEmissionCdf e = emission_lights[uint(media[i].bounds0.x)];
+      if (e.measure.w > 0.0) p += e.measure.w * emission_direction_pdf(e, o, norm[uint(media[i].bounds0.x)], d);
     }
   return p;
 }
 
 // A light direction for next-event estimation from point o: the environment
 // map's, or toward a point drawn from an emissive grid's emission CDF (the
-// light picked by light_choice at o). false: none.
+// light chosen by frame.lights.x and each grid's measure.w). false: none.
 bool sample_light_direction(vec3 o, vec4 norm, inout uint rng, out vec3 dir) {
   dir = vec3(0.0, 0.0, 1.0);
-  vec4 p_grid;
-  const float p_env = light_choice(norm, p_grid);
   float u = rng_next(rng);
   vec2 u2 = vec2(rng_next(rng), rng_next(rng));
   float u_z = rng_next(rng);
-  if (HAS_ENVIRONMENT && u < p_env) {
+  if (HAS_ENVIRONMENT && u < frame.lights.x) {
     EnvSample es = env_sample(environment, u2);
     dir = es.dir;
     return es.pdf > 0.0;
   }
   if (!HAS_GRIDS || !HAS_EMISSION) return false;
-  u -= p_env;
+  u -= frame.lights.x;
   // The grid medium whose light probability covers u.
   // (The last light when rounding leaves u past them all, like the CPU reference.)
   uint pick = MEDIUM_COUNT;
   bool found = false;
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     if (uint(media[i].sigma_a.w) != SHAPE_GRID) continue;
-    float p = p_grid[uint(media[i].bounds0.x)];
+    float p = emission_lights[uint(media[i].bounds0.x)].measure.w;
     if (!(p > 0.0) || found) continue;
     pick = i;
     if (u < p) found = true; else u -= p;

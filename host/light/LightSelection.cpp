@@ -1,6 +1,5 @@
 #include "light/LightSelection.h"
 
-#include <cmath>
 #include <string>
 
 #include "light/EmissionCdf.h"
@@ -13,21 +12,6 @@ bool LightSelection::any() const {
   for (double p : p_medium)
     if (p > 0.0) return true;
   return false;
-}
-
-double LightSelection::choice_at(const std::vector<double>& norm, std::vector<double>& p_medium_at) const {
-  p_medium_at.assign(p_medium.size(), 0.0);
-  double e_total = p_env > 0.0 ? env_irradiance : 0.0;
-  for (size_t j = 0; j < p_medium.size(); ++j)
-    if (p_medium[j] > 0.0) e_total += medium_power[j] * norm[j];
-  if (!(e_total > 0.0) || !std::isfinite(e_total)) {  // nothing to weigh: the static choice
-    p_medium_at = p_medium;
-    return p_env;
-  }
-  const double a = kLightChoiceStaticShare;
-  for (size_t j = 0; j < p_medium.size(); ++j)
-    if (p_medium[j] > 0.0) p_medium_at[j] = a * p_medium[j] + (1.0 - a) * medium_power[j] * norm[j] / e_total;
-  return p_env > 0.0 ? a * p_env + (1.0 - a) * env_irradiance / e_total : 0.0;
 }
 
 namespace {
@@ -48,13 +32,9 @@ LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, cons
     if (c && !c->empty() && c->power() > 0.0) media_power += c->power();
   const double media_share = media_power > 0.0 ? (env_light ? 0.5 : 1.0) : 0.0;
   s.p_env = env_light ? 1.0 - media_share : 0.0;
-  s.env_irradiance = env_light ? double(gpu::LIGHT_CHOICE_ENV_IRRADIANCE_PER_POWER) * env->power() : 0.0;
-  s.medium_power.assign(cdfs.size(), 0.0);
   for (size_t i = 0; i < cdfs.size(); ++i)
-    if (cdfs[i] && !cdfs[i]->empty() && cdfs[i]->power() > 0.0) {
+    if (cdfs[i] && !cdfs[i]->empty() && cdfs[i]->power() > 0.0)
       s.p_medium[i] = media_share * cdfs[i]->power() / media_power;
-      s.medium_power[i] = cdfs[i]->power();
-    }
   const Integrator& in = scene.integrator;
   const bool eligible = in.mis && in.emission_estimator == "collision" && in.max_depth >= 1 && s.any() &&
                         scene_scatters(scene);

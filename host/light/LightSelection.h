@@ -6,7 +6,6 @@
 #include <vector>
 
 #include "scene/Scene.h"
-#include "shared/light_types.h"
 
 namespace pyrolume {
 
@@ -25,24 +24,11 @@ enum class LightStrategy {
 // and 1/4 on terrain_explosion).
 inline constexpr double kContinueOwn = 0.5;
 
-// The share of the static choice (p_env, p_medium below) in the choice
-// between lights seen from a receiver (LightSelection::choice_at): it keeps
-// every light's probability at least this fraction of its static one, so a
-// light the receiver-aware estimate misjudges is still sampled. One value for
-// both renderers (shaders/shared/light_types.h).
-inline constexpr double kLightChoiceStaticShare = double(gpu::LIGHT_CHOICE_STATIC_SHARE);
-
 struct LightSelection {
-  // The static choice: probability that one next-event sample picks the
-  // environment map, and per scene medium its emission CDF (0: not a light).
+  // Probability that one next-event sample picks the environment map.
   double p_env = 0.0;
+  // Per scene medium: probability of picking its emission CDF (0: not a light).
   std::vector<double> p_medium;
-  // What the choice seen from a receiver weighs: the environment's irradiance
-  // on a flat receiver, E_env = ∫ Y(L_env) dω / 4 (EnvironmentMap::power;
-  // LIGHT_CHOICE_ENV_IRRADIANCE_PER_POWER), and per medium its power
-  // Φ_j = ∫ w dV (EmissionCdf::power); 0 where that light is not a light.
-  double env_irradiance = 0.0;
-  std::vector<double> medium_power;
   LightStrategy strategy = LightStrategy::Bsdf;
   // With next-event estimation, the probability that a vertex's continuation
   // is drawn from its own lobe; otherwise from the lights, by the same
@@ -59,15 +45,6 @@ struct LightSelection {
   bool ratio_tracked_continuation = false;
 
   bool any() const;
-  // The choice seen from receiver o (docs/mis.md "Choosing the light"), given
-  // each medium's emission-CDF normaliser norm[j] = EmissionCdf::receiver_norm(o)
-  // (Σ_s Φ_s/Φ_j / max(|o − c_s|², r_s²); 0 where not a light). Each light's
-  // irradiance at o on a flat receiver facing it, ignoring occlusion and
-  // extinction, is estimated as E_env = env_irradiance and
-  // E_j = medium_power[j]·norm[j] (both luminance × solid angle), and
-  //   P(light) = a·P_static(light) + (1 − a)·E_light / Σ E,   a = kLightChoiceStaticShare.
-  // Writes p_medium_at[j] for every medium and returns the environment's.
-  double choice_at(const std::vector<double>& norm, std::vector<double>& p_medium_at) const;
   // The continuation's solid-angle pdf of a direction that the vertex's lobe
   // draws with p_own and the lights with p_light (docs/mis.md eq. 5).
   double continuation_pdf(double p_own, double p_light) const {
@@ -80,11 +57,10 @@ struct LightSelection {
 //
 // Continuation: p_continue_own = kContinueOwn with next-event estimation, 1 without.
 //
-// Static choice between lights: the environment and the emissive media get
-// 1/2 each when both exist (their powers, ∫Y dω and ∫Y(σa Le) dV, have
-// different units, so their ratio means nothing without a distance); among the
-// emissive media, by power ∫ w dV (EmissionCdf::power). The renderers mix it
-// with a receiver-aware choice that supplies the distance (choice_at).
+// Choice between lights: the environment and the emissive media get 1/2 each
+// when both exist (their powers, ∫Y dω and ∫Y(σa Le) dV, have different units,
+// so their ratio means nothing without a distance); among the emissive media,
+// by power ∫ w dV (EmissionCdf::power).
 //
 // Strategy: Mis or LightOnly needs integrator.mis, the collision emission
 // estimator (what the renderers' MIS is written and tested for; docs/mis.md),

@@ -13,17 +13,6 @@
 namespace pyrolume::gpu {
 #endif
 
-// Next-event estimation picks a light with probability
-// a·(its static probability) + (1 − a)·(its estimated irradiance at the
-// receiver / all lights'), a = LIGHT_CHOICE_STATIC_SHARE (docs/mis.md
-// "Choosing the light"; host/light/LightSelection choice_at).
-PYRO_CONST float LIGHT_CHOICE_STATIC_SHARE = 0.2;
-// The irradiance estimates of that choice are those of a flat receiver facing
-// the light: Σ_s Φ_s / d_s² for an emissive grid (a point source per cluster,
-// no extinction), and for the environment π·L̄ = ∫ Y(L) dω / 4, L̄ its mean
-// luminance over the sphere (a uniform sky over the receiver's hemisphere).
-PYRO_CONST float LIGHT_CHOICE_ENV_IRRADIANCE_PER_POWER = 0.25;
-
 // A lat-long environment map (32 bytes). +Z up, Blender's equirectangular
 // convention: map direction (sinθ cosφ, sinθ sinφ, cosθ) with θ = π·v, φ = π − 2π·u,
 // v = 0 the top row. World direction d is looked up at Rz(−rotation)·d.

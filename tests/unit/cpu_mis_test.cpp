@@ -153,53 +153,5 @@ TEST(LightSelection, ProbabilitiesAndStrategies) {
   EXPECT_EQ(light_strategy_warning(s), "");
 }
 
-// The choice seen from a receiver (LightSelection::choice_at): a light's
-// probability is a·(static) + (1 − a)·(its irradiance estimate / all), so the
-// probabilities sum to 1, none falls below a·(static), a receiver close to
-// the fire gives it more than a far one, and a medium that is not a light
-// gets nothing.
-TEST(LightSelection, ChoiceSeenFromTheReceiver) {
-  const auto dir = test::temp_dir("cpu_mis_choice");
-  Scene s = test::fire_over_plane_scene(dir, Strategy::Mis, true, true);
-  const EnvironmentMap env = EnvironmentMap::load(s.environment->file);
-  const StoredVolume vol = load_stored_volume(s.media[0]);
-  const EmissionCdf cdf = EmissionCdf::build_light(s.media[0], vol);
-  ASSERT_TRUE(cdf.is_clustered());
-  const LightSelection l = select_lights(s, &env, {&cdf, nullptr});
-  ASSERT_GT(l.p_env, 0.0);
-  EXPECT_DOUBLE_EQ(l.env_irradiance, double(gpu::LIGHT_CHOICE_ENV_IRRADIANCE_PER_POWER) * env.power());
-  EXPECT_DOUBLE_EQ(l.medium_power[0], cdf.power());
-  EXPECT_DOUBLE_EQ(l.medium_power[1], 0.0);
-  const double a = kLightChoiceStaticShare;
-  const glm::dvec3 centre = cdf.cell_to_world(glm::dvec3(cdf.cells()) * 0.5);
-  double last_fire = 2.0;
-  for (double distance : {0.0, 1.0, 10.0, 100.0, 1e4}) {
-    const glm::dvec3 o = centre + glm::dvec3(0.0, 0.0, -distance);
-    const std::vector<double> norm = {cdf.receiver_norm(o), 0.0};
-    std::vector<double> p_medium;
-    const double p_env = l.choice_at(norm, p_medium);
-    ASSERT_EQ(p_medium.size(), 2u);
-    EXPECT_NEAR(p_env + p_medium[0] + p_medium[1], 1.0, 1e-12) << distance;
-    EXPECT_EQ(p_medium[1], 0.0);
-    EXPECT_GE(p_env, a * l.p_env - 1e-15);
-    EXPECT_GE(p_medium[0], a * l.p_medium[0] - 1e-15);
-    // The irradiance share, exactly: E_j = Φ_j·norm_j against E_env.
-    const double e_fire = cdf.power() * norm[0];
-    EXPECT_NEAR(p_medium[0], a * l.p_medium[0] + (1.0 - a) * e_fire / (e_fire + l.env_irradiance), 1e-12);
-    EXPECT_LT(p_medium[0], last_fire) << "farther from the fire, less of it: " << distance;
-    last_fire = p_medium[0];
-  }
-  // Next to the fire it dominates; far away the environment does.
-  std::vector<double> p_near, p_far;
-  l.choice_at({cdf.receiver_norm(centre), 0.0}, p_near);
-  l.choice_at({cdf.receiver_norm(centre + glm::dvec3(0.0, 0.0, -1e4)), 0.0}, p_far);
-  EXPECT_GT(p_near[0], 0.5 * (1.0 + a * l.p_medium[0]));
-  EXPECT_LT(p_far[0], 1.01 * a * l.p_medium[0]);
-  // Norms of 0 (nothing to weigh): the static choice.
-  std::vector<double> p_static;
-  EXPECT_DOUBLE_EQ(select_lights(s, nullptr, {&cdf}).choice_at({0.0}, p_static), 0.0);
-  EXPECT_DOUBLE_EQ(p_static[0], 1.0);
-}
-
 }  // namespace
 }  // namespace pyrolume

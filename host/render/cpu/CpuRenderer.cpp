@@ -130,29 +130,16 @@ double unidirectional_weight(const WalkLights& lights, const RayMis& mis) {
   return power_heuristic(mis.pdf_dir, mis.p_light);
 }
 
-// The light choice seen from receiver o (LightSelection::choice_at): each
-// emissive medium's receiver normaliser in norm, each one's probability in
-// p_medium; returns the environment's.
-double light_choice(const WalkLights& lights, const glm::dvec3& o, std::vector<double>& norm,
-                    std::vector<double>& p_medium) {
-  norm.assign(lights.cdf.size(), 0.0);
-  for (size_t j = 0; j < lights.cdf.size(); ++j)
-    if (lights.selection.p_medium[j] > 0.0) norm[j] = lights.cdf[j]->receiver_norm(o);
-  return lights.selection.choice_at(norm, p_medium);
-}
-
 // The solid-angle pdf with which next_event at o picks direction d: the
 // environment map's, and for each emissive grid the pdf of the direction
 // toward a point drawn from its emission CDF (EmissionCdf::direction_pdf),
-// mixed by the light choice seen from o.
+// mixed by the light selection probabilities.
 double light_direction_pdf(const WalkScene& ws, const glm::dvec3& o, const glm::dvec3& d) {
   const WalkLights& lights = ws.lights;
-  std::vector<double> norm, p_medium;
-  const double p_env = light_choice(lights, o, norm, p_medium);
   double p = 0.0;
-  if (p_env > 0.0) p += p_env * ws.environment->pdf(d);
+  if (lights.selection.p_env > 0.0) p += lights.selection.p_env * ws.environment->pdf(d);
   for (size_t j = 0; j < lights.cdf.size(); ++j)
-    if (p_medium[j] > 0.0) p += p_medium[j] * lights.cdf[j]->direction_pdf(o, norm[j], d);
+    if (lights.selection.p_medium[j] > 0.0) p += lights.selection.p_medium[j] * lights.cdf[j]->direction_pdf(o, d);
   return p;
 }
 
@@ -173,27 +160,25 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
 // grid's emission CDF and the direction toward it. false: nothing drawn.
 bool light_direction(const WalkScene& ws, const glm::dvec3& o, Pcg32& rng, glm::dvec3& dir) {
   const WalkLights& lights = ws.lights;
-  std::vector<double> norm, p_medium;
-  const double p_env = light_choice(lights, o, norm, p_medium);
   double u = rng.uniform();
   const double u_env = rng.uniform(), v_env = rng.uniform();
   const glm::dvec3 u3(rng.uniform(), rng.uniform(), rng.uniform());
-  if (u < p_env) {
+  if (u < lights.selection.p_env) {
     const EnvSample es = ws.environment->sample({u_env, v_env});
     dir = es.dir;
     return es.pdf > 0.0;
   }
-  u -= p_env;
+  u -= lights.selection.p_env;
   int j = -1;
   for (size_t i = 0; i < lights.cdf.size(); ++i) {
-    const double p = p_medium[i];
+    const double p = lights.selection.p_medium[i];
     if (!(p > 0.0)) continue;
     j = int(i);
     if (u < p) break;
     u -= p;
   }
   if (j < 0) return false;
-  const EmissionSample es = lights.cdf[j]->sample_from(o, norm[size_t(j)], u_env, v_env, u3);
+  const EmissionSample es = lights.cdf[j]->sample_from(o, u_env, v_env, u3);
   if (!(es.pdf > 0.0)) return false;
   const glm::dvec3 v = es.p - o;
   const double r = glm::length(v);
