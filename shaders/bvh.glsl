@@ -161,7 +161,7 @@ bool bvh_traverse(vec3 o, vec3 d, float t_max, bool any_hit, inout SurfaceHit hi
       bool popped = false;
       while (sp > 0u && !popped) {
         --sp;
-        popped = stack_t[sp] <= t_closest * 1.0000004;
+        popped = stack_t[sp] <= t_reach;
         node = stack_node[sp];
       }
       if (!popped) break;
