@@ -312,6 +312,9 @@ float majorant_at(vec3 o, vec3 d, float t, vec2 span[MEDIA_N], out float t_next,
 // Below this running transmittance estimate, ratio tracking plays Russian
 // roulette (transmittance() and light rays).
 const float RATIO_TRACKING_ROULETTE_BELOW = 0.1;
+// Once scatterings that next-event estimation keeps from being absorbed have
+// lowered a path's weight below this fraction, Russian roulette (path_step).
+const float SCATTER_ROULETTE_BELOW = 0.1;
 
 // Transmittance along a ray to infinity, per channel. Ratio tracking (Novák et
 // al. 2014): multiply by the null fraction sigma_n/sigma_bar at every tentative
@@ -439,6 +442,9 @@ struct PathState {
   // f · MIS weight / p_light), then the path goes on with the continuation
   // sampled at the vertex (next_*), one ray segment (free flights up to its
   // event) per path_step like any other ray (LAVAPIPE.md: divergence).
+  // The product of the weight factors by which scatterings that next-event
+  // estimation keeps from being absorbed lowered the weight (Russian roulette below).
+  float survival;
   bool light_ray;
   float light_T;  // a light ray's ratio-tracking transmittance (max channel) since its last roulette
   // Ratio-tracked continuation (docs/mis.md): 1 while the surface vertex's
@@ -739,6 +745,14 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     float c = sigma_bar * avg3(p.w);
     p_a = avg3(sigma_a * p.w) / c;
     p_s = HAS_SCATTERING ? avg3(sigma_s * p.w) / c : 0.0;
+    // With next-event estimation a real collision scatters whenever it can
+    // (docs/mis.md "No absorption events"): the collision estimator has already
+    // collected the emission here, and the scattering's weight
+    // sigma_s / (sigma_bar·(P_a + P_s)) keeps the expectation.
+    if (NEE && COLLISION_ESTIMATOR && p_s > 0.0) {
+      p_s += p_a;
+      p_a = 0.0;
+    }
     float u = rng_next(rng);
     if (u < p_a) {
       event = EVENT_ABSORB;
@@ -766,7 +780,21 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   // Scattered.
   if (p.depth >= frame.image.w) return true;  // max_depth reached
   ++p.depth;
+  const float w_before = max3(p.w);
   p.w *= sigma_s / (sigma_bar * p_s);
+  if (NEE && COLLISION_ESTIMATOR) {
+    // Russian roulette for what absorption no longer ends: once the factors
+    // that kept this path alive have lowered its weight below
+    // SCATTER_ROULETTE_BELOW of what it was, survive with probability
+    // survival / SCATTER_ROULETTE_BELOW, reweighted.
+    p.survival *= max3(p.w) / w_before;
+    const float q = p.survival / SCATTER_ROULETTE_BELOW;
+    if (q < 1.0) {
+      if (rng_next(rng) >= q) return true;
+      p.w /= q;
+      p.survival = SCATTER_ROULETTE_BELOW;
+    }
+  }
   // Phase function of the mixture f = Σ_i share_i·HG_i, share_i = σs_i/σs (per
   // channel): sample lobe i with q_i ∝ avg(share_i ⊙ w); the direction's pdf
   // is the mixture's, Σ_i q_i·HG_i, and the weight f/pdf.
@@ -826,6 +854,7 @@ PathState camera_path(uvec2 pixel, uint k, out uint rng) {
   p.has_hit = false;
   p.pdf_dir = 0.0;
   p.p_light = 0.0;
+  p.survival = 1.0;
   p.light_ray = false;
   p.light_T = 1.0;
   p.continuation_ray = 0u;

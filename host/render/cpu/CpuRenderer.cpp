@@ -245,6 +245,11 @@ bool continue_from(const WalkScene& ws, const glm::dvec3& o, Lobe& lobe, Own sam
   return true;
 }
 
+// With next-event estimation, once the scatterings kept from absorption have
+// lowered β below this fraction, Russian roulette (walk_channel; the GPU's
+// SCATTER_ROULETTE_BELOW).
+constexpr double kScatterRouletteBelow = 0.1;
+
 // One random walk of a *grey* world: colour channel c alone.
 //
 // Chromatic σ and albedo: each RGB channel is rendered as its own grey world
@@ -294,7 +299,11 @@ bool continue_from(const WalkScene& ws, const glm::dvec3& o, Lobe& lobe, Own sam
 // max_depth 0); the continuation is drawn from the vertex's lobe or the lights
 // (continue_from), and what its ray finds before the next real event (emission
 // at tentative collisions, the environment on escape) is weighted by the power
-// heuristic of the two direction pdfs (unidirectional_weight).
+// heuristic of the two direction pdfs (unidirectional_weight). A real
+// collision then never absorbs where the mixture scatters: it scatters with β
+// multiplied by σs/(σa + σs), and Russian roulette (kScatterRouletteBelow)
+// ends paths that these factors have made faint (docs/mis.md "No absorption
+// events").
 //
 // Light rays (role LightRay, max_depth 0) estimate the same integral
 // I(y, ω) = ∫ T σa Le dt + T(∞) L_env by ratio tracking instead (Novák et al.
@@ -313,6 +322,7 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
   const bool has_surfaces = !ws.surfaces.empty();
   int scatters = 0;
   double beta = 1.0;  // path weight: product of the albedos of the surface bounces so far
+  double survival = 1.0;  // the factors σs/(σa + σs) of the scatterings kept from absorption, since the last roulette
   double L = 0.0;     // the collision estimator's running sum
   RayMis mis;         // the camera ray: never MIS-weighted
   const int n_surface = lights.selection.surface_light_samples;  // next-event samples per vertex
@@ -355,7 +365,12 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
         }
 
         const double u = rng.uniform() * sigma_maj;
-        if (u < sigma_a) {
+        // With next-event estimation a real collision scatters whenever the
+        // mixture scatters at all (docs/mis.md "No absorption events"): the
+        // collision estimator has collected the emission here already, and
+        // β · σs/(σa + σs) keeps the expectation.
+        const bool survive = lights.active() && collision_estimator && sigma_s > 0.0;
+        if (!survive && u < sigma_a) {
           ++cnt.collisions;
           return collision_estimator ? L : beta * emitted_at(md, c, x, s) / sigma_a;
         }
@@ -363,6 +378,20 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
         ++cnt.collisions;
         if (scatters == max_depth) return collision_estimator ? L : 0.0;
         ++scatters;
+        if (survive) {
+          // Russian roulette once these factors have lowered β below
+          // kScatterRouletteBelow of what it was: survive with probability
+          // survival / kScatterRouletteBelow, reweighted.
+          const double r = sigma_s / (sigma_a + sigma_s);
+          beta *= r;
+          survival *= r;
+          if (survival < kScatterRouletteBelow) {
+            const double q = survival / kScatterRouletteBelow;
+            if (!(rng.uniform() < q)) return L;
+            beta /= q;
+            survival = kScatterRouletteBelow;
+          }
+        }
         // The phase function of the mixture: Σ_i (σs_i/σs) HG(g_i).
         s.lobe_w.clear();
         s.lobe_g.clear();
@@ -380,8 +409,9 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
           return VertexLobe{p, p};  // sampled exactly: pdf = value
         };
         if (lights.active()) L += beta * next_event(ws, c, x, phase, n_medium, rng, cnt, s);
-        // Given a scattering, u − σa is uniform on [0, σs): reuse it to pick the lobe.
-        double pick = (u - sigma_a) / sigma_s, g = 0.0;
+        // Given a scattering, u − σa is uniform on [0, σs) (u on [0, σa + σs)
+        // when it survives absorption): reuse it to pick the lobe.
+        double pick = survive ? u / (sigma_a + sigma_s) : (u - sigma_a) / sigma_s, g = 0.0;
         for (size_t l = 0; l < s.lobe_w.size(); ++l) {
           g = s.lobe_g[l];
           pick -= s.lobe_w[l];
