@@ -434,6 +434,10 @@ struct PathState {
   // continuation (0: camera or light ray) and next-event estimation pick the
   // ray's direction.
   float pdf_dir, p_light;
+  // The product of the weight factors by which scatterings that next-event
+  // estimation keeps from being absorbed lowered the weight since the last
+  // roulette (path_step; docs/mis.md "No absorption events").
+  float survival;
   bool has_hit;     // a surface lies ahead on the current ray
   SurfaceHit hit;   // the closest one (t = its distance)
   // Next-event estimation runs as a light ray in this same state: it collects
@@ -442,9 +446,6 @@ struct PathState {
   // f · MIS weight / p_light), then the path goes on with the continuation
   // sampled at the vertex (next_*), one ray segment (free flights up to its
   // event) per path_step like any other ray (LAVAPIPE.md: divergence).
-  // The product of the weight factors by which scatterings that next-event
-  // estimation keeps from being absorbed lowered the weight (Russian roulette below).
-  float survival;
   bool light_ray;
   float light_T;  // a light ray's ratio-tracking transmittance (max channel) since its last roulette
   // Ratio-tracked continuation (docs/mis.md): 1 while the surface vertex's

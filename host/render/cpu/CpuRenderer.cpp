@@ -280,8 +280,9 @@ constexpr double kScatterRouletteBelow = 0.1;
 // Surfaces do not emit.
 //
 // Emission estimators (integrator.emission_estimator), β the path weight
-// (the product of the surface albedos met so far; medium events keep it,
-// their probabilities equal the coefficient ratios):
+// (the product of the surface albedos met so far; without next-event
+// estimation medium events keep it, their probabilities equal the
+// coefficient ratios):
 //  - "absorption": an absorbed path returns β · Le of the absorbing mixture,
 //    Le = Σ σa_i Le_i / σa at x; escaping returns β · background.
 //  - "collision" (pbrt-v4 §14.2, VolPathIntegrator: beta · σa · Le / σ_maj at
@@ -321,7 +322,7 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
   const bool collision_estimator = ws.collision_estimator;
   const bool has_surfaces = !ws.surfaces.empty();
   int scatters = 0;
-  double beta = 1.0;  // path weight: product of the albedos of the surface bounces so far
+  double beta = 1.0;  // path weight: the surface albedos and, with NEE, the scattering albedos met so far
   double survival = 1.0;  // the factors σs/(σa + σs) of the scatterings kept from absorption, since the last roulette
   double L = 0.0;     // the collision estimator's running sum
   RayMis mis;         // the camera ray: never MIS-weighted
