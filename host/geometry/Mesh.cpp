@@ -4,6 +4,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <string_view>
 
 // The only translation unit that compiles tinyobjloader (header-only use).
 #define TINYOBJLOADER_IMPLEMENTATION
@@ -24,6 +25,34 @@ std::string first_line(const std::string& text) {
 }
 
 bool finite(float x) { return std::isfinite(x); }
+
+// Keeps only the statements a mesh needs (v, vn, vt, f, o, g) and blanks every
+// other line, so line numbers in tinyobjloader's messages still match the
+// file. What is dropped (materials, smoothing groups, lines, points, skin
+// weights, tags) is ignored by pyrolume anyway, and tinyobjloader parses some
+// of it unsafely: "vw 1 1e35 0.5" converts a float joint id to int out of
+// range (undefined behaviour; fuzz_obj found it). Line ends are \n, \r\n or a
+// lone \r, as tinyobjloader's own line splitter reads them.
+std::string mesh_statements(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  size_t i = 0;
+  while (i < text.size()) {
+    size_t end = text.find_first_of("\r\n", i);
+    if (end == std::string::npos) end = text.size();
+    size_t a = text.find_first_not_of(" \t", i);
+    if (a == std::string::npos || a > end) a = end;
+    size_t b = text.find_first_of(" \t", a);
+    if (b == std::string::npos || b > end) b = end;
+    const std::string_view keyword(text.data() + a, b - a);
+    if (keyword == "v" || keyword == "vn" || keyword == "vt" || keyword == "f" || keyword == "o" || keyword == "g")
+      out.append(text, i, end - i);
+    out.push_back('\n');
+    i = end;  // past one line end: \r\n, \r or \n
+    if (i < text.size()) i += (text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n') ? 2 : 1;
+  }
+  return out;
+}
 
 }  // namespace
 
@@ -49,7 +78,7 @@ Mesh load_obj(const std::filesystem::path& file) {
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
   std::string warn, err;
-  std::istringstream stream(text);
+  std::istringstream stream(mesh_statements(text));
   const bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream, /*readMatFn=*/nullptr,
                                    /*triangulate=*/true, /*default_vcols_fallback=*/false);
   if (!ok) throw input_error(name, "", "not a valid OBJ file: " + first_line(err));

@@ -287,5 +287,45 @@ TEST(CorruptObj, MtllibIsNotOpened) {
   EXPECT_EQ(done.get(), 1u);
 }
 
+// load_obj hands tinyobjloader only v, vn, vt, f, o and g lines. Its `vw`
+// parser converts a float joint id to int: 1e35 is undefined behaviour (UBSan
+// float-cast-overflow under tools/sanitize; fuzz_obj found it). The dropped
+// lines must not change the mesh, and every kind of line end must still split
+// lines (CRLF, lone CR, LF, none at the end).
+TEST(CorruptObj, StatementsPyrolumeIgnoresAreNotParsed) {
+  const auto dir = test::temp_dir("objskip");
+  const fs::path obj = dir / "skip.obj";
+  test::write_file(obj,
+                   "# skin weights, tags, smoothing, lines, points, materials\r\n"
+                   "vw 1 1e35 0.5\r\n"
+                   "t crease 2/1/0 1 2 4.5\r"
+                   "s 1\n"
+                   "usemtl rock\r\n"
+                   "  v 0 0 0\r"
+                   "v 1 0 0\r\n"
+                   "v 0 1 0\n"
+                   "\tv 1 1 0\n"
+                   "l 1 2\n"
+                   "p 3\n"
+                   "g top\n"
+                   "f 1 2 3\r\n"
+                   "f 2 4 3");
+  const geometry::Mesh mesh = geometry::load_obj(obj);
+  EXPECT_EQ(mesh.positions.size(), 4u);
+  ASSERT_EQ(mesh.triangles.size(), 2u);
+  EXPECT_EQ(mesh.triangles[1][1].position, 3u);
+  EXPECT_EQ(mesh.positions[3], glm::vec3(1, 1, 0));
+}
+
+// Dropped lines are blanked, not removed: tinyobjloader's line numbers still
+// point into the user's file.
+TEST(CorruptObj, ParseErrorsKeepTheFilesLineNumbers) {
+  const auto dir = test::temp_dir("objline");
+  const fs::path obj = dir / "zero.obj";
+  test::write_file(obj, "mtllib a.mtl\r\nusemtl a\rs off\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
+  const std::string msg = outcome(obj, [&] { geometry::load_obj(obj); });
+  EXPECT_NE(msg.find("line 7"), std::string::npos) << msg;
+}
+
 }  // namespace
 }  // namespace pyrolume
