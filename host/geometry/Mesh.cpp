@@ -40,8 +40,8 @@ std::string mesh_statements(const std::string& text) {
   while (i < text.size()) {
     size_t end = text.find_first_of("\r\n", i);
     if (end == std::string::npos) end = text.size();
-    size_t a = text.find_first_not_of(" \t", i);
-    if (a == std::string::npos || a > end) a = end;
+    size_t a = text.find_first_not_of(" \t", i);  // stops at the line end at the latest
+    if (a == std::string::npos) a = end;
     size_t b = text.find_first_of(" \t", a);
     if (b == std::string::npos || b > end) b = end;
     const std::string_view keyword(text.data() + a, b - a);

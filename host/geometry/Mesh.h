@@ -26,8 +26,8 @@ struct Mesh {
 
 // Reads a Wavefront OBJ (tinyobjloader): every object and group, polygons
 // triangulated, vertex colours and materials (mtllib/usemtl) ignored — the
-// scene assigns the material. Only v/vn/vt/f/o/g lines reach the parser. A face with normals or uvs on only some corners
-// drops them for the whole face.
+// scene assigns the material. Only v/vn/vt/f/o/g lines reach the parser. A
+// face with normals or uvs on only some corners drops them for the whole face.
 // Missing or unreadable file, a parse error, an index out of range, a
 // non-finite coordinate or no triangles at all → InputError "FILE: REASON".
 Mesh load_obj(const std::filesystem::path& file);
