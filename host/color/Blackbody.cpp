@@ -71,8 +71,18 @@ glm::dvec3 mode_rgb(const glm::dvec3& xyz, BlackbodyMode mode) {
 
 }  // namespace
 
+// Stefan–Boltzmann mode: the spectrum's chromaticity at luminance
+// (T / T_ref)^4, the T⁴ growth of a blackbody's total radiance σT⁴/π
+// (Stefan–Boltzmann law, Planck's law integrated over all wavelengths).
+static glm::dvec3 stefan_boltzmann_xyz(const glm::dvec3& xyz, double temperature_k) {
+  if (!(xyz.y > 0.0)) return glm::dvec3(0.0);
+  const double t = temperature_k / kStefanBoltzmannReferenceK;
+  return xyz * (t * t * t * t / xyz.y);
+}
+
 glm::dvec3 blackbody_xyz(double temperature_k, BlackbodyMode mode, int observer) {
-  return spectrum_xyz(temperature_k, mode, observer, 1);
+  const glm::dvec3 xyz = spectrum_xyz(temperature_k, mode, observer, 1);
+  return mode == BlackbodyMode::StefanBoltzmann ? stefan_boltzmann_xyz(xyz, temperature_k) : xyz;
 }
 
 glm::dvec2 blackbody_xy(double temperature_k, int observer) {
@@ -92,6 +102,7 @@ glm::dvec3 blackbody_rgb(double temperature_k, BlackbodyMode mode, int observer,
 glm::dvec3 blackbody_rgb_5nm(double temperature_k, BlackbodyMode mode, int observer,
                              std::optional<double> adapt_to_k) {
   glm::dvec3 xyz = spectrum_xyz(temperature_k, mode, observer, 5);
+  if (mode == BlackbodyMode::StefanBoltzmann) xyz = stefan_boltzmann_xyz(xyz, temperature_k);
   if (adapt_to_k) {
     // The white costs a 1 nm sum; callers use one white for millions of calls.
     thread_local double cached_k = -1.0;
@@ -109,7 +120,8 @@ glm::dvec3 blackbody_rgb_5nm(double temperature_k, BlackbodyMode mode, int obser
 
 const char* to_string(BlackbodyMode mode) {
   switch (mode) {
-    case BlackbodyMode::Seed: return "seed";
+    case BlackbodyMode::Seed: return "chromaticity";
+    case BlackbodyMode::StefanBoltzmann: return "stefan_boltzmann";
     case BlackbodyMode::Peak: return "peak";
     case BlackbodyMode::Physical: return "physical";
   }
@@ -117,7 +129,8 @@ const char* to_string(BlackbodyMode mode) {
 }
 
 std::optional<BlackbodyMode> parse_blackbody_mode(std::string_view name) {
-  if (name == "seed") return BlackbodyMode::Seed;
+  if (name == "chromaticity" || name == "seed") return BlackbodyMode::Seed;  // "seed": the old name
+  if (name == "stefan_boltzmann") return BlackbodyMode::StefanBoltzmann;
   if (name == "peak") return BlackbodyMode::Peak;
   if (name == "physical") return BlackbodyMode::Physical;
   return std::nullopt;

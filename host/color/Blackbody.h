@@ -22,8 +22,17 @@ namespace pyrolume::color {
 //             negatives clamped. 6500 K gives about (98.8, 93.1, 98.0).
 //   Physical: XYZ = sum B(l,T) [W·sr⁻¹·m⁻²·nm⁻¹] · cmf(l) · 1 nm, so Y is the
 //             ybar-weighted radiance in W·sr⁻¹·m⁻² (× 683 lm/W = cd/m²), then sRGB.
+//   StefanBoltzmann (the scene default): the spectrum's chromaticity with
+//             luminance Y = (T / kStefanBoltzmannReferenceK)⁴, the growth of the
+//             total radiance σT⁴/π (what Cycles' Blackbody Intensity does), then
+//             sRGB, negatives clamped.
 // Throws std::invalid_argument for an observer other than 2 or 10, and for an
 // adapt_to_k that is not a temperature with visible light (NaN, <= 0, below ~23 K).
+// The temperature at which the Stefan–Boltzmann mode has luminance 1: chosen
+// so that a 1000–2500 K fire sits at a sensible exposure under the default
+// film settings (docs/blackbody.md "Stefan–Boltzmann").
+inline constexpr double kStefanBoltzmannReferenceK = 1500.0;
+
 glm::dvec3 blackbody_rgb(double temperature_k, BlackbodyMode mode, int observer = 2,
                          std::optional<double> adapt_to_k = std::nullopt);
 
@@ -52,7 +61,7 @@ glm::dvec2 blackbody_xy(double temperature_k, int observer = 2);
 // adapt_to_k (same observer) to D65 (Nguyen et al. 2002; Fairchild 1998).
 glm::dvec3 adapt_blackbody_xyz(const glm::dvec3& xyz, double adapt_to_k, int observer = 2);
 
-// "seed" | "peak" | "physical".
+// "chromaticity" (also read as "seed", its old name) | "peak" | "physical" | "stefan_boltzmann".
 const char* to_string(BlackbodyMode mode);
 std::optional<BlackbodyMode> parse_blackbody_mode(std::string_view name);
 
