@@ -39,6 +39,7 @@
 
 #include "image/ImageIo.h"
 #include "render/Backend.h"
+#include "render/SceneSetup.h"
 #include "scene/Scene.h"
 
 using namespace pyrolume;
@@ -91,7 +92,8 @@ struct Strategy {
 
 int main(int argc, char** argv) try {
   const Options o = parse(argc, argv);
-  const Scene base = load_scene(o.scene);
+  Scene base = load_scene(o.scene);
+  complete_scene(base, 0, true);  // source conventions and framing, as `render` settles them
   auto backend = make_backend(o.backend);
   auto render = [&](const Scene& s, int spp, uint32_t seed) {
     RenderSettings rs;

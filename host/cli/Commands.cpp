@@ -17,6 +17,7 @@
 #include "image/RenderImage.h"
 #include "render/Backend.h"
 #include "render/Checkpoint.h"
+#include "render/SceneSetup.h"
 #include "render/vulkan/Devices.h"
 #include "render/vulkan/VulkanRenderer.h"
 #include "scene/Scene.h"
@@ -127,6 +128,24 @@ std::vector<std::string> missing_inputs(const Scene& pattern_scene, const Scene&
   return missing;
 }
 
+// A missing input whose folder does not exist either usually means a
+// generated sequence was never generated: say how, for the one pyrolume ships.
+void print_how_to_make_inputs(const Scene& pattern_scene, const Scene& frame_scene) {
+  for (size_t i = 0; i < frame_scene.media.size(); ++i) {
+    const std::filesystem::path folder = frame_scene.media[i].file.parent_path();
+    std::error_code ec;
+    if (folder.empty() || std::filesystem::is_directory(folder, ec)) continue;
+    const std::string pattern = pattern_scene.media[i].file.filename().string();
+    if (pattern == "explosion_####.vdb")
+      std::cerr << "pyrolume: the folder " << folder.string()
+                << " does not exist: tools/gen_explosion_sequence --out " << folder.string()
+                << " writes these frames (a build in build/ writes them there)\n";
+    else
+      std::cerr << "pyrolume: the folder " << folder.string() << " does not exist\n";
+    return;
+  }
+}
+
 // `render --frames`: one backend (one Vulkan device and, through frame reuse,
 // one pipeline and BVH) for every frame; each frame is rendered exactly as
 // `--frames N-N` would render it alone.
@@ -168,6 +187,7 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
     std::vector<std::string> absent = missing_inputs(scene, frame_scene);
     if (!absent.empty()) {
       for (const auto& a : absent) std::cerr << "pyrolume: " << tag << "missing input " << a << "\n";
+      if (missing == 0) print_how_to_make_inputs(scene, frame_scene);
       if (args.strict) {
         std::cerr << "pyrolume: stopping at the missing frame " << frame << " (--strict)\n";
         return 2;
@@ -206,6 +226,11 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
                 args.frames.c_str(), rendered, skipped, missing, format_seconds(wall).c_str(),
                 format_seconds(load_seconds).c_str(), format_seconds(render_seconds).c_str());
   std::cout << line << std::endl;
+  if (missing > 0 && !args.allow_missing) {
+    std::cerr << "pyrolume: " << missing << (missing == 1 ? " frame was" : " frames were")
+              << " not rendered for missing inputs: exit status 2 (--allow-missing accepts them)\n";
+    return 2;
+  }
   return 0;
 }
 
@@ -215,6 +240,15 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   Scene scene = load_scene(args.scene);
 
   const bool sequence = !args.frames.empty();
+  // Source conventions, up axis and framing, read off the first frame of a sequence.
+  const SceneSetup setup = complete_scene(scene, sequence ? parse_frame_range(args.frames).first : 0,
+                                          args.width || args.height || scene.film.size_given);
+  const double aspect =
+      double(args.width.value_or(scene.film.width)) / double(args.height.value_or(scene.film.height));
+  for (const std::string& note : setup.notes) std::cerr << "pyrolume: note: " << note << "\n";
+  if (!scene.camera.framed_automatically)
+    if (const std::string w = nothing_in_view(scene.camera, setup.boxes, aspect); !w.empty())
+      std::cerr << "pyrolume: warning: " << scene.file.string() << ": " << w << "\n";
   std::filesystem::path output =
       !args.output.empty() ? std::filesystem::path(args.output)
       : sequence           ? std::filesystem::path(std::filesystem::path(args.scene).stem().string() + "_####.exr")
@@ -232,6 +266,7 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
 
   if (args.skip_existing) throw input_error("--skip-existing", "", "needs --frames");
   if (args.strict) throw input_error("--strict", "", "needs --frames");
+  if (args.allow_missing) throw input_error("--allow-missing", "", "needs --frames");
   if (has_frame_pattern(output.string()))
     throw input_error(output.string(), "", "the output is a frame pattern: give --frames A-B (or one frame, --frames N)");
   for (size_t i = 0; i < scene.media.size(); ++i)

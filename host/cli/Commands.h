@@ -18,6 +18,7 @@ struct RenderArgs {
   std::string frames;
   bool skip_existing = false;  // skip frames whose output exists (resume)
   bool strict = false;         // stop with exit 2 at the first missing input frame
+  bool allow_missing = false;  // frames with missing inputs are skipped and the exit status stays 0
   // Checkpoints (render/Checkpoint.h): save OUT.checkpoint every `checkpoint`
   // seconds (0 = only when interrupted); continue from it with `resume`.
   double checkpoint = 0.0;

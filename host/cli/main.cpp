@@ -57,6 +57,9 @@ int main(int argc, char** argv) {
                      "Render frames A-B[:step] (or one frame A); -o and --stats are then patterns: out_####.exr");
   render->add_flag("--skip-existing", render_args.skip_existing, "With --frames: skip frames whose output exists");
   render->add_flag("--strict", render_args.strict, "With --frames: stop (exit 2) at the first missing input frame");
+  render->add_flag("--allow-missing", render_args.allow_missing,
+                   "With --frames: frames whose input files are missing are skipped and the exit status stays 0 "
+                   "(without it the other frames are rendered and the exit status is 2)");
   render->add_option("--checkpoint", render_args.checkpoint,
                      "Every SEC seconds save the accumulation to OUT.checkpoint (e.g. out.exr.checkpoint; an "
                      "interrupted render always saves it; a finished one removes it)")

@@ -36,6 +36,7 @@
 #include "render/vulkan/Context.h"
 #include "render/vulkan/RenderSession.h"
 #include "render/vulkan/VkCheck.h"
+#include "render/SceneSetup.h"
 #include "scene/Scene.h"
 #include "util/Error.h"
 
@@ -571,6 +572,9 @@ int run_preview_command(const PreviewArgs& args) {
     }
   }
   Scene scene = load_scene(args.scene);  // InputError: the CLI prints it, exit 2
+  // Source conventions, up axis and framing, as `render` settles them.
+  for (const std::string& note : complete_scene(scene, 0, args.width || args.height || scene.film.size_given).notes)
+    std::cerr << "pyrolume: note: " << note << "\n";
 
   g_signal = 0;
   auto old_int = std::signal(SIGINT, on_preview_signal);

@@ -36,6 +36,10 @@ struct Keyframes {
 struct Camera {
   glm::dvec3 position{0, 1, -6};
   glm::dvec3 look_at{0, 1, 0};
+  // The file gives neither position nor look_at: the camera frames the scene's
+  // media and shapes (host/render/SceneSetup, docs/scene-format.md "camera").
+  bool framed_automatically = false;
+  bool up_given = false;
   Keyframes<glm::dvec3> position_keys, look_at_keys;
   glm::dvec3 up{0, 1, 0};
   double fov_deg = 40.0;  // vertical field of view
@@ -44,6 +48,9 @@ struct Camera {
 struct Film {
   int width = 640;
   int height = 360;
+  // The file gives width or height: auto-framing keeps the film as it is
+  // (otherwise a tall subject turns the default film upright).
+  bool size_given = false;
   int spp = 64;
   double exposure = 0.0;  // stops, applied to PNG output only
   Keyframes<double> exposure_keys;
@@ -77,7 +84,9 @@ struct Bounds {
   glm::dvec3 min{0.0}, max{0.0};
 };
 
-enum class BlackbodyMode { Seed, Peak, Physical };
+// Seed: "chromaticity" in scene files (colour only); StefanBoltzmann: the
+// default, brightness ∝ T⁴ (docs/blackbody.md).
+enum class BlackbodyMode { Seed, Peak, Physical, StefanBoltzmann };
 
 struct Emission {
   // Exactly one of rgb / temperature_k is set for homogeneous media; grid media
@@ -86,7 +95,7 @@ struct Emission {
   std::optional<double> temperature_k;
   double scale = 1.0;
   Keyframes<double> scale_keys;
-  BlackbodyMode blackbody = BlackbodyMode::Seed;
+  BlackbodyMode blackbody = BlackbodyMode::StefanBoltzmann;
   int observer = 2;  // CIE 1931 2° or CIE 1964 10°
   std::optional<double> adapt_to_k;
   bool emits() const { return (rgb || temperature_k || is_grid) && scale > 0.0; }
@@ -98,6 +107,17 @@ struct TemperatureMapping {
   double offset = 0.0;
   double cutoff_k = 100.0;  // no emission at or below
 };
+
+// Which keys of a vdb medium the file wrote: a source convention
+// (host/volume/SourceConventions) fills in only the others.
+struct ExplicitKeys {
+  bool temperature_scale = false, temperature_offset = false, temperature_cutoff = false;
+  bool emission = false;  // an "emission" block
+};
+
+// The simulator that wrote a vdb file (docs/sources.md): it decides the grids
+// read, the temperature mapping and the up axis. Auto: detected from the file.
+enum class VolumeSource { Auto, Blender, Houdini, EmberGen, Kelvin };
 
 struct Transform {
   glm::dvec3 translate{0.0};
@@ -117,6 +137,8 @@ struct Medium {
   std::filesystem::path file;  // may hold a frame pattern (####, $F4, $F): see scene_at_frame
   std::string density_grid;      // empty: default "density"
   std::string temperature_grid;  // empty: first of temperature, heat, flame
+  VolumeSource source = VolumeSource::Auto;
+  ExplicitKeys given;
   double density_scale = 1.0;
   TemperatureMapping temperature;
   Transform transform;
@@ -140,8 +162,14 @@ struct Shape {
   std::filesystem::path texture;  // empty: constant albedo
 };
 
+enum class UpAxis { Y, Z };
+
 struct Scene {
   std::filesystem::path file;  // the JSON it came from (for messages)
+  // The world's up: the default camera's up, auto-framing's vertical and the
+  // environment map's zenith. Unset: from camera.up, else from the media's
+  // source, else Y (host/render/SceneSetup).
+  std::optional<UpAxis> up_axis;
   Camera camera;
   Film film;
   Integrator integrator;

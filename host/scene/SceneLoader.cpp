@@ -194,8 +194,22 @@ Bounds read_bounds(Reader r) {
 }
 
 BlackbodyMode read_blackbody(Reader& r) {
-  std::string m = r.choice("blackbody", "seed", {"seed", "peak", "physical"});
-  return m == "peak" ? BlackbodyMode::Peak : m == "physical" ? BlackbodyMode::Physical : BlackbodyMode::Seed;
+  // "seed" is the old name of "chromaticity", still read.
+  const std::string m = r.choice("blackbody", "stefan_boltzmann",
+                                 {"stefan_boltzmann", "physical", "peak", "chromaticity", "seed"});
+  return m == "peak"               ? BlackbodyMode::Peak
+         : m == "physical"         ? BlackbodyMode::Physical
+         : m == "stefan_boltzmann" ? BlackbodyMode::StefanBoltzmann
+                                   : BlackbodyMode::Seed;
+}
+
+VolumeSource read_source(Reader& r) {
+  const std::string s = r.choice("source", "auto", {"auto", "blender", "houdini", "embergen", "kelvin"});
+  return s == "blender"    ? VolumeSource::Blender
+         : s == "houdini"  ? VolumeSource::Houdini
+         : s == "embergen" ? VolumeSource::EmberGen
+         : s == "kelvin"   ? VolumeSource::Kelvin
+                           : VolumeSource::Auto;
 }
 
 Emission read_emission(Reader r, bool grid) {
@@ -244,6 +258,7 @@ Medium read_medium(Reader r, const std::filesystem::path& base, int index) {
     if (r.has("bounds")) r.fail("bounds", "a vdb medium is bounded by its grids");
     if (!r.has("file")) r.fail("file", "missing required key");
     m.file = resolve(base, r.string("file", ""));
+    m.source = read_source(r);
     m.density_grid = r.string("density_grid", "");
     m.temperature_grid = r.string("temperature_grid", "");
     m.density_scale = r.number("density_scale", 1.0);
@@ -252,6 +267,9 @@ Medium read_medium(Reader r, const std::filesystem::path& base, int index) {
     m.texture_format = r.choice("texture_format", "r16f", {"r16f", "r32f"});
     if (r.has("temperature")) {
       Reader t = r.child("temperature");
+      m.given.temperature_scale = t.has("scale");
+      m.given.temperature_offset = t.has("offset");
+      m.given.temperature_cutoff = t.has("cutoff_k");
       m.temperature.scale = t.number("scale", 1.0);
       m.temperature.offset = t.number("offset", 0.0);
       m.temperature.cutoff_k = t.number("cutoff_k", 100.0);
@@ -260,8 +278,11 @@ Medium read_medium(Reader r, const std::filesystem::path& base, int index) {
     }
     if (r.has("transform")) m.transform = read_transform(r.child("transform"));
   }
+  m.given.emission = r.has("emission");
   if (r.has("emission")) m.emission = read_emission(r.child("emission"), m.type == Medium::Type::Vdb);
-  else m.emission.is_grid = false;
+  // A vdb medium without an emission block glows where its source convention
+  // finds a temperature (host/volume/SourceConventions); a homogeneous one does not.
+  else m.emission.is_grid = m.type == Medium::Type::Vdb;
   r.finish();
   return m;
 }
@@ -339,8 +360,12 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
   s.file = file;
   Reader r(root, "", fname);
 
+  if (r.has("up_axis")) s.up_axis = r.choice("up_axis", "y", {"y", "z"}) == "z" ? UpAxis::Z : UpAxis::Y;
+  s.camera.framed_automatically = true;
   if (r.has("camera")) {
     Reader c = r.child("camera");
+    s.camera.framed_automatically = !c.has("position") && !c.has("look_at");
+    s.camera.up_given = c.has("up");
     s.camera.position = c.vec3_keyed("position", s.camera.position, s.camera.position_keys);
     s.camera.look_at = c.vec3_keyed("look_at", s.camera.look_at, s.camera.look_at_keys);
     s.camera.up = c.vec3("up", s.camera.up);
@@ -353,6 +378,7 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
   }
   if (r.has("film")) {
     Reader f = r.child("film");
+    s.film.size_given = f.has("width") || f.has("height");
     s.film.width = f.integer("width", s.film.width, 1, 16384);
     s.film.height = f.integer("height", s.film.height, 1, 16384);
     s.film.spp = f.integer("spp", s.film.spp, 1, 1 << 24);

@@ -45,6 +45,10 @@ StoredVolume load_stored_volume(const Medium& m, const DenseLimits& limits) {
   v.density = store(std::move(grids.density), wanted);
   if (grids.temperature) v.temperature = store(std::move(*grids.temperature), wanted);
   v.warnings = std::move(grids.warnings);
+  // A mapping under which nothing glows is almost always a missing scale.
+  if (v.temperature && !v.temperature->grid.values.empty())
+    if (const std::string w = cold_temperature_warning(v.temperature->grid, m.temperature); !w.empty())
+      v.warnings.push_back(m.file.string() + ": " + w);
   return v;
 }
 

@@ -13,24 +13,13 @@
 #include <openvdb/openvdb.h>
 
 #include "util/Error.h"
+#include "volume/SourceConventions.h"
 #include "volume/VdbFile.h"
 
 namespace pyrolume {
 namespace {
 
-// What one grid block prints; unset fields print as unknown.
-struct GridReport {
-  std::string name, type, grid_class;
-  bool saved_as_half = false;
-  glm::dvec3 voxel_size{0.0};
-  glm::dmat4 index_to_world{1.0};
-  std::optional<uint64_t> active_voxels;
-  std::optional<glm::i64vec3> bbox_min, bbox_max;  // inclusive active-voxel box
-  std::optional<double> min_value, max_value;
-  std::string range_label = "values";  // "|values|" for vector grids (magnitudes)
-  uint64_t nonfinite = 0;
-  std::string note;  // why a field is missing
-};
+using GridReport = GridInfo;
 
 std::string vec3(const glm::dvec3& v) {
   std::ostringstream s;
@@ -71,15 +60,7 @@ void print_report(const GridReport& g, std::ostream& out) {
     const glm::i64vec3 lo = *g.bbox_min, hi = *g.bbox_max, d = hi - lo + int64_t(1);
     out << "  index bbox: [" << lo.x << ' ' << lo.y << ' ' << lo.z << "]-[" << hi.x << ' ' << hi.y << ' ' << hi.z
         << "] (" << d.x << " x " << d.y << " x " << d.z << ")\n";
-    // The outer voxel faces: voxel ijk covers index ijk +- 0.5 (cell-centred).
-    glm::dvec3 wlo(std::numeric_limits<double>::infinity()), whi(-std::numeric_limits<double>::infinity());
-    for (int c = 0; c < 8; ++c) {
-      glm::dvec3 q((c & 1) ? hi.x + 0.5 : lo.x - 0.5, (c & 2) ? hi.y + 0.5 : lo.y - 0.5,
-                   (c & 4) ? hi.z + 0.5 : lo.z - 0.5);
-      glm::dvec3 w(g.index_to_world * glm::dvec4(q, 1.0));
-      wlo = glm::min(wlo, w);
-      whi = glm::max(whi, w);
-    }
+    const auto [wlo, whi] = *g.world_bbox();
     out << "  world bbox: [" << vec3(wlo) << "]-[" << vec3(whi) << "]\n";
   }
   out << "  " << g.range_label << ": ";
@@ -158,43 +139,47 @@ GridReport report_openvdb(const openvdb::GridBase& g, const std::string& file) {
   return r;
 }
 
-int info_openvdb(const std::string& file, bool values, std::ostream& out) {
+VolumeFileInfo read_openvdb_info(const std::string& file, bool values, const std::string& only_grid) {
+  auto wanted = [&](const std::string& name) { return values && (only_grid.empty() || name == only_grid); };
   ensure_openvdb_initialized();
   // OpenVDB trusts the lengths and offsets it reads: check them first, and
   // with --values read only the trees the check walked.
   const std::vector<std::string> walked =
-      validate_openvdb_file(file, [values](const std::string&) { return values; });
+      validate_openvdb_file(file, wanted);
+  VolumeFileInfo info;
+  info.file = file;
   try {
     openvdb::io::File f(file);
     f.open(/*delayLoad=*/false);
-    std::string creator;
     if (auto meta = f.getMetadata())
-      if (auto c = (*meta)["creator"]) creator = c->str();
+      for (auto it = meta->beginMeta(); it != meta->endMeta(); ++it)
+        if (it->second) info.metadata.emplace_back(it->first, it->second->str());
+    info.format_text = "OpenVDB, file format " + f.version();
     std::vector<std::string> names;
     for (auto it = f.beginName(); it != f.endName(); ++it) names.push_back(*it);
-    out << "file \"" << file << "\": OpenVDB, file format " << f.version();
-    if (!creator.empty()) out << ", creator \"" << creator << "\"";
-    out << ", " << names.size() << (names.size() == 1 ? " grid\n" : " grids\n");
-    // Per grid, so that one unregistered grid type spoils only its own block.
+    // Per grid, so that one unregistered grid type spoils only its own entry.
     for (const std::string& name : names) {
       openvdb::GridBase::Ptr g;
-      const bool read_values = values && std::find(walked.begin(), walked.end(), name) != walked.end();
+      const bool read_values = wanted(name) && std::find(walked.begin(), walked.end(), name) != walked.end();
       try {
         g = read_values ? f.readGrid(name) : f.readGridMetadata(name);
       } catch (const openvdb::Exception& e) {
-        out << "grid \"" << name << "\"\n  unreadable: " << e.what() << "\n";
+        GridReport r;
+        r.name = name;
+        r.unreadable = e.what();
+        info.grids.push_back(r);
         continue;
       }
       GridReport r = report_openvdb(*g, file);
       if (read_values) fill_from_values(*g, r);
       else fill_from_metadata(*g, r);
-      if (values && !read_values) r.note = "values not read: " + r.type + " trees are not checked";
-      print_report(r, out);
+      if (wanted(name) && !read_values) r.note = "values not read: " + r.type + " trees are not checked";
+      info.grids.push_back(r);
     }
   } catch (const openvdb::Exception& e) {
     throw input_error(file, "", std::string("cannot read as OpenVDB: ") + e.what());
   }
-  return 0;
+  return info;
 }
 
 // ---- NanoVDB ----
@@ -247,7 +232,7 @@ void nano_grid(const nanovdb::NanoGrid<BuildT>& grid, bool values, GridReport& r
   }
 }
 
-int info_nanovdb(const std::string& file, bool values, std::ostream& out) {
+VolumeFileInfo read_nanovdb_info(const std::string& file, bool values_asked, const std::string& only_grid) {
   std::vector<nanovdb::io::GridMetaData> metas;
   validate_nanovdb_file(file);  // nanovdb::io allocates by the sizes it reads
   try {
@@ -255,9 +240,12 @@ int info_nanovdb(const std::string& file, bool values, std::ostream& out) {
   } catch (const std::exception& e) {
     throw input_error(file, "", std::string("cannot read as NanoVDB: ") + e.what());
   }
-  out << "file \"" << file << "\": NanoVDB, " << metas.size() << (metas.size() == 1 ? " grid\n" : " grids\n");
+  VolumeFileInfo info;
+  info.file = file;
+  info.format_text = "NanoVDB";
   for (size_t n = 0; n < metas.size(); ++n) {
     const auto& md = metas[n];
+    const bool values = values_asked && (only_grid.empty() || md.gridName == only_grid);
     GridReport r;
     r.name = md.gridName;
     r.type = nanovdb::toStr(md.gridType);
@@ -286,16 +274,64 @@ int info_nanovdb(const std::string& file, bool values, std::ostream& out) {
       else if (auto* g = h.grid<nanovdb::FpN>()) nano_grid(*g, values, r);
       else r.note = "no value range for " + r.type + " grids";
     }
-    print_report(r, out);
+    info.grids.push_back(r);
   }
-  return 0;
+  return info;
 }
 
 }  // namespace
 
+std::optional<std::pair<glm::dvec3, glm::dvec3>> GridInfo::world_bbox() const {
+  if (!bbox_min || !bbox_max || (active_voxels && *active_voxels == 0)) return std::nullopt;
+  const glm::i64vec3 lo = *bbox_min, hi = *bbox_max;
+  // The outer voxel faces: voxel ijk covers index ijk +- 0.5 (cell-centred).
+  glm::dvec3 wlo(std::numeric_limits<double>::infinity()), whi(-std::numeric_limits<double>::infinity());
+  for (int c = 0; c < 8; ++c) {
+    glm::dvec3 q((c & 1) ? hi.x + 0.5 : lo.x - 0.5, (c & 2) ? hi.y + 0.5 : lo.y - 0.5, (c & 4) ? hi.z + 0.5 : lo.z - 0.5);
+    glm::dvec3 w(index_to_world * glm::dvec4(q, 1.0));
+    wlo = glm::min(wlo, w);
+    whi = glm::max(whi, w);
+  }
+  return std::make_pair(wlo, whi);
+}
+
+const GridInfo* VolumeFileInfo::grid(const std::string& name) const {
+  for (const auto& g : grids)
+    if (g.name == name && g.unreadable.empty()) return &g;
+  return nullptr;
+}
+
+std::string VolumeFileInfo::metadata_value(const std::string& key) const {
+  for (const auto& [k, v] : metadata)
+    if (k == key) return v;
+  return "";
+}
+
+VolumeFileInfo read_volume_file_info(const std::filesystem::path& file, bool values, const std::string& only_grid) {
+  return detect_volume_format(file) == VolumeFormat::NanoVdb ? read_nanovdb_info(file.string(), values, only_grid)
+                                                             : read_openvdb_info(file.string(), values, only_grid);
+}
+
 int run_info_command(const std::filesystem::path& file, bool values, std::ostream& out) {
-  return detect_volume_format(file) == VolumeFormat::NanoVdb ? info_nanovdb(file.string(), values, out)
-                                                             : info_openvdb(file.string(), values, out);
+  const VolumeFileInfo info = read_volume_file_info(file, values);
+  print_volume_file_info(info, out);
+  SourceConvention c = source_convention(info, VolumeSource::Auto);
+  fit_temperature_mapping(c, file.string());
+  out << "scene:\n  " << scene_snippet(file.string(), c);
+  return 0;
+}
+
+void print_volume_file_info(const VolumeFileInfo& info, std::ostream& out) {
+  const size_t n = info.grids.size();
+  out << "file \"" << info.file << "\": " << info.format_text;
+  if (const std::string creator = info.metadata_value("creator"); !creator.empty()) out << ", creator \"" << creator << "\"";
+  out << ", " << n << (n == 1 ? " grid\n" : " grids\n");
+  for (const auto& [key, value] : info.metadata)
+    if (key != "creator") out << "metadata \"" << key << "\": " << value << "\n";
+  for (const GridInfo& g : info.grids) {
+    if (!g.unreadable.empty()) out << "grid \"" << g.name << "\"\n  unreadable: " << g.unreadable << "\n";
+    else print_report(g, out);
+  }
 }
 
 }  // namespace pyrolume

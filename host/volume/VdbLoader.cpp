@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -419,6 +420,25 @@ VolumeGrids load_volume(const Medium& m, bool need_temperature, const DenseLimit
   if (m.downsample < 1) throw input_error(file, "downsample", "must be >= 1");
   return detect_volume_format(m.file) == VolumeFormat::NanoVdb ? load_nanovdb(m, need_temperature, limits)
                                                                : load_openvdb(m, need_temperature, limits);
+}
+
+std::string cold_temperature_warning(const DenseGrid& t, const TemperatureMapping& map) {
+  const double hottest_value = map.scale >= 0.0 ? t.max_value : t.min_value;
+  const double hottest_k = (hottest_value - map.offset) * map.scale;
+  if (!(hottest_k <= map.cutoff_k)) return "";  // something glows (NaN-safe)
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "temperature grid \"%s\": the hottest voxel maps to %.4g K, at or below temperature.cutoff_k %.4g K, so "
+                "nothing glows",
+                t.name.c_str(), hottest_k, map.cutoff_k);
+  std::string w = line;
+  // The scale that would put the hottest voxel at 1500 K, a visible fire.
+  if (hottest_value - map.offset > 0.0) {
+    std::snprintf(line, sizeof line, "; temperature.scale %.4g would put it at 1500 K",
+                  1500.0 / (hottest_value - map.offset));
+    w += line;
+  }
+  return w;
 }
 
 }  // namespace pyrolume

@@ -24,6 +24,11 @@ inline constexpr const char* kDefaultDensityGrid = "density";
 // the limit, the "downsample" that would fit) before its dense array exists.
 VolumeGrids load_volume(const Medium& m, bool need_temperature, const DenseLimits& limits = {});
 
+// "" when the temperature grid's hottest value maps above the cutoff;
+// otherwise the warning (naming the grid, the hottest temperature and a
+// temperature.scale that would make it glow) that load_stored_volume adds.
+std::string cold_temperature_warning(const DenseGrid& temperature, const TemperatureMapping& mapping);
+
 // The most texels one dense grid may have (default 2^32, 16 GiB as float:
 // past what any host or device here holds); beyond it load_volume throws
 // InputError and suggests "downsample". The fuzz target and the corrupt-input

@@ -153,6 +153,7 @@ TEST_F(RealRender, MantaflowSmokeWithTemperature) {
   m.temperature_grid = "temperature";
   m.emission.is_grid = true;
   m.emission.scale = 3.0;
+  m.emission.blackbody = BlackbodyMode::Seed;
   m.temperature.scale = 1000.0;
   m.temperature.cutoff_k = 600.0;
   Scene s = framed(m, {0, 1, 0}, {0, 0, 1}, 32, 32);

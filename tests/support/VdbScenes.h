@@ -177,6 +177,9 @@ inline Medium vdb_medium(const std::string& name, const std::filesystem::path& f
   m.emission.scale = emission_scale;
   m.emission.rgb = Le_rgb;
   m.emission.is_grid = !Le_rgb && temperature_emission;
+  // The closed forms of these scenes use the colour-only normalisation (not
+  // the scene default), so the expected Le stays of order 1 at any temperature.
+  m.emission.blackbody = BlackbodyMode::Seed;
   if (m.emission.is_grid) m.temperature_grid = "temperature";
   if (!Le_rgb && !temperature_emission) m.emission.scale = 0.0;  // emits nothing
   return m;

@@ -57,7 +57,7 @@ INSTANTIATE_TEST_SUITE_P(
         CliCase{"vdb_missing_file", R"({"media": [{"type": "vdb", "file": "nothere.vdb"}]})", "",
                 "nothere.vdb: file not found"},
         CliCase{"vdb_missing_grid",
-                R"({"media": [{"type": "vdb", "file": ")" PYROLUME_SOURCE_DIR R"(/assets/volumes/fire.vdb", "density_grid": "smoke"}]})",
+                R"({"media": [{"type": "vdb", "file": ")" PYROLUME_SOURCE_DIR R"(/assets/volumes/fire.vdb", "source": "houdini", "density_grid": "smoke"}]})",
                 "", "density grid \"smoke\": no such grid; the file has: \"density\""},
         CliCase{"vdb_not_a_vdb", R"({"media": [{"type": "vdb", "file": ")" PYROLUME_SOURCE_DIR R"(/README.md"}]})", "",
                 "not an OpenVDB (.vdb) or NanoVDB (.nvdb) file"}),

@@ -34,7 +34,7 @@ const char* kScene = R"({
   "camera": {"position": {"keys": [[1, [0, 0, -4]], [3, [0.5, 0.3, -3.5]]]}, "look_at": [0, 0, 0], "fov_deg": 40},
   "film": {"width": 20, "height": 14, "spp": 4, "seed": 5, "exposure": {"keys": [[1, 0], [3, 1]]}},
   "background": {"rgb": [0.05, 0.05, 0.08]},
-  "media": [{"name": "shell", "type": "vdb", "file": "shell_####.vdb",
+  "media": [{"name": "shell", "type": "vdb", "file": "shell_####.vdb", "source": "kelvin",
              "sigma_a": [1, 1, 1], "sigma_s": [2, 2, 2], "g": 0.3,
              "emission": {"scale": {"keys": [[1, 1.0], [3, 0.4]]}}}]
 })";
@@ -122,8 +122,8 @@ TEST_P(Sequence, FrameNumberKeysTheRandomNumbers) {
 
 TEST_P(Sequence, MissingFrameIsReportedAndWritesNothing) {
   fs::path dir = scene_with_frames("seq-missing", {1, 3});
-  CliResult r = run_cli("render " + q(dir / "seq.json") + " --frames 1-3 -o " + q(dir / "out_####.png") + " --stats " +
-                        q(dir / "st_####.json") + backend());
+  CliResult r = run_cli("render " + q(dir / "seq.json") + " --frames 1-3 --allow-missing -o " +
+                        q(dir / "out_####.png") + " --stats " + q(dir / "st_####.json") + backend());
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(count(r.err, "shell_0002.vdb"), 1) << r.err;
   EXPECT_EQ(count(r.err, "\n"), 1) << r.err;  // one line per missing file
@@ -133,6 +133,18 @@ TEST_P(Sequence, MissingFrameIsReportedAndWritesNothing) {
   EXPECT_TRUE(fs::exists(dir / "out_0003.png"));
   EXPECT_TRUE(fs::exists(dir / "st_0003.json"));
   EXPECT_NE(r.out.find("2 rendered, 0 skipped, 1 missing"), std::string::npos) << r.out;
+
+  // By default the other frames are rendered too, and the exit status is 2,
+  // so a render farm sees the failure.
+  fs::path dflt = scene_with_frames("seq-missing-default", {1, 3});
+  CliResult d = run_cli("render " + q(dflt / "seq.json") + " --frames 1-3 -o " + q(dflt / "o_####.png") + backend());
+  EXPECT_EQ(d.status, 2) << d.err;
+  EXPECT_EQ(count(d.err, "shell_0002.vdb"), 1) << d.err;
+  EXPECT_NE(d.err.find("1 frame was not rendered for missing inputs: exit status 2"), std::string::npos) << d.err;
+  EXPECT_EQ(count(d.err, "\n"), 2) << d.err;
+  EXPECT_TRUE(fs::exists(dflt / "o_0001.png"));
+  EXPECT_FALSE(fs::exists(dflt / "o_0002.png"));
+  EXPECT_TRUE(fs::exists(dflt / "o_0003.png"));
 
   // --strict: exit 2 at the first missing frame, nothing after it.
   fs::path strict = scene_with_frames("seq-strict", {1, 3});

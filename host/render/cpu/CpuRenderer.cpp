@@ -540,7 +540,6 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
     throw std::invalid_argument("cpu reference: unknown emission_estimator \"" + estimator + "\"");
   const bool collision_estimator = estimator == "collision";
   const MediaData media = prepare_media(scene);  // loads the vdb media's grids
-  for (const std::string& w : media.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   const geometry::Surfaces surfaces = geometry::build_surfaces(scene);  // meshes, textures, BVH
   std::optional<EnvironmentMap> environment;
   if (scene.environment)
@@ -564,6 +563,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   const WalkScene walk_scene{media,     surfaces,           environment ? &*environment : nullptr, scene.background,
                              max_depth, collision_estimator, lights};
   RenderResult res;
+  res.warnings = media.warnings;  // the CLI prints them ("pyrolume: warning: ...")
   res.width = W;
   res.height = H;
   res.backend = name();
