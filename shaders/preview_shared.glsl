@@ -23,7 +23,8 @@ struct DisplayConstants {
   uvec4 size;   // x, y: render image size; z, w: target (swapchain) size
   uvec4 rect;   // x, y: top-left of the image in the target; z, w: its size there (letterboxed)
   vec4 tone;    // x: 2^exposure / spp (accumulated sum -> displayed linear radiance); yzw: border colour (sRGB, 0..1)
-  uvec4 flags;  // x: 1 = the target stores B,G,R,A in memory (swap red and blue); yzw: unused
+  uvec4 flags;  // x: 1 = the target stores B,G,R,A in memory (swap red and blue);
+                // y: the view, VIEW_AGX or VIEW_STANDARD (shared/view_transform.h); zw: unused
 };
 
 #ifdef __cplusplus

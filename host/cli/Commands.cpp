@@ -13,6 +13,7 @@
 #include "color/Blackbody.h"
 #include "image/AtomicFile.h"
 #include "image/Compare.h"
+#include "image/DisplayTransform.h"
 #include "image/ImageIo.h"
 #include "image/RenderImage.h"
 #include "render/Backend.h"
@@ -49,6 +50,12 @@ namespace {
 struct FrameOutputs {
   std::filesystem::path image, stats;
 };
+
+// Where the auto exposure line goes: stderr, for display output only (an EXR
+// is linear; an exposure chosen for it would mean nothing).
+std::ostream* display_log(const std::filesystem::path& output) {
+  return lower_extension(output) == ".png" ? &std::cerr : nullptr;
+}
 
 void check_folder(const std::filesystem::path& file, const std::string& what) {
   if (file.has_parent_path() && !std::filesystem::is_directory(file.parent_path()))
@@ -169,6 +176,8 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
   auto backend = make_backend(args.backend, options);
   if (auto* vulkan = dynamic_cast<VulkanRenderer*>(backend.get())) vulkan->set_frame_reuse(true);
 
+  // Auto exposure comes from the first frame rendered and holds for the rest (no flicker).
+  DisplayExposure exposure(parse_exposure(args.exposure));
   int rendered = 0, skipped = 0, missing = 0;
   double load_seconds = 0.0, render_seconds = 0.0;
   for (int frame : range.frames()) {
@@ -211,7 +220,8 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
                 << " spp; that frame is not written (rerun with --skip-existing to resume)\n";
       break;
     }
-    write_image(out.image, image_from_render(result, args.variance), frame_scene.film.exposure);
+    const Image image = image_from_render(result, args.variance);
+    write_image(out.image, image, exposure.stops(frame_scene.film, image, display_log(out.image)), frame_scene.film.view);
     if (!out.stats.empty()) write_stats(out.stats, args, out.image, result, frame);
     print_warnings(result, tag);
     print_summary(out.image, result);
@@ -237,6 +247,7 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
 }  // namespace
 
 int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
+  parse_exposure(args.exposure);  // a bad --exposure fails before the scene loads
   Scene scene = load_scene(args.scene);
 
   const bool sequence = !args.frames.empty();
@@ -326,9 +337,10 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   }
 
   // The image and (short of the target) the checkpoint of what was rendered.
+  DisplayExposure exposure(parse_exposure(args.exposure));
   auto save = [&](const RenderResult& result, bool keep_checkpoint) {
     Image image = image_from_render(result, args.variance);
-    write_image(output, image, scene.film.exposure);
+    write_image(output, image, exposure.stops(scene.film, image, display_log(output)), scene.film.view);
     if (!args.stats.empty()) write_stats(args.stats, args, output, result, std::nullopt);
     bool checkpointed = false;
     if (result.spp < settings.spp && keep_checkpoint && !result.state.data.empty())

@@ -23,6 +23,9 @@ struct RenderArgs {
   // seconds (0 = only when interrupted); continue from it with `resume`.
   double checkpoint = 0.0;
   bool resume = false;
+  // --exposure: stops or "auto", overriding film.exposure for display output
+  // (PNG) on every frame; empty = the scene's (docs/view-transform.md).
+  std::string exposure;
 };
 int run_render(const RenderArgs& args, const std::atomic<bool>& cancel);
 

@@ -52,6 +52,8 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   render->add_option("--stats", render_args.stats, "Write render statistics as JSON");
   render->add_flag("--variance", render_args.variance, "EXR: add the per-pixel variance of the mean (variance.R/G/B)");
+  render->add_option("--exposure", render_args.exposure,
+                     "PNG: exposure in stops, or auto (overrides film.exposure on every frame; EXR stays linear)");
   render->add_option("--device", render_args.device, "Vulkan device index (see `pyrolume devices`)")->check(CLI::NonNegativeNumber);
   render->add_option("--frames", render_args.frames,
                      "Render frames A-B[:step] (or one frame A); -o and --stats are then patterns: out_####.exr");
@@ -75,6 +77,7 @@ int main(int argc, char** argv) {
   preview->add_option("--device", pv.device, "Vulkan device index")->check(CLI::NonNegativeNumber);
   preview->add_option("--width", pv.width, "Window width (overrides film.width)")->check(CLI::Range(16, 16384));
   preview->add_option("--height", pv.height, "Window height (overrides film.height)")->check(CLI::Range(16, 16384));
+  preview->add_option("--exposure", pv.exposure, "Starting exposure in stops, or auto (overrides film.exposure)");
 
   std::string info_file;
   bool info_values = false;

@@ -24,18 +24,15 @@
 #include <vector>
 
 #include "image/AtomicFile.h"
+#include "image/DisplayTransform.h"
+#include "shared/view_transform.h"
 #include "util/Error.h"
 
 namespace pyrolume {
 
 namespace fs = std::filesystem;
 
-float srgb_encode(float linear) {
-  if (!(linear > 0.0f)) return 0.0f;  // negatives and NaN
-  if (linear >= 1.0f) return 1.0f;
-  if (linear <= 0.0031308f) return 12.92f * linear;
-  return 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
-}
+float srgb_encode(float linear) { return display::view_srgb_oetf(linear); }
 
 float srgb_decode(float v) {
   if (v <= 0.04045f) return v / 12.92f;
@@ -106,9 +103,8 @@ void write_exr(std::ostream& os, const Image& img) {
   out.writePixels(img.height);
 }
 
-void write_png(std::ostream& os, const Image& img, double exposure_stops) {
-  std::vector<unsigned char> bytes(img.rgb.size());
-  for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = srgb_encode_u8(img.rgb[i], exposure_stops);
+void write_png(std::ostream& os, const Image& img, double exposure_stops, ViewTransform view) {
+  const std::vector<unsigned char> bytes = display_rgb8(img, exposure_stops, view);
   auto sink = [](void* ctx, void* data, int size) { static_cast<std::ostream*>(ctx)->write((const char*)data, size); };
   if (!stbi_write_png_to_func(sink, &os, img.width, img.height, 3, bytes.data(), img.width * 3))
     throw std::runtime_error("PNG encoding failed");
@@ -348,7 +344,7 @@ Image read_stb(const fs::path& file, const std::vector<unsigned char>& bytes) {
 
 }  // namespace
 
-void write_image(const fs::path& file, const Image& img, double exposure_stops) {
+void write_image(const fs::path& file, const Image& img, double exposure_stops, ViewTransform view) {
   const std::string ext = lower_extension(file);
   if (ext != ".exr" && ext != ".png")
     throw input_error(file.string(), "", "unknown image extension '" + file.extension().string() + "' (use .exr or .png)");
@@ -362,7 +358,7 @@ void write_image(const fs::path& file, const Image& img, double exposure_stops) 
       if (ext == ".exr")
         write_exr(os, img);
       else
-        write_png(os, img, exposure_stops);
+        write_png(os, img, exposure_stops, view);
     });
   } catch (const InputError&) {
     throw;

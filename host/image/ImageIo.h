@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "image/Image.h"
+#include "scene/Scene.h"
 
 namespace pyrolume {
 
@@ -11,6 +12,7 @@ namespace pyrolume {
 //   encode: 12.92·L for L ≤ 0.0031308, else 1.055·L^(1/2.4) − 0.055
 //   decode: V/12.92 for V ≤ 0.04045, else ((V + 0.055)/1.055)^2.4
 // encode clamps to [0, 1] first (NaN → 0); decode expects V in [0, 1].
+// encode is view_srgb_oetf of shaders/shared/view_transform.h.
 float srgb_encode(float linear);
 float srgb_decode(float encoded);
 
@@ -21,10 +23,13 @@ unsigned char srgb_encode_u8(float linear, double exposure_stops = 0.0);
 //   .exr  float32, ZIP, channels R, G, B (+ variance.R/G/B when img has variance);
 //         int header attributes "spp" / "spp_target" when img.spp / spp_target > 0;
 //         linear, exposure NOT applied.
-//   .png  8-bit sRGB RGB, exposure applied, variance dropped.
+//   .png  8-bit sRGB RGB through exposure and `view` (image/DisplayTransform.h
+//         display_rgb8), variance dropped. Renders pass film.view; the default,
+//         Standard, suits data such as textures (a plain sRGB encode).
 // Atomic (see AtomicFile.h): a failure leaves no file at `file`.
 // Unknown extension, empty image, or an I/O failure → InputError.
-void write_image(const std::filesystem::path& file, const Image& img, double exposure_stops = 0.0);
+void write_image(const std::filesystem::path& file, const Image& img, double exposure_stops = 0.0,
+                 ViewTransform view = ViewTransform::Standard);
 
 // Reads by content, not by extension:
 //   EXR: data window; R, G, B (missing ones read as 0); a Y-only file gives

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "preview_shared.glsl"
+#include "shared/view_transform.h"
 #include "render/vulkan/Spirv.h"
 
 namespace pyrolume::preview {
@@ -36,13 +37,14 @@ void DisplayPass::resize(VkExtent2D target, bool bgra) {
   set_.write_buffer(gpu::PREVIEW_BINDING_DISPLAY, display_);
 }
 
-void DisplayPass::record(VkCommandBuffer cmd, int spp, double exposure_stops, VkImage image) {
+void DisplayPass::record(VkCommandBuffer cmd, int spp, double exposure_stops, ViewTransform view, VkImage image) {
   gpu::DisplayConstants dc{};
   dc.size = gpu::uvec4(image_w_, image_h_, target_.width, target_.height);
   dc.rect = gpu::uvec4(rect_.x, rect_.y, rect_.width, rect_.height);
   const float border = 0.08f;  // dark grey bars, so the image's own black edges stay visible
   dc.tone = gpu::vec4(spp > 0 ? float(std::exp2(exposure_stops) / spp) : 0.0f, border, border, border);
-  dc.flags = gpu::uvec4(bgra_ ? 1u : 0u, 0u, 0u, 0u);
+  dc.flags = gpu::uvec4(bgra_ ? 1u : 0u, view == ViewTransform::Standard ? display::VIEW_STANDARD : display::VIEW_AGX,
+                        0u, 0u);
   pipeline_.bind(cmd, set_.set());
   pipeline_.push(cmd, dc);
   const uint32_t g = gpu::PREVIEW_WORKGROUP_SIZE;

@@ -11,6 +11,7 @@
 #include "render/vulkan/Context.h"
 #include "render/vulkan/Memory.h"
 #include "render/vulkan/Pipeline.h"
+#include "scene/Scene.h"
 
 namespace pyrolume::preview {
 
@@ -46,10 +47,11 @@ class DisplayPass {
   // (Re)allocate the display buffer for a target (swapchain) size. The device must be idle.
   void resize(VkExtent2D target, bool bgra);
 
-  // Record: tonemap (mean = Σ L / spp, × 2^exposure, sRGB) into the display
-  // buffer, then copy it into `image` and leave that in PRESENT_SRC layout.
+  // Record: mean = Σ L / spp, × 2^exposure, through the view transform
+  // (shaders/shared/view_transform.h, as PNG output) into the display buffer,
+  // then copy it into `image` and leave that in PRESENT_SRC layout.
   // `image` must be UNDEFINED or PRESENT_SRC (its contents are discarded).
-  void record(VkCommandBuffer cmd, int spp, double exposure_stops, VkImage image);
+  void record(VkCommandBuffer cmd, int spp, double exposure_stops, ViewTransform view, VkImage image);
 
   // What the last recorded frame showed inside the image rect, as RGB bytes
   // (sRGB-encoded), row 0 = top. Waits for earlier submitted work.

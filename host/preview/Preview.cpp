@@ -27,6 +27,7 @@
 #include <stb_image_write.h>
 
 #include "image/AtomicFile.h"
+#include "image/DisplayTransform.h"
 #include "image/ImageIo.h"
 #include "image/RenderImage.h"
 #include "preview/DisplayPass.h"
@@ -63,6 +64,9 @@ constexpr int kMaxSpp = 1 << 16;
 constexpr double kOrbitRadPerPixel = 0.005;
 constexpr double kExposureStep = 0.5;       // stops per key press
 constexpr double kTemperatureStep = 1.05;   // factor per key press
+// Auto exposure follows the image until it has this many samples per pixel,
+// then holds (docs/view-transform.md): a noisy first frame must not decide.
+constexpr int kAutoExposureSpp = 16;
 
 const char* kControls =
     "left drag: orbit, right/middle drag: pan, wheel: zoom, +/-: exposure, [ ]: temperature scale, R: reset, S: save, "
@@ -164,13 +168,16 @@ class PreviewWindow {
   void draw_frame();
   void update_title(bool force);
   void pace(int pass_spp, double pass_seconds, double period);
+  void follow_auto_exposure();
   int first_grid_medium() const;
 
   const PreviewArgs& args_;
   const Scene original_;
   Scene scene_;
   RenderSettings settings_;
+  DisplayExposure exposure_choice_;  // --exposure, else film.exposure (or auto)
   double exposure_;
+  bool auto_exposure_held_ = false;  // auto exposure chosen for good (or the user took over with +/-)
   Input input_;
 
   // Declared in creation order; destroyed in reverse (surface before instance,
@@ -200,7 +207,11 @@ class PreviewWindow {
 };
 
 PreviewWindow::PreviewWindow(const PreviewArgs& args, Scene scene)
-    : args_(args), original_(scene), scene_(std::move(scene)), exposure_(scene_.film.exposure) {
+    : args_(args),
+      original_(scene),
+      scene_(std::move(scene)),
+      exposure_choice_(parse_exposure(args.exposure)),
+      exposure_(exposure_choice_.automatic(scene_.film) ? 0.0 : exposure_choice_.stops(scene_.film, Image())) {
   settings_.width = args.width.value_or(scene_.film.width);
   settings_.height = args.height.value_or(scene_.film.height);
   settings_.spp = scene_.film.spp;
@@ -317,7 +328,9 @@ void PreviewWindow::apply_input() {
   if (in.reset) {
     // Back to the scene as loaded: view, exposure and temperature scale.
     scene_ = original_;
-    exposure_ = original_.film.exposure;
+    exposure_choice_.forget_auto();
+    auto_exposure_held_ = false;
+    exposure_ = exposure_choice_.automatic(scene_.film) ? 0.0 : exposure_choice_.stops(scene_.film, Image());
     changed = true;
   }
   if (in.orbit_x != 0 || in.orbit_y != 0) {
@@ -339,7 +352,10 @@ void PreviewWindow::apply_input() {
     preview::zoom(scene_.camera, in.zoom);
     changed = true;
   }
-  if (in.exposure_steps != 0) exposure_ += kExposureStep * in.exposure_steps;  // display only: no restart
+  if (in.exposure_steps != 0) {
+    exposure_ += kExposureStep * in.exposure_steps;  // display only: no restart
+    auto_exposure_held_ = true;                      // the user's choice from here on
+  }
   if (in.temperature_steps != 0) {
     const int i = first_grid_medium();
     if (i < 0) {
@@ -369,7 +385,7 @@ void PreviewWindow::save_accumulation() {
   const fs::path exr = base.string() + ".exr", png = base.string() + ".png";
   try {
     write_image(exr, image);
-    write_image(png, image, exposure_);
+    write_image(png, image, exposure_, scene_.film.view);
     std::cout << exr.string() << "\n" << png.string() << std::endl;
     note_ = "saved " + png.filename().string();
   } catch (const std::exception& e) {
@@ -424,7 +440,7 @@ void PreviewWindow::draw_frame() {
   }
   if (pass_spp > 0) session_->record_pass(cmd_, pass_spp);
   if (timestamps_) vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps_.get(), 1);
-  display_->record(cmd_, session_->spp_done(), exposure_, swapchain_->image(index));
+  display_->record(cmd_, session_->spp_done(), exposure_, scene_.film.view, swapchain_->image(index));
   VK_CHECK(vkEndCommandBuffer(cmd_));
 
   VkSemaphore wait = image_acquired_.get();
@@ -492,6 +508,20 @@ void PreviewWindow::pace(int pass_spp, double pass_seconds, double period) {
   msamples_per_s_ = msamples_per_s_ > 0 ? 0.8 * msamples_per_s_ + 0.2 * ms : ms;
 }
 
+// With auto exposure: choose it again from the accumulation so far (a
+// readback) before each frame, until kAutoExposureSpp samples per pixel; then
+// print the choice and hold it.
+void PreviewWindow::follow_auto_exposure() {
+  if (auto_exposure_held_ || !exposure_choice_.automatic(scene_.film) || session_->spp_done() <= 0) return;
+  RenderResult result;
+  session_->read(result);
+  const Image image = image_from_render(result, /*with_variance=*/false);
+  const bool hold = session_->spp_done() >= kAutoExposureSpp;
+  exposure_choice_.forget_auto();
+  exposure_ = exposure_choice_.stops(scene_.film, image, hold ? &std::cerr : nullptr);
+  auto_exposure_held_ = hold;
+}
+
 void PreviewWindow::update_title(bool force) {
   const auto now = Clock::now();
   if (!force && now - last_title_ < std::chrono::milliseconds(250)) return;
@@ -526,6 +556,7 @@ void PreviewWindow::run() {
       glfwWaitEventsTimeout(0.1);
       continue;
     }
+    follow_auto_exposure();
     draw_frame();
     update_title(false);
     if (args_.frames > 0 && frames_shown_ >= args_.frames) break;
@@ -571,6 +602,7 @@ int run_preview_command(const PreviewArgs& args) {
       return 2;
     }
   }
+  parse_exposure(args.exposure);         // InputError (a bad --exposure): exit 2
   Scene scene = load_scene(args.scene);  // InputError: the CLI prints it, exit 2
   // Source conventions, up axis and framing, as `render` settles them.
   for (const std::string& note : complete_scene(scene, 0, args.width || args.height || scene.film.size_given).notes)

@@ -12,6 +12,7 @@ struct PreviewArgs {
   std::string screenshot;  // PNG written from what the window shows
   int device = -1;
   std::optional<int> width, height;
+  std::string exposure;  // stops or "auto", overriding film.exposure; empty = the scene's
 };
 
 // Returns the exit status. Without a display, without GLFW at build time, or

@@ -45,6 +45,10 @@ struct Camera {
   double fov_deg = 40.0;  // vertical field of view
 };
 
+// film.view: how display output (PNG, the preview) shows the linear render
+// (docs/view-transform.md). EXR output is never transformed.
+enum class ViewTransform { AgX, Standard };
+
 struct Film {
   int width = 640;
   int height = 360;
@@ -52,8 +56,10 @@ struct Film {
   // (otherwise a tall subject turns the default film upright).
   bool size_given = false;
   int spp = 64;
-  double exposure = 0.0;  // stops, applied to PNG output only
+  double exposure = 0.0;  // stops, applied to display output (PNG, preview) only
   Keyframes<double> exposure_keys;
+  bool exposure_auto = false;  // "exposure": "auto": chosen from the rendered image (docs/view-transform.md)
+  ViewTransform view = ViewTransform::AgX;
   uint32_t seed = 1;
 };
 

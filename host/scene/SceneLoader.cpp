@@ -382,7 +382,14 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
     s.film.width = f.integer("width", s.film.width, 1, 16384);
     s.film.height = f.integer("height", s.film.height, 1, 16384);
     s.film.spp = f.integer("spp", s.film.spp, 1, 1 << 24);
-    s.film.exposure = f.number_keyed("exposure", s.film.exposure, s.film.exposure_keys);
+    if (f.has("exposure") && f.raw("exposure").is_string()) {
+      const std::string e = f.string("exposure", "");
+      if (e != "auto") f.fail("exposure", "expected a number of stops, keys or \"auto\", got \"" + e + "\"");
+      s.film.exposure_auto = true;
+    } else {
+      s.film.exposure = f.number_keyed("exposure", s.film.exposure, s.film.exposure_keys);
+    }
+    s.film.view = f.choice("view", "agx", {"agx", "standard"}) == "agx" ? ViewTransform::AgX : ViewTransform::Standard;
     s.film.seed = static_cast<uint32_t>(f.integer("seed", static_cast<int>(s.film.seed), 0, 2147483647));
     f.finish();
   }

@@ -66,13 +66,17 @@ TEST_P(CliRender, WritesExrWithVarianceStatsAndSummary) {
 TEST_P(CliRender, PngIsSrgbWithExposure) {
   const std::string backend = GetParam();
   auto dir = temp_dir("png");
-  write_file(dir / "s.json", kScene);
+  // The standard view: exposure, clip, sRGB (AgX, the default, has its own tests:
+  // tests/unit/image_view_transform_test.cpp).
+  std::string standard = kScene;
+  standard.replace(standard.find("\"seed\": 3"), 9, "\"seed\": 3, \"view\": \"standard\"");
+  write_file(dir / "s.json", standard);
   CliResult a = run_cli("render " + (dir / "s.json").string() + " -o " + (dir / "a.png").string() + " --backend " + backend);
   ASSERT_EQ(a.status, 0) << a.err;
   Image img = read_image(dir / "a.png");  // decoded back to linear
   EXPECT_NEAR(img.at(0, 0, 1), 0.1, 0.004);
   // film.exposure = +1 stop doubles the PNG's linear values (EXR stays linear).
-  std::string brighter = kScene;
+  std::string brighter = standard;
   brighter.replace(brighter.find("\"seed\": 3"), 9, "\"seed\": 3, \"exposure\": 1");
   write_file(dir / "b.json", brighter);
   CliResult b = run_cli("render " + (dir / "b.json").string() + " -o " + (dir / "b.png").string() + " --backend " + backend);

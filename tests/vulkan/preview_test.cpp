@@ -15,6 +15,8 @@
 #include <gtest/gtest.h>
 
 #include "image/ImageIo.h"
+#include "scene/Scene.h"
+#include "shared/view_transform.h"
 #include "preview/DisplayPass.h"
 #include "preview/OrbitCamera.h"
 #include "support/TestSupport.h"
@@ -52,19 +54,21 @@ CliResult run_wrapped(const std::string& prefix, const std::string& args) {
 
 size_t count_lines(const std::string& s) { return size_t(std::count(s.begin(), s.end(), '\n')); }
 
-}  // namespace
-
 // The window shows N frames, the screenshot is what it showed, and that agrees
-// with `render` at the same total spp.
-TEST(Preview, ScreenshotUnderXvfbMatchesRender) {
+// with `render` at the same total spp, seen through the same view and exposure.
+void check_screenshot_matches_render(ViewTransform view, double exposure) {
   if (!on_path("xvfb-run")) GTEST_SKIP() << "xvfb-run is not installed (Debian package xvfb): no display to test on";
   auto dir = temp_dir("preview");
-  const fs::path shot = dir / "shot.png", ref = dir / "ref.exr";
+  const fs::path shot = dir / "shot.png", ref = dir / "ref.exr", scene = dir / "spheres.json";
   const std::string size = " --width 96 --height 54";
+  std::string text = read_file(kSpheres);
+  if (view == ViewTransform::Standard) text.replace(text.find("\"film\": {"), 9, "\"film\": {\"view\": \"standard\", ");
+  write_file(scene, text);
+  const std::string flags = exposure != 0.0 ? " --exposure " + std::to_string(exposure) : "";
 
   // Validation on even when run outside ctest: the preview must raise no messages.
   CliResult p = run_wrapped("PYROLUME_VALIDATION=1 xvfb-run -a",
-                            "preview " + kSpheres.string() + " --frames 16 --screenshot " + shot.string() + size);
+                            "preview " + scene.string() + " --frames 16 --screenshot " + shot.string() + size + flags);
   if (p.status == 2 && p.err.find("no GLFW") != std::string::npos)
     GTEST_SKIP() << "this build has no preview window (GLFW was not found at configure time)";
   ASSERT_EQ(p.status, 0) << p.err;
@@ -76,7 +80,7 @@ TEST(Preview, ScreenshotUnderXvfbMatchesRender) {
   ASSERT_GE(spp, 16);  // at least one sample per frame
   ASSERT_TRUE(fs::exists(shot));
 
-  CliResult r = run_cli("render " + kSpheres.string() + " -o " + ref.string() + " --variance --spp " +
+  CliResult r = run_cli("render " + scene.string() + " -o " + ref.string() + " --variance --spp " +
                         std::to_string(spp) + size);
   ASSERT_EQ(r.status, 0) << r.err;
 
@@ -87,16 +91,28 @@ TEST(Preview, ScreenshotUnderXvfbMatchesRender) {
   ASSERT_TRUE(want.has_variance());
   const double n = double(shown.pixel_count());
 
-  // The window shows clamp(mean · 2^exposure, 0, 1) (exposure 0 in this scene),
-  // sRGB-encoded to 8 bits. Per channel, the image means must agree within
-  //   4 · 2 · SE + q.
-  // SE = sqrt(Σ var_i) / n is the standard error of the render's image mean
-  // (var_i: its per-pixel variance of the mean, from --variance). The preview's
-  // mean has the same SE; the two share the RNG scheme, so they may be
-  // correlated, and SE(A − B) ≤ SE_A + SE_B = 2·SE holds whatever the
+  // What the window should show, display-linear: the view of mean · 2^exposure
+  // (standard: clamp(·, 0, 1); AgX: view_agx), per pixel.
+  const float scale = float(std::exp2(exposure));
+  Image shown_want = want;
+  for (int y = 0; y < want.height; ++y)
+    for (int x = 0; x < want.width; ++x) {
+      const glm::vec3 L(want.at(x, y, 0) * scale, want.at(x, y, 1) * scale, want.at(x, y, 2) * scale);
+      const glm::vec3 d = view == ViewTransform::Standard ? glm::clamp(L, 0.0f, 1.0f) : display::view_agx(L);
+      for (int c = 0; c < 3; ++c) shown_want.at(x, y, c) = d[c];
+    }
+  // The render's per-pixel variance of the mean, through the exposure.
+  for (float& v : want.variance) v *= scale * scale;
+
+  // Per channel, the image means must agree within 4 · 2 · SE + q (standard
+  // view). SE = sqrt(Σ var_i) / n is the standard error of the render's image
+  // mean (var_i: its per-pixel variance of the mean, from --variance). The
+  // preview's mean has the same SE; the two share the RNG scheme, so they may
+  // be correlated, and SE(A − B) ≤ SE_A + SE_B = 2·SE holds whatever the
   // correlation. Clamping is 1-Lipschitz, so it cannot raise the SE.
   // q bounds the 8-bit rounding: ≤ 0.5/255 in the encoded value, times the
   // steepest slope of the sRGB decode (2.4/1.055 at V = 1) in linear units.
+  // AgX is not linear, so only the per-pixel test below applies to it.
   const double q = 0.5 / 255.0 * 2.4 / 1.055;
   double brightest = 0.0;
   for (int c = 0; c < 3; ++c) {
@@ -104,20 +120,25 @@ TEST(Preview, ScreenshotUnderXvfbMatchesRender) {
     for (int y = 0; y < shown.height; ++y)
       for (int x = 0; x < shown.width; ++x) {
         sum_shown += shown.at(x, y, c);
-        sum_want += std::clamp(double(want.at(x, y, c)), 0.0, 1.0);
+        sum_want += shown_want.at(x, y, c);
         sum_var += want.var_at(x, y, c);
       }
     const double mean_shown = sum_shown / n, mean_want = sum_want / n, se = std::sqrt(sum_var) / n;
     ASSERT_TRUE(std::isfinite(se)) << "channel " << c;
-    EXPECT_NEAR(mean_shown, mean_want, 8.0 * se + q) << "channel " << c << ", SE " << se << ", spp " << spp;
+    if (view == ViewTransform::Standard)
+      EXPECT_NEAR(mean_shown, mean_want, 8.0 * se + q) << "channel " << c << ", SE " << se << ", spp " << spp;
     brightest = std::max(brightest, mean_shown);
   }
   EXPECT_GT(brightest, 0.05) << "the screenshot is (nearly) black";
 
   // Per pixel, so a flipped or channel-swapped window cannot pass on the means:
-  // each pixel within 4 · 2 · sigma_i + q, sigma_i² pooled over the 3×3
+  // each pixel within 4 · 2 · sigma + q, sigma² pooled over the 3×3
   // neighbourhood (a per-pixel variance from a few dozen samples can be far
   // too small, e.g. 0 where no sample happened to hit a rare bright path).
+  // Through AgX, which mixes the channels, the band is where the view takes
+  // the corners of the box mean ± 8·sigma (per channel): q plus the largest
+  // change of the channel over those 8 corners, plus the GLSL-vs-C++
+  // difference that view_transform_gpu_test allows (1e-3 encoded).
   // Allow the 0.25 % of pixel channels a correct renderer may miss (Mitsuba's rule).
   auto pooled_var = [&](int x, int y, int c) {
     double v = 0;
@@ -128,14 +149,37 @@ TEST(Preview, ScreenshotUnderXvfbMatchesRender) {
   };
   int outliers = 0;
   for (int y = 0; y < shown.height; ++y)
-    for (int x = 0; x < shown.width; ++x)
-      for (int c = 0; c < 3; ++c) {
-        const double diff = std::abs(shown.at(x, y, c) - std::clamp(double(want.at(x, y, c)), 0.0, 1.0));
-        if (diff > 8.0 * std::sqrt(pooled_var(x, y, c)) + q) ++outliers;
+    for (int x = 0; x < shown.width; ++x) {
+      glm::vec3 band;
+      if (view == ViewTransform::Standard) {
+        for (int c = 0; c < 3; ++c) band[c] = float(8.0 * std::sqrt(pooled_var(x, y, c)) + q);
+      } else {
+        const glm::vec3 L(want.at(x, y, 0) * scale, want.at(x, y, 1) * scale, want.at(x, y, 2) * scale);
+        const glm::vec3 d(8.0 * std::sqrt(pooled_var(x, y, 0)), 8.0 * std::sqrt(pooled_var(x, y, 1)),
+                          8.0 * std::sqrt(pooled_var(x, y, 2)));
+        const glm::vec3 centre = display::view_agx(L);
+        band = glm::vec3(float(q + 1e-3 * 2.4 / 1.055));
+        glm::vec3 spread(0.0f);
+        for (int corner = 0; corner < 8; ++corner) {
+          const glm::vec3 s(corner & 1 ? 1.0f : -1.0f, corner & 2 ? 1.0f : -1.0f, corner & 4 ? 1.0f : -1.0f);
+          spread = glm::max(spread, glm::abs(display::view_agx(L + s * d) - centre));
+        }
+        band += spread;
       }
+      for (int c = 0; c < 3; ++c)
+        if (std::abs(shown.at(x, y, c) - shown_want.at(x, y, c)) > band[c]) ++outliers;
+    }
   EXPECT_LE(outliers, int(0.0025 * n * 3)) << outliers << " of " << n * 3 << " pixel channels differ";
   fs::remove_all(dir);
 }
+
+}  // namespace
+
+// The standard view, with --exposure: the window shows clamp(mean · 2^EV, 0, 1).
+TEST(Preview, ScreenshotUnderXvfbMatchesRender) { check_screenshot_matches_render(ViewTransform::Standard, -1.0); }
+
+// The default view: the window shows AgX of the mean.
+TEST(Preview, AgxScreenshotMatchesRender) { check_screenshot_matches_render(ViewTransform::AgX, 0.0); }
 
 TEST(Preview, NoDisplayIsOneLineAndStatus2) {
   // Without a display the window cannot open: one line that points at `render`

@@ -1,0 +1,112 @@
+#include "image/DisplayTransform.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "shared/view_transform.h"
+#include "util/Error.h"
+
+namespace pyrolume {
+
+namespace {
+
+display::uint view_id(ViewTransform view) {
+  return view == ViewTransform::Standard ? display::VIEW_STANDARD : display::VIEW_AGX;
+}
+
+// BT.709 / sRGB relative luminance of linear RGB.
+double luminance(const float* rgb) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }
+
+// The scene-linear grey value that `view` shows at the encoded display level
+// `level`: bisection in log2 over ±kAutoExposureLimit stops (every view is
+// non-decreasing on greys; tests/unit/image_view_transform_test.cpp checks).
+double grey_for_display_level(double level, ViewTransform view) {
+  double lo = -kAutoExposureLimit, hi = kAutoExposureLimit;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    const float g = float(std::exp2(mid));
+    (display_encode(glm::vec3(g), view).y < level ? lo : hi) = mid;
+  }
+  return std::exp2(0.5 * (lo + hi));
+}
+
+}  // namespace
+
+glm::vec3 display_encode(glm::vec3 exposed, ViewTransform view) { return display::view_display(exposed, view_id(view)); }
+
+std::vector<unsigned char> display_rgb8(const Image& img, double exposure_stops, ViewTransform view) {
+  const double scale = std::exp2(exposure_stops);
+  const display::uint id = view_id(view);
+  std::vector<unsigned char> bytes(img.rgb.size());
+  for (size_t i = 0; i + 2 < img.rgb.size(); i += 3) {
+    // Scaled in double, rounded once to float: the arithmetic PNG output always had.
+    const glm::vec3 exposed(float(double(img.rgb[i]) * scale), float(double(img.rgb[i + 1]) * scale),
+                            float(double(img.rgb[i + 2]) * scale));
+    const glm::vec3 v = display::view_display(exposed, id);
+    for (int c = 0; c < 3; ++c) bytes[i + size_t(c)] = static_cast<unsigned char>(std::lround(255.0f * v[c]));
+  }
+  return bytes;
+}
+
+AutoExposure auto_exposure(const Image& img, ViewTransform view) {
+  std::vector<double> lit;
+  lit.reserve(img.pixel_count());
+  for (size_t i = 0; i + 2 < img.rgb.size(); i += 3) {
+    const double y = luminance(&img.rgb[i]);
+    if (std::isfinite(y) && y > 0.0) lit.push_back(y);
+  }
+  AutoExposure a;
+  a.lit_pixels = lit.size();
+  if (lit.empty()) return a;
+  // Nearest rank: the smallest value with at least p % of the lit pixels at or below it.
+  const size_t rank = size_t(std::ceil(kAutoExposurePercentile / 100.0 * double(lit.size())));
+  const size_t k = std::clamp<size_t>(rank, 1, lit.size()) - 1;
+  std::nth_element(lit.begin(), lit.begin() + std::ptrdiff_t(k), lit.end());
+  a.percentile_luminance = lit[k];
+  const double target = grey_for_display_level(kAutoExposureLevel, view);
+  a.stops = std::clamp(std::log2(target / a.percentile_luminance), -kAutoExposureLimit, kAutoExposureLimit);
+  return a;
+}
+
+ExposureOverride parse_exposure(const std::string& text, const std::string& flag) {
+  ExposureOverride e;
+  if (text.empty()) return e;
+  if (text == "auto") {
+    e.automatic = true;
+    return e;
+  }
+  size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || !std::isfinite(v))
+    throw input_error(flag, "", "expected a number of stops or \"auto\", got \"" + text + "\"");
+  e.stops = v;
+  return e;
+}
+
+double DisplayExposure::stops(const Film& film, const Image& image, std::ostream* log) {
+  if (cli_.stops) return *cli_.stops;
+  if (!automatic(film)) return film.exposure;
+  if (!auto_) {
+    auto_ = auto_exposure(image, film.view);
+    if (log) *log << auto_exposure_line(*auto_) << "\n";
+  }
+  return auto_->stops;
+}
+
+std::string auto_exposure_line(const AutoExposure& a) {
+  char line[160];
+  if (a.lit_pixels == 0)
+    std::snprintf(line, sizeof line, "pyrolume: auto exposure: %+.2f EV (the image is black)", a.stops);
+  else
+    std::snprintf(line, sizeof line, "pyrolume: auto exposure: %+.2f EV (%gth percentile luminance %.4g of %zu lit pixels)",
+                  a.stops, kAutoExposurePercentile, a.percentile_luminance, a.lit_pixels);
+  return line;
+}
+
+}  // namespace pyrolume
