@@ -30,8 +30,10 @@ struct EnvSample {
   vec3 radiance;  // scale included
 };
 
-// Map (u, v) of a world direction: Rz(−rotation)·d, then u = 0.5 − φ/2π, v = θ/π.
-vec2 env_direction_to_uv(GpuEnvironment env, vec3 d) {
+// Map (u, v) of a world direction: Rz(−rotation)·d (after Rx(90°), d.x, −d.z,
+// d.y, in a Y-up scene), then u = 0.5 − φ/2π, v = θ/π.
+vec2 env_direction_to_uv(GpuEnvironment env, vec3 world_d) {
+  vec3 d = env.size.w != 0u ? vec3(world_d.x, -world_d.z, world_d.y) : world_d;
   float c = env.transform.x, s = env.transform.y;
   float x = c * d.x + s * d.y;
   float y = -s * d.x + c * d.y;
@@ -47,7 +49,8 @@ vec3 env_uv_to_direction(GpuEnvironment env, vec2 uv) {
   float st = sin(theta);
   float x = st * cos(phi), y = st * sin(phi);
   float c = env.transform.x, s = env.transform.y;
-  return vec3(c * x - s * y, s * x + c * y, cos(theta));
+  vec3 d = vec3(c * x - s * y, s * x + c * y, cos(theta));
+  return env.size.w != 0u ? vec3(d.x, d.z, -d.y) : d;  // Rx(−90°) back to a Y-up world
 }
 
 // Bilinear between texel centres, wrapping in u, clamping in v (no scale).

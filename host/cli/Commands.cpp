@@ -178,6 +178,8 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
 
   // Auto exposure comes from the first frame rendered and holds for the rest (no flicker).
   DisplayExposure exposure(parse_exposure(args.exposure));
+  const std::string ext = lower_extension(output);
+  bool look_warned = false;
   int rendered = 0, skipped = 0, missing = 0;
   double load_seconds = 0.0, render_seconds = 0.0;
   for (int frame : range.frames()) {
@@ -221,9 +223,15 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
       break;
     }
     const Image image = image_from_render(result, args.variance);
-    write_image(out.image, image, exposure.stops(frame_scene.film, image, display_log(out.image)), frame_scene.film.view);
+    const double stops = exposure.stops(frame_scene.film, image, display_log(out.image));
+    write_image(out.image, image, stops, frame_scene.film.view);
     if (!out.stats.empty()) write_stats(out.stats, args, out.image, result, frame);
     print_warnings(result, tag);
+    if (!look_warned)  // once per sequence, at the first frame it concerns
+      if (const std::string w = film_look_warning(image, stops, frame_scene.film.view, ext == ".png"); !w.empty()) {
+        std::cerr << "pyrolume: warning: " << tag << w << "\n";
+        look_warned = true;
+      }
     print_summary(out.image, result);
     ++rendered;
     load_seconds += result.load_seconds;
@@ -257,6 +265,8 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   const double aspect =
       double(args.width.value_or(scene.film.width)) / double(args.height.value_or(scene.film.height));
   for (const std::string& note : setup.notes) std::cerr << "pyrolume: note: " << note << "\n";
+  if (const std::string w = nothing_emits(scene); !w.empty())
+    std::cerr << "pyrolume: warning: " << scene.file.string() << ": " << w << "\n";
   if (!scene.camera.framed_automatically)
     if (const std::string w = nothing_in_view(scene.camera, setup.boxes, aspect); !w.empty())
       std::cerr << "pyrolume: warning: " << scene.file.string() << ": " << w << "\n";
@@ -340,8 +350,12 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   DisplayExposure exposure(parse_exposure(args.exposure));
   auto save = [&](const RenderResult& result, bool keep_checkpoint) {
     Image image = image_from_render(result, args.variance);
-    write_image(output, image, exposure.stops(scene.film, image, display_log(output)), scene.film.view);
+    const double stops = exposure.stops(scene.film, image, display_log(output));
+    write_image(output, image, stops, scene.film.view);
     if (!args.stats.empty()) write_stats(args.stats, args, output, result, std::nullopt);
+    if (result.spp >= settings.spp)  // a finished render: one the user will look at
+      if (const std::string w = film_look_warning(image, stops, scene.film.view, ext == ".png"); !w.empty())
+        std::cerr << "pyrolume: warning: " << output.string() << ": " << w << "\n";
     bool checkpointed = false;
     if (result.spp < settings.spp && keep_checkpoint && !result.state.data.empty())
       checkpointed = save_checkpoint(result.state);

@@ -49,6 +49,34 @@ std::vector<unsigned char> display_rgb8(const Image& img, double exposure_stops,
   return bytes;
 }
 
+std::string film_look_warning(const Image& img, double exposure_stops, ViewTransform view, bool clips) {
+  const std::vector<unsigned char> bytes = display_rgb8(img, exposure_stops, view);
+  size_t black = 0, clipped = 0;
+  const size_t pixels = bytes.size() / 3;
+  for (size_t i = 0; i + 2 < bytes.size(); i += 3) {
+    const unsigned char hi = std::max({bytes[i], bytes[i + 1], bytes[i + 2]});
+    black += hi <= 1;
+    clipped += hi == 255;
+  }
+  if (pixels == 0) return "";
+  char line[320];
+  if (double(black) >= kBlackFilmFraction * double(pixels)) {
+    std::snprintf(line, sizeof line,
+                  "the image is almost entirely black (%.1f %% of pixels at most 1/255 at exposure %+.2f EV): raise "
+                  "--exposure (or use --exposure auto) or emission.scale, or check that something is in view and lit",
+                  100.0 * double(black) / double(pixels), exposure_stops);
+    return line;
+  }
+  if (clips && double(clipped) >= kClippedFilmFraction * double(pixels)) {
+    std::snprintf(line, sizeof line,
+                  "the image is almost entirely clipped (%.1f %% of pixels have a channel at 255 at exposure %+.2f "
+                  "EV): lower --exposure (or use --exposure auto)",
+                  100.0 * double(clipped) / double(pixels), exposure_stops);
+    return line;
+  }
+  return "";
+}
+
 AutoExposure auto_exposure(const Image& img, ViewTransform view) {
   std::vector<double> lit;
   lit.reserve(img.pixel_count());

@@ -64,6 +64,16 @@ class DisplayExposure {
   std::optional<AutoExposure> auto_;
 };
 
+// A render a user will surely be disappointed by, judged on what the display
+// shows (exposure and view applied): "" unless it is almost entirely black
+// (at least kBlackFilmFraction of the pixels have every channel <= 1/255) or,
+// for display output (`clips`: PNG), almost entirely clipped (at least
+// kClippedFilmFraction of the pixels have a channel at 255). Otherwise one line
+// saying so and what to change.
+inline constexpr double kBlackFilmFraction = 0.995;
+inline constexpr double kClippedFilmFraction = 0.95;
+std::string film_look_warning(const Image& img, double exposure_stops, ViewTransform view, bool clips);
+
 // "pyrolume: auto exposure: +N.NN EV (...)": what was chosen and from what.
 std::string auto_exposure_line(const AutoExposure& a);
 

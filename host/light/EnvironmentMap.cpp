@@ -22,20 +22,21 @@ int wrap(int i, int n) {
 
 }  // namespace
 
-EnvironmentMap EnvironmentMap::load(const std::filesystem::path& file, double scale, double rotation_deg) {
+EnvironmentMap EnvironmentMap::load(const std::filesystem::path& file, double scale, double rotation_deg,
+                                    bool zenith_y) {
   std::error_code ec;
   if (!std::filesystem::exists(file, ec))
     throw input_error(file.string(), "", "environment map not found");
   Image img = read_image(file);  // names the file in its InputError
   if (img.width < 1 || img.height < 1) throw input_error(file.string(), "", "environment map has no pixels");
   try {
-    return from_image(img, scale, rotation_deg, file.string());
+    return from_image(img, scale, rotation_deg, zenith_y, file.string());
   } catch (const std::invalid_argument& e) {
     throw input_error(file.string(), "", e.what());
   }
 }
 
-EnvironmentMap EnvironmentMap::from_image(const Image& img, double scale, double rotation_deg,
+EnvironmentMap EnvironmentMap::from_image(const Image& img, double scale, double rotation_deg, bool zenith_y,
                                           const std::string& name) {
   if (img.width < 1 || img.height < 1 || img.rgb.size() != img.pixel_count() * 3)
     throw std::invalid_argument("environment map: empty image");
@@ -47,6 +48,7 @@ EnvironmentMap EnvironmentMap::from_image(const Image& img, double scale, double
   e.height_ = img.height;
   e.scale_ = scale;
   e.rotation_deg_ = rotation_deg;
+  e.zenith_y_ = zenith_y;
   const double r = rotation_deg * kPi / 180.0;
   e.cos_rot_ = std::cos(r);
   e.sin_rot_ = std::sin(r);
@@ -115,8 +117,9 @@ void EnvironmentMap::build_distribution() {
   }
 }
 
-glm::dvec2 EnvironmentMap::direction_to_uv(const glm::dvec3& dir) const {
-  // Into the map's frame: Rz(−rotation)·dir.
+glm::dvec2 EnvironmentMap::direction_to_uv(const glm::dvec3& world_dir) const {
+  // Into the map's frame: Rz(−rotation)·Rx(90°)·dir for a Y-up scene, Rz(−rotation)·dir for a Z-up one.
+  const glm::dvec3 dir = zenith_y_ ? glm::dvec3(world_dir.x, -world_dir.z, world_dir.y) : world_dir;
   const double x = cos_rot_ * dir.x + sin_rot_ * dir.y;
   const double y = -sin_rot_ * dir.x + cos_rot_ * dir.y;
   double u = 0.5 - std::atan2(y, x) / (2.0 * kPi);
@@ -131,7 +134,8 @@ glm::dvec3 EnvironmentMap::uv_to_direction(const glm::dvec2& uv) const {
   const double theta = kPi * uv.y, phi = kPi - 2.0 * kPi * uv.x;
   const double s = std::sin(theta);
   const double x = s * std::cos(phi), y = s * std::sin(phi);
-  return {cos_rot_ * x - sin_rot_ * y, sin_rot_ * x + cos_rot_ * y, std::cos(theta)};
+  const glm::dvec3 d(cos_rot_ * x - sin_rot_ * y, sin_rot_ * x + cos_rot_ * y, std::cos(theta));
+  return zenith_y_ ? glm::dvec3(d.x, d.z, -d.y) : d;  // Rx(−90°) back to a Y-up world
 }
 
 glm::dvec3 EnvironmentMap::lookup_uv(const glm::dvec2& uv) const {
@@ -194,7 +198,7 @@ std::vector<float> EnvironmentMap::gpu_texels() const {
 gpu::GpuEnvironment EnvironmentMap::gpu_header() const {
   gpu::GpuEnvironment g{};
   g.transform = gpu::vec4(float(cos_rot_), float(sin_rot_), float(scale_), float(power_));
-  g.size = gpu::uvec4(uint32_t(width_), uint32_t(height_), has_distribution() ? 1u : 0u, 0u);
+  g.size = gpu::uvec4(uint32_t(width_), uint32_t(height_), has_distribution() ? 1u : 0u, zenith_y_ ? 1u : 0u);
   return g;
 }
 

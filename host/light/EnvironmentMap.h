@@ -41,11 +41,15 @@ class EnvironmentMap {
 
   // Reads a lat-long map (EXR; Radiance .hdr and 8-bit images via read_image).
   // Missing file, unreadable or not an image → InputError "FILE: REASON".
-  static EnvironmentMap load(const std::filesystem::path& file, double scale = 1.0, double rotation_deg = 0.0);
+  // zenith_y: the scene is Y up (scene up_axis "y"); the map's zenith, +Z in
+  // its own frame, is then world +Y: world d is looked up at (d.x, −d.z, d.y)
+  // (a quarter turn about +X), before the rotation about the zenith.
+  static EnvironmentMap load(const std::filesystem::path& file, double scale = 1.0, double rotation_deg = 0.0,
+                             bool zenith_y = false);
   // From an image already in memory (tests, generated skies). Negative and
   // non-finite texel values are set to 0 (counted in sanitized_texels()).
   // Throws std::invalid_argument for an empty image or a non-finite / negative scale.
-  static EnvironmentMap from_image(const Image& img, double scale = 1.0, double rotation_deg = 0.0,
+  static EnvironmentMap from_image(const Image& img, double scale = 1.0, double rotation_deg = 0.0, bool zenith_y = false,
                                    const std::string& name = "environment");
 
   int width() const { return width_; }
@@ -104,6 +108,7 @@ class EnvironmentMap {
   int width_ = 0, height_ = 0;
   double scale_ = 1.0, rotation_deg_ = 0.0;
   double cos_rot_ = 1.0, sin_rot_ = 0.0;
+  bool zenith_y_ = false;
   std::vector<float> rgb_;      // W·H·3, row 0 = top
   std::vector<float> pdf_uv_;   // W·H
   std::vector<float> cdf_;      // see gpu_cdf()

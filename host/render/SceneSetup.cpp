@@ -142,6 +142,14 @@ std::string nothing_in_view(const Camera& camera, const std::vector<WorldBox>& b
          " lie outside it); leave out camera.position and camera.look_at to frame the scene automatically";
 }
 
+std::string nothing_emits(const Scene& scene) {
+  if (scene.environment || scene.background != glm::dvec3(0.0)) return "";
+  for (const Medium& m : scene.media)
+    if (m.emission.emits()) return "";
+  return "nothing in the scene gives light (no medium emits, the background is black and there is no environment), "
+         "so the image will be black: add background.rgb or an environment to light smoke";
+}
+
 SceneSetup complete_scene(Scene& scene, int frame, bool film_size_fixed) {
   SceneSetup out;
   std::optional<UpAxis> source_up;

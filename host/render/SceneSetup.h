@@ -37,6 +37,10 @@ SceneSetup complete_scene(Scene& scene, int frame, bool film_size_fixed);
 // fov_deg: every corner inside the picture with a 5 % margin.
 Camera framing_camera(const std::vector<WorldBox>& boxes, UpAxis up, double fov_deg, double aspect);
 
+// "" when something in the scene gives light (an emitting medium, a
+// background or an environment); otherwise a one-line reason.
+std::string nothing_emits(const Scene& scene);
+
 // "" when some box is in the camera's view; otherwise a one-line reason.
 std::string nothing_in_view(const Camera& camera, const std::vector<WorldBox>& boxes, double aspect);
 

@@ -15,7 +15,8 @@ namespace pyrolume::gpu {
 
 // A lat-long environment map (32 bytes). +Z up, Blender's equirectangular
 // convention: map direction (sinθ cosφ, sinθ sinφ, cosθ) with θ = π·v, φ = π − 2π·u,
-// v = 0 the top row. World direction d is looked up at Rz(−rotation)·d.
+// v = 0 the top row. World direction d is looked up at Rz(−rotation)·d, or
+// in a Y-up scene at Rz(−rotation)·(d.x, −d.z, d.y) (the zenith on world +Y).
 // Buffers (names the includer declares, see lights.glsl):
 //   env_texels[W·H]: vec4(r, g, b, p_uv), row 0 = top; p_uv = the piecewise-constant
 //                    (u, v) sampling density of that texel; radiance = rgb × scale.
@@ -23,7 +24,7 @@ namespace pyrolume::gpu {
 //                    per row (row j at (H + 1) + j·(W + 1)); each 0 … 1.
 struct GpuEnvironment {
   vec4 transform;  // x: cos(rotation), y: sin(rotation), z: scale, w: power ≈ ∫ Y(L) dω (scale included)
-  uvec4 size;      // x: width W, y: height H, z: 1 if it can be sampled (else pdf 0), w: 0
+  uvec4 size;      // x: width W, y: height H, z: 1 if it can be sampled (else pdf 0), w: 1 if the zenith is world +Y (else +Z)
 };
 
 // An emissive grid medium's emission CDF as seen from a receiver (160 bytes;

@@ -377,3 +377,25 @@ TEST(EnvironmentMap, GeneratedSkyAssetHasItsSunWhereGenSkyPutsIt) {
     if (glm::dot(env.sample({U(rng), U(rng)}).dir, sun) > std::cos(3.0 * kPi / 180.0)) ++on_sun;
   EXPECT_GT(on_sun, 40);
 }
+
+// A Y-up scene's map: world d is the Z-up map's (d.x, −d.z, d.y), so the top
+// row is world +Y; lookups, pdfs and samples all go through the same turn.
+TEST(EnvironmentMap, ZenithOnWorldYIsAQuarterTurnAboutX) {
+  const EnvironmentMap z_up = EnvironmentMap::from_image(test_map(64, 32), 1.5, 37.0);
+  const EnvironmentMap y_up = EnvironmentMap::from_image(test_map(64, 32), 1.5, 37.0, true);
+  EXPECT_NEAR(y_up.direction_to_uv({0, 1, 0}).y, 0.0, 1e-12);  // the zenith row
+  EXPECT_NEAR(y_up.direction_to_uv({0, -1, 0}).y, 1.0, 1e-12);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  for (int n = 0; n < 1000; ++n) {
+    const glm::dvec3 d = glm::normalize(glm::dvec3(U(rng), U(rng), U(rng)));
+    const glm::dvec3 turned(d.x, -d.z, d.y);
+    const glm::dvec2 uv = y_up.direction_to_uv(d);
+    ASSERT_NEAR(glm::distance(uv, z_up.direction_to_uv(turned)), 0.0, 1e-12);
+    ASSERT_NEAR(glm::distance(y_up.uv_to_direction(uv), d), 0.0, 1e-9);  // and back
+    ASSERT_NEAR(y_up.pdf(d), z_up.pdf(turned), 1e-9 * z_up.pdf(turned));
+    ASSERT_NEAR(glm::distance(y_up.radiance(d), z_up.radiance(turned)), 0.0, 1e-9);
+  }
+  // The turn is not its own inverse: a map that undid it the wrong way is caught.
+  EXPECT_GT(glm::distance(y_up.direction_to_uv({0, 0, 1}), z_up.direction_to_uv({0, 0, 1})), 0.1);
+}

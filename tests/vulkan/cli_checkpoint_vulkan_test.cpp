@@ -114,6 +114,7 @@ TEST(CliLimitsVulkan, GridPastTheDevicesTextureLimitIsBadInput) {
   auto dir = temp_dir("cli-wide");
   write_two_voxels_vdb(dir / "wide.vdb", {20000, 1, 1});  // past any GPU's 3D limit (16384 at most today)
   write_file(dir / "s.json", R"({"film": {"width": 4, "height": 4, "spp": 1},
+    "background": {"rgb": [0.1, 0.1, 0.1]},
     "media": [{"name": "wide", "type": "vdb", "file": "wide.vdb", "source": "houdini", "sigma_a": [1, 1, 1], "sigma_s": [0, 0, 0]}]})");
   CliResult r = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "o.exr"));
   EXPECT_EQ(r.status, 2) << r.err;

@@ -269,6 +269,11 @@ TEST(LightGpu, SkewedGridAndRotatedSkyMatchTheCpu) {
   check(env, cdf.clustered(3), 4);
 }
 
+TEST(LightGpu, YUpSkyMatchesTheCpu) {
+  EnvironmentMap env = EnvironmentMap::from_image(sky(128, 64), 2.0, 30.0, /*zenith_y=*/true);
+  check(env, skewed_fire().clustered(16), 5);
+}
+
 TEST(LightGpu, DemoFireMatchesTheCpu) {
   const Scene scene = load_scene(std::filesystem::path(PYROLUME_SOURCE_DIR) / "assets/scenes/fire.json");
   const StoredVolume vol = load_stored_volume(scene.media.at(0));

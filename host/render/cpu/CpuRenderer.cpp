@@ -544,7 +544,8 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   std::optional<EnvironmentMap> environment;
   if (scene.environment)
     environment = EnvironmentMap::load(scene.environment->file, scene.environment->scale,
-                                       scene.environment->rotation_deg);
+                                       scene.environment->rotation_deg,
+                                       scene.up_axis.value_or(UpAxis::Z) == UpAxis::Y);
 
   const int W = settings.width, H = settings.height;
   const int max_depth = std::max(0, scene.integrator.max_depth);

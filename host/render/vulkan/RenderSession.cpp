@@ -326,7 +326,8 @@ void RenderSession::create_environment(const Scene& scene) {
   gpu::GpuEnvironment header{};
   if (scene.environment) {
     EnvironmentMap env = EnvironmentMap::load(scene.environment->file, scene.environment->scale,
-                                              scene.environment->rotation_deg);
+                                              scene.environment->rotation_deg,
+                                              scene.up_axis.value_or(UpAxis::Z) == UpAxis::Y);
     texels = env.gpu_texels();
     cdf = env.gpu_cdf();
     header = env.gpu_header();
