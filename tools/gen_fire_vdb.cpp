@@ -198,9 +198,10 @@ openvdb::FloatGrid::Ptr make_grid(const std::string& name, double voxel, const o
   return grid;
 }
 
-int usage() {
-  std::cerr << "usage: gen_fire_vdb OUT.vdb [--resolution N] [--seed S] [--time T] [--sparse] [--float]\n";
-  return 2;
+// To stderr with status 2 for a bad command line; to stdout with 0 for --help.
+int usage(bool asked = false) {
+  (asked ? std::cout : std::cerr) << "usage: gen_fire_vdb OUT.vdb [--resolution N] [--seed S] [--time T] [--sparse] [--float]\n";
+  return asked ? 0 : 2;
 }
 
 }  // namespace
@@ -212,6 +213,7 @@ int main(int argc, char** argv) {
     const std::string a = argv[i];
     auto next = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
     const char* v = nullptr;
+    if (a == "--help" || a == "-h") return usage(true);
     if (a == "--resolution" && (v = next())) prm.resolution = std::atoi(v);
     else if (a == "--seed" && (v = next())) prm.seed = uint32_t(std::strtoul(v, nullptr, 10));
     else if (a == "--time" && (v = next())) prm.time = std::atof(v);

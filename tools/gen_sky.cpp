@@ -69,17 +69,20 @@ struct Sky {
   }
 };
 
-int usage() {
-  std::fprintf(stderr,
+// To stderr with status 2 for a bad command line; to stdout with 0 for --help.
+int usage(bool asked = false) {
+  std::fprintf(asked ? stdout : stderr,
                "usage: gen_sky OUT.exr [--width W] [--height H] [--sun-elevation DEG] [--sun-azimuth DEG] "
                "[--sun-radiance L] [--float]\n");
-  return 2;
+  return asked ? 0 : 2;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2) return usage();
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") return usage(true);
+  if (argc < 2 || argv[1][0] == '-') return usage();  // the first argument is the output, never an option
   std::string out = argv[1];
   int W = 512, H = 256;
   bool as_float = false;

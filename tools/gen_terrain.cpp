@@ -25,6 +25,10 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
+    if (a == "--help" || a == "-h") {
+      std::printf("usage: gen_terrain [--out DIR] [--seed S] [--grid N] [--texture N]\n");
+      return 0;
+    }
     try {
       if (a == "--out")
         out = value();
