@@ -38,20 +38,24 @@ openvdb::FloatGrid::Ptr build(const FloatGridSpec& spec) {
   return g;
 }
 
-std::filesystem::path write_grids(const std::filesystem::path& file, const openvdb::GridPtrVec& grids) {
+std::filesystem::path write_grids(const std::filesystem::path& file, const openvdb::GridPtrVec& grids,
+                                  const FileMetadata& metadata = {}) {
   openvdb::io::File f(file.string());
-  f.write(grids);
+  openvdb::MetaMap meta;
+  for (const auto& [key, value] : metadata) meta.insertMeta(key, openvdb::StringMetadata(value));
+  f.write(grids, meta);
   f.close();
   return file;
 }
 
 }  // namespace
 
-std::filesystem::path write_vdb(const std::filesystem::path& file, const std::vector<FloatGridSpec>& grids) {
+std::filesystem::path write_vdb(const std::filesystem::path& file, const std::vector<FloatGridSpec>& grids,
+                                const FileMetadata& metadata) {
   ensure_openvdb();
   openvdb::GridPtrVec out;
   for (const FloatGridSpec& spec : grids) out.push_back(build(spec));
-  return write_grids(file, out);
+  return write_grids(file, out, metadata);
 }
 
 std::filesystem::path write_two_voxels_vdb(const std::filesystem::path& file, const glm::ivec3& far) {

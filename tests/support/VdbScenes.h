@@ -22,6 +22,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -92,8 +93,12 @@ inline FloatGridSpec make_empty_grid(const std::string& name, const Lattice& l =
   return make_float_grid(name, l, VoxelBox{{0, 0, 0}, {-1, -1, -1}}, [](int, int, int) { return 0.0f; });
 }
 
+// File-level string metadata, as simulators write it ("creator", ...).
+using FileMetadata = std::vector<std::pair<std::string, std::string>>;
+
 // Writes the grids, in order, to one .vdb file; returns `file`.
-std::filesystem::path write_vdb(const std::filesystem::path& file, const std::vector<FloatGridSpec>& grids);
+std::filesystem::path write_vdb(const std::filesystem::path& file, const std::vector<FloatGridSpec>& grids,
+                                const FileMetadata& metadata = {});
 
 // "density" with two active voxels of value 1, at index (0, 0, 0) and at
 // `far`, on OpenVDB's default unit transform: a tiny sparse grid whose dense

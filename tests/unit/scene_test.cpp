@@ -66,6 +66,41 @@ TEST(Scene, DesignExampleParses) {
   EXPECT_EQ(s.shapes[0].texture, std::filesystem::path("/scenes/rock.png"));
 }
 
+// What a scene leaves out: the blackbody normalisation is stefan_boltzmann, a
+// vdb medium glows from its grid, a homogeneous one does not; "seed" is still
+// read, as "chromaticity"; the camera is framed automatically until the file
+// places it; the film remembers whether its size was written.
+TEST(Scene, DefaultsForTheShortestFile) {
+  const Scene s = parse_scene(R"({"media": [{"type": "vdb", "file": "f.vdb"},
+    {"type": "homogeneous", "bounds": {"sphere": {"center": [0, 0, 0], "radius": 1}}},
+    {"type": "homogeneous", "bounds": {"sphere": {"center": [0, 0, 0], "radius": 1}},
+     "emission": {"temperature_k": 1500, "blackbody": "seed"}},
+    {"type": "homogeneous", "bounds": {"sphere": {"center": [0, 0, 0], "radius": 1}},
+     "emission": {"temperature_k": 1500}}]})", "s.json");
+  EXPECT_EQ(s.media[0].source, VolumeSource::Auto);
+  EXPECT_TRUE(s.media[0].emission.is_grid);
+  EXPECT_FALSE(s.media[0].given.emission);
+  EXPECT_FALSE(s.media[1].emission.emits());
+  EXPECT_EQ(s.media[2].emission.blackbody, BlackbodyMode::Seed);
+  EXPECT_EQ(s.media[3].emission.blackbody, BlackbodyMode::StefanBoltzmann);
+  EXPECT_TRUE(s.camera.framed_automatically);
+  EXPECT_FALSE(s.up_axis.has_value());
+  EXPECT_FALSE(s.film.size_given);
+
+  const Scene t = parse_scene(R"({"up_axis": "z", "camera": {"fov_deg": 30}, "film": {"height": 100},
+    "media": [{"type": "vdb", "file": "f.vdb", "source": "houdini", "temperature": {"offset": 1},
+               "emission": {"blackbody": "chromaticity"}}]})", "t.json");
+  EXPECT_EQ(t.up_axis, UpAxis::Z);
+  EXPECT_TRUE(t.camera.framed_automatically);  // fov alone does not place the camera
+  EXPECT_TRUE(t.film.size_given);
+  EXPECT_EQ(t.media[0].source, VolumeSource::Houdini);
+  EXPECT_TRUE(t.media[0].given.temperature_offset);
+  EXPECT_FALSE(t.media[0].given.temperature_scale);
+  EXPECT_TRUE(t.media[0].given.emission);
+  EXPECT_EQ(t.media[0].emission.blackbody, BlackbodyMode::Seed);
+  EXPECT_FALSE(parse_scene(R"({"camera": {"look_at": [0, 0, 1]}})", "u.json").camera.framed_automatically);
+}
+
 TEST(Scene, BoxBoundsAndDefaults) {
   Scene s = parse_scene(R"({"media": [{"type": "homogeneous", "bounds": {"box": {"min": [0,0,0], "max": [1,2,3]}},
                              "emission": {"rgb": [1, 0.5, 0.25], "scale": 2}}]})",
@@ -128,6 +163,13 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"blackbody mode", one_medium(R"(, "emission": {"temperature_k": 1000, "blackbody": "cie"})"),
                 "media[0].emission.blackbody: must be one of"},
         BadCase{"fov", R"({"camera": {"fov_deg": 180}})", "camera.fov_deg"},
+        BadCase{"source", R"({"media": [{"type": "vdb", "file": "f.vdb", "source": "maya"}]})",
+                "media[0].source: must be one of \"auto\", \"blender\", \"houdini\", \"embergen\", \"kelvin\", got \"maya\""},
+        BadCase{"source type", R"({"media": [{"type": "vdb", "file": "f.vdb", "source": 3}]})",
+                "media[0].source: expected a string"},
+        BadCase{"source on homogeneous", one_medium(R"(, "source": "blender")"), "media[0].source: unknown key"},
+        BadCase{"up axis", R"({"up_axis": "x"})", "up_axis: must be one of \"y\", \"z\", got \"x\""},
+        BadCase{"up axis type", R"({"up_axis": [0, 0, 1]})", "up_axis: expected a string"},
         BadCase{"up parallel", R"({"camera": {"position": [0,0,0], "look_at": [0,1,0], "up": [0,1,0]}})", "camera.up"},
         BadCase{"estimator", R"({"integrator": {"emission_estimator": "track"}})", "integrator.emission_estimator"},
         BadCase{"light_only", R"({"integrator": {"light_only": "yes"}})", "integrator.light_only"},
