@@ -410,7 +410,7 @@ int run_devices(int device) {
 int run_info(const std::string& file, bool values) { return run_info_command(file, values, std::cout); }
 
 int run_blackbody(const BlackbodyArgs& a) {
-  BlackbodyMode mode = a.mode == "peak" ? BlackbodyMode::Peak : a.mode == "physical" ? BlackbodyMode::Physical : BlackbodyMode::Seed;
+  const BlackbodyMode mode = color::parse_blackbody_mode(a.mode).value_or(BlackbodyMode::Seed);  // CLI checked the name
   return color::run_blackbody_command(a.from_k, a.to_k, a.step_k, mode, a.observer, a.png, std::cout, std::cerr);
 }
 

@@ -34,7 +34,7 @@ int run_info(const std::string& file, bool values);
 
 struct BlackbodyArgs {
   double from_k = 0, to_k = 0, step_k = 0;
-  std::string mode = "seed", png;
+  std::string mode = "chromaticity", png;
   int observer = 2;
 };
 int run_blackbody(const BlackbodyArgs& args);

@@ -94,7 +94,8 @@ int main(int argc, char** argv) {
   blackbody->add_option("--from", bb.from_k, "First temperature, K")->required();
   blackbody->add_option("--to", bb.to_k, "Last temperature, K (inclusive)")->required();
   blackbody->add_option("--step", bb.step_k, "Step, K")->required();
-  blackbody->add_option("--mode", bb.mode, "seed | peak | physical")->check(CLI::IsMember({"seed", "peak", "physical"}));
+  blackbody->add_option("--mode", bb.mode, "chromaticity (default; also: seed) | stefan_boltzmann | physical | peak")
+      ->check(CLI::IsMember({"chromaticity", "seed", "stefan_boltzmann", "peak", "physical"}));
   blackbody->add_option("--observer", bb.observer, "2 (CIE 1931) or 10 (CIE 1964)")->check(CLI::IsMember({2, 10}));
   blackbody->add_option("--png", bb.png, "Also draw the swatch strip to this PNG");
 

@@ -326,8 +326,13 @@ void print_volume_file_info(const VolumeFileInfo& info, std::ostream& out) {
   out << "file \"" << info.file << "\": " << info.format_text;
   if (const std::string creator = info.metadata_value("creator"); !creator.empty()) out << ", creator \"" << creator << "\"";
   out << ", " << n << (n == 1 ? " grid\n" : " grids\n");
-  for (const auto& [key, value] : info.metadata)
-    if (key != "creator") out << "metadata \"" << key << "\": " << value << "\n";
+  for (const auto& [key, value] : info.metadata) {
+    if (key == "creator") continue;
+    std::string one_line = value;  // matrices print over several lines
+    for (char& c : one_line)
+      if (c == '\n' || c == '\r') c = ' ';
+    out << "metadata \"" << key << "\": " << one_line << "\n";
+  }
   for (const GridInfo& g : info.grids) {
     if (!g.unreadable.empty()) out << "grid \"" << g.name << "\"\n  unreadable: " << g.unreadable << "\n";
     else print_report(g, out);
