@@ -533,8 +533,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
       throw std::invalid_argument("cpu reference: camera up is parallel to the view direction");
   }
   // Σ L and Σ L² in double, and one copy of them for a checkpoint.
-  check_accumulation_size(scene.file.string(), settings.width, settings.height, 2 * 6 * sizeof(double),
-                          physical_memory_bytes(), "this machine's memory");
+  check_accumulation_fits_memory(scene.file.string(), settings.width, settings.height, 2 * 6 * sizeof(double));
   const std::string& estimator = scene.integrator.emission_estimator;
   if (estimator != "absorption" && estimator != "collision")
     throw std::invalid_argument("cpu reference: unknown emission_estimator \"" + estimator + "\"");

@@ -40,9 +40,8 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   check_accumulation_size(scene.file.string(), settings.width, settings.height, sizeof(gpu::AccumTexel),
                           range_binds ? range : ctx.max_allocation_size(),
                           range_binds ? "this device's maxStorageBufferRange" : "this device's maxMemoryAllocationSize");
-  check_accumulation_size(scene.file.string(), settings.width, settings.height,
-                          sizeof(gpu::AccumTexel) + 6 * sizeof(double), physical_memory_bytes(),
-                          "this machine's memory");
+  check_accumulation_fits_memory(scene.file.string(), settings.width, settings.height,
+                                 sizeof(gpu::AccumTexel) + 6 * sizeof(double));
   // Load only what the scene uses: the grids of its vdb media, each checked
   // against the device's texture limits before its dense array is allocated.
   volumes_.resize(scene.media.size());
