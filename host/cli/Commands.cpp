@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli/OutputCheck.h"
 #include "cli/Sequence.h"
 #include "color/Blackbody.h"
 #include "image/AtomicFile.h"
@@ -49,9 +50,11 @@ struct FrameOutputs {
   std::filesystem::path image, stats;
 };
 
-void check_folder(const std::filesystem::path& file, const std::string& what) {
-  if (file.has_parent_path() && !std::filesystem::is_directory(file.parent_path()))
-    throw input_error(file.string(), "", what + " folder does not exist");
+// One frame's outputs against its inputs, before it is rendered (cli/OutputCheck.h).
+void check_frame_outputs(const FrameOutputs& out, const Scene& frame_scene, CreatedFolders& folders) {
+  std::vector<NamedPath> outputs{{"-o", out.image}};
+  if (!out.stats.empty()) outputs.push_back({"--stats", out.stats});
+  check_outputs(outputs, {}, scene_inputs(frame_scene), folders);
 }
 
 // The stats JSON of one render (DESIGN.md "--stats").
@@ -141,8 +144,14 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
                       "with --frames the output must be a frame pattern (#### or $F4), e.g. out_####.exr");
   if (!args.stats.empty() && !has_frame_pattern(args.stats))
     throw input_error(args.stats, "", "with --frames --stats must be a frame pattern too, e.g. stats_####.json");
-  check_folder(expand_frame_pattern(output.string(), range.first), "output");
-  if (!args.stats.empty()) check_folder(expand_frame_pattern(args.stats, range.first), "stats");
+  // The first frame's outputs before the backend starts; each frame's again before its render.
+  CreatedFolders folders;
+  auto frame_outputs = [&](int frame) {
+    return FrameOutputs{expand_frame_pattern(output.string(), frame),
+                        args.stats.empty() ? std::filesystem::path()
+                                           : std::filesystem::path(expand_frame_pattern(args.stats, frame))};
+  };
+  check_frame_outputs(frame_outputs(range.first), scene_at_frame(scene, range.first), folders);
 
   const auto t0 = std::chrono::steady_clock::now();
   BackendOptions options;
@@ -152,11 +161,10 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
 
   int rendered = 0, skipped = 0, missing = 0;
   double load_seconds = 0.0, render_seconds = 0.0;
-  for (int frame : range.frames()) {
+  for (int frame : range) {
     if (cancel.load()) break;
     const std::string tag = "frame " + std::to_string(frame) + ": ";
-    FrameOutputs out{expand_frame_pattern(output.string(), frame),
-                     args.stats.empty() ? std::filesystem::path() : std::filesystem::path(expand_frame_pattern(args.stats, frame))};
+    const FrameOutputs out = frame_outputs(frame);
     // Outputs are written atomically (temp + rename), so an existing one is complete.
     std::error_code ec;
     if (args.skip_existing && std::filesystem::exists(out.image, ec)) {
@@ -176,6 +184,8 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
       continue;
     }
 
+    check_frame_outputs(out, frame_scene, folders);
+
     RenderSettings settings = settings_from(args, frame_scene);
     settings.frame = uint32_t(frame);
     ProgressBar bar("frame " + std::to_string(frame));
@@ -191,8 +201,12 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
                 << " spp; that frame is not written (rerun with --skip-existing to resume)\n";
       break;
     }
-    write_image(out.image, image_from_render(result, args.variance), frame_scene.film.exposure);
-    if (!out.stats.empty()) write_stats(out.stats, args, out.image, result, frame);
+    {
+      OutputCommit both;  // the image and its stats, or neither
+      write_image(out.image, image_from_render(result, args.variance), frame_scene.film.exposure);
+      if (!out.stats.empty()) write_stats(out.stats, args, out.image, result, frame);
+      both.commit();
+    }
     print_warnings(result, tag);
     print_summary(out.image, result);
     ++rendered;
@@ -238,16 +252,22 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
     if (scene.media[i].type == Medium::Type::Vdb && has_frame_pattern(scene.media[i].file.string()))
       throw input_error(scene.file.string(), "media[" + std::to_string(i) + "].file",
                         "is a frame pattern: give --frames A-B (or one frame, --frames N)");
-  check_folder(output, "output");
-  if (!args.stats.empty()) check_folder(args.stats, "stats");
+  // Every output checked (and its folder made) before anything renders: none
+  // may be an input or another output, and each must be writable.
+  const std::filesystem::path checkpoint_file = checkpoint_path(output);
+  CreatedFolders folders;
+  {
+    std::vector<NamedPath> outputs{{"-o", output}};
+    if (!args.stats.empty()) outputs.push_back({"--stats", args.stats});
+    check_outputs(outputs, {{"the checkpoint (-o + .checkpoint)", checkpoint_file}}, scene_inputs(scene), folders);
+  }
 
   // Without --frames the render is frame 0: keys evaluate there (clamped) and
   // the RNG is keyed with frame 0, as before animation existed.
   RenderSettings settings = settings_from(args, scene);
   settings.frame = 0;
 
-  // Checkpoints: OUT.checkpoint carries the accumulation and what it belongs to.
-  const std::filesystem::path checkpoint_file = checkpoint_path(output);
+  // Checkpoints: OUT.checkpoint (checkpoint_file) carries the accumulation and what it belongs to.
   CheckpointIdentity identity{args.backend, args.scene,     scene_fingerprint(args.scene), settings.width,
                               settings.height, settings.seed, settings.frame,                 ""};
   std::optional<Checkpoint> resumed;
@@ -293,8 +313,12 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   // The image and (short of the target) the checkpoint of what was rendered.
   auto save = [&](const RenderResult& result, bool keep_checkpoint) {
     Image image = image_from_render(result, args.variance);
-    write_image(output, image, scene.film.exposure);
-    if (!args.stats.empty()) write_stats(args.stats, args, output, result, std::nullopt);
+    {
+      OutputCommit both;  // the image and the stats, or neither
+      write_image(output, image, scene.film.exposure);
+      if (!args.stats.empty()) write_stats(args.stats, args, output, result, std::nullopt);
+      both.commit();
+    }
     bool checkpointed = false;
     if (result.spp < settings.spp && keep_checkpoint && !result.state.data.empty())
       checkpointed = save_checkpoint(result.state);
