@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <new>
 
 #include <unistd.h>
 
@@ -133,6 +134,11 @@ int main(int argc, char** argv) {
   } catch (const vk::NoDeviceError& e) {
     std::cerr << "pyrolume: " << e.what() << "\n";
     return 2;
+  } catch (const std::bad_alloc&) {
+    // Last resort: inputs are sized against the memory available before they
+    // are allocated (docs/robustness.md "Limits"); this is what slipped past.
+    std::cerr << "pyrolume: out of memory: an allocation failed (std::bad_alloc); nothing more was written\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "pyrolume: internal error: " << e.what() << "\n";
     return 1;

@@ -29,6 +29,7 @@
 #include <openvdb/openvdb.h>
 
 #include "util/Error.h"
+#include "util/Memory.h"
 #include "volume/VdbFile.h"
 
 namespace pyrolume {
@@ -124,6 +125,7 @@ GridChoice choose_grids(const std::vector<GridEntry>& entries, const Medium& m, 
 }
 
 uint64_t max_dense_texels = uint64_t(1) << 32;
+constexpr uint64_t kHostBytesPerTexel = 12;  // 4 (float array) + 4 (texture copy) + 4 (its upload)
 
 int64_t floor_div(int64_t a, int64_t k) { return a >= 0 ? a / k : -((-a + k - 1) / k); }
 
@@ -174,6 +176,25 @@ class DenseBuilder {
       std::ostringstream s;
       s << "active bounding box of " << dims.x - 2 << " x " << dims.y - 2 << " x " << dims.z - 2
         << " voxels is too large for a dense texture; use \"downsample\": k (box filter by k)";
+      throw input_error(file, role_key(role, out.name), s.str());
+    }
+    // The host's memory, before the array exists: the dense floats, the
+    // texture copy the renderers store beside them and its upload (R32F at
+    // worst), kHostBytesPerTexel in all. Past it the grid is refused with the
+    // downsample that would fit, not allocated into std::bad_alloc.
+    const uint64_t room = memory_available_bytes();
+    auto host_fits = [&](const glm::i64vec3& d) {
+      return room == 0 || uint64_t(d.x) * uint64_t(d.y) * uint64_t(d.z) * kHostBytesPerTexel <= room;
+    };
+    if (!host_fits(dims)) {
+      int64_t suggest = k;
+      while (suggest <= 64 && !host_fits(dims_at(suggest, nullptr))) ++suggest;
+      std::ostringstream s;
+      s << dims.x << "x" << dims.y << "x" << dims.z << " texels (with downsample " << k << ") need "
+        << format_bytes(texels * kHostBytesPerTexel) << " of host memory (" << kHostBytesPerTexel
+        << " B per texel: the dense array, its texture copy and upload), more than the " << format_bytes(room)
+        << " this process can still allocate";
+      if (suggest <= 64) s << "; add \"downsample\": " << suggest << " to the medium";
       throw input_error(file, role_key(role, out.name), s.str());
     }
     out_.origin = glm::ivec3(cmin - int64_t(1));
