@@ -882,9 +882,9 @@ void kahan_add(inout vec3 s, inout vec3 c, vec3 x) {
 }
 
 void main() {
-  uvec2 pixel = gl_GlobalInvocationID.xy;
+  uvec2 pixel = gl_GlobalInvocationID.xy + uvec2(0u, pass_constants.row_begin);
   uint width = frame.image.x, height = frame.image.y;
-  if (pixel.x >= width || pixel.y >= height) return;
+  if (pixel.x >= width || pixel.y >= min(height, pass_constants.row_end)) return;
   uint pixel_index = pixel.y * width + pixel.x;
 
   vec3 pass_sum = vec3(0.0), pass_sq = vec3(0.0);

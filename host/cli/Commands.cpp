@@ -348,6 +348,10 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
     return 1;
   }
   bar.finish();
+  if (result.cancelled && result.spp == 0) {  // interrupted within the first pass: no image exists yet
+    std::cerr << "pyrolume: interrupted before the first pass finished; nothing is written\n";
+    return 0;
+  }
 
   const bool short_of_target = result.spp < settings.spp;
   const bool checkpointed = save(result, result.cancelled || args.checkpoint > 0.0);

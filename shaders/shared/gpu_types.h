@@ -120,8 +120,8 @@ struct FrameConstants {
 struct PassConstants {
   uint sample_offset;  // index of this pass's first sample per pixel
   uint spp;            // samples per pixel in this pass
-  uint pad0;
-  uint pad1;
+  uint row_begin;      // this dispatch's rows: row_begin <= y < row_end. A pass is dispatched in
+  uint row_end;        // bands sized to finish well under a second (RenderSession::run_pass)
 };
 
 // What one pass reports back (zeroed before every pass). llvmpipe ends every
