@@ -920,7 +920,8 @@ void main() {
       for (uint n = 0u; n < 16384u && k < last; ++n) {
         if (!path_step(p, span, rng, stats)) continue;
         vec3 L = p.L;
-        if (any(isnan(L)) || any(isinf(L))) {
+        // NaN and Inf fail the comparison too.
+        if (!all(lessThanEqual(abs(L), vec3(MAX_SAMPLE_RADIANCE)))) {
           nonfinite += 1.0;
           L = vec3(0.0);
         }

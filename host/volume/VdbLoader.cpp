@@ -251,6 +251,27 @@ class DenseBuilder {
   float lo_ = std::numeric_limits<float>::infinity(), hi_ = -std::numeric_limits<float>::infinity();
 };
 
+// The renderers map rays into the grid with these matrices (the GPU in
+// float): entries beyond kMaxMapEntry, or non-finite ones, lose the grid and
+// turn samples non-finite (a transform scale of 1e-300 gave voxels of 1e-300
+// and a world-to-index map of 1e300). Voxels from 1e-15 to 1e15 scene units pass.
+constexpr double kMaxMapEntry = 1e15;
+
+void check_index_maps(const DenseGrid& g, const std::string& file, Role role) {
+  auto within = [](const glm::dmat4& M) {
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r)
+        if (!(std::abs(M[c][r]) <= kMaxMapEntry)) return false;
+    return true;
+  };
+  if (within(g.index_to_world) && within(g.world_to_index)) return;
+  std::ostringstream s;
+  s << "its index-to-world map with the medium's transform on top is degenerate or beyond float range (a voxel is "
+    << glm::length(glm::dvec3(g.index_to_world[0])) << " units along x; at most " << kMaxMapEntry
+    << " either way): check the medium's transform.scale";
+  throw input_error(file, role_key(role, g.name), s.str());
+}
+
 void report_counts(const DenseBuilder& b, const std::string& file, Role role, const std::string& grid,
                    std::vector<std::string>& warnings) {
   if (b.nonfinite)
@@ -278,6 +299,7 @@ DenseGrid dense_from_openvdb(const GridT& grid, const Medium& m, Role role, cons
   if (grid.activeVoxelCount() == 0 || bbox.empty()) {
     out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world;
     out.world_to_index = glm::inverse(out.index_to_world);
+    check_index_maps(out, file, role);
     warn_empty(file, role, out.name, warnings);
     return out;
   }
@@ -300,6 +322,7 @@ DenseGrid dense_from_openvdb(const GridT& grid, const Medium& m, Role role, cons
   report_counts(b, file, role, out.name, warnings);
   out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world * b.index_map();
   out.world_to_index = glm::inverse(out.index_to_world);
+  check_index_maps(out, file, role);
   return out;
 }
 
@@ -373,6 +396,7 @@ DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Medium
   if (grid.activeVoxelCount() == 0 || bbox.empty()) {
     out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world;
     out.world_to_index = glm::inverse(out.index_to_world);
+    check_index_maps(out, file, role);
     warn_empty(file, role, out.name, warnings);
     return out;
   }
@@ -390,6 +414,7 @@ DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Medium
   report_counts(b, file, role, out.name, warnings);
   out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world * b.index_map();
   out.world_to_index = glm::inverse(out.index_to_world);
+  check_index_maps(out, file, role);
   return out;
 }
 

@@ -20,10 +20,12 @@
 #include "light/EnvironmentMap.h"
 #include "light/LightSelection.h"
 #include "render/Limits.h"
+#include "render/SceneChecks.h"
 #include "render/cpu/Media.h"
 #include "render/cpu/Rng.h"
 #include "render/cpu/Sampling.h"
 #include "render/cpu/Transmittance.h"
+#include "shared/gpu_types.h"
 
 namespace pyrolume {
 namespace cpu {
@@ -556,7 +558,10 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   if (estimator != "absorption" && estimator != "collision")
     throw std::invalid_argument("cpu reference: unknown emission_estimator \"" + estimator + "\"");
   const bool collision_estimator = estimator == "collision";
+  check_scene_ranges(scene);
   const MediaData media = prepare_media(scene);  // loads the vdb media's grids
+  for (size_t i = 0; i < media.media.size(); ++i)
+    if (media.media[i].volume) check_majorant_depth(scene, i, media.media[i].volume->density.grid);
   for (const std::string& w : media.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   const geometry::Surfaces surfaces = geometry::build_surfaces(scene);  // meshes, textures, BVH
   std::optional<EnvironmentMap> environment;
@@ -634,9 +639,12 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
               glm::dvec3 L;
               for (int c = 0; c < 3; ++c)
                 L[c] = walk_channel(walk_scene, c, scene.camera.position, dir, rng, cnt, scratch, max_depth);
-              if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z)) {
+              // NaN, Inf and beyond MAX_SAMPLE_RADIANCE (where float sums of
+              // squares could overflow): recorded as 0, counted in nonfinite_samples.
+              const double kMaxL = gpu::MAX_SAMPLE_RADIANCE;
+              if (!(std::abs(L.x) <= kMaxL && std::abs(L.y) <= kMaxL && std::abs(L.z) <= kMaxL)) {
                 ++cnt.nonfinite;
-                L = glm::dvec3(0.0);  // recorded as 0, counted in nonfinite_samples
+                L = glm::dvec3(0.0);
               }
               for (int c = 0; c < 3; ++c) {
                 sum[c] += L[c];

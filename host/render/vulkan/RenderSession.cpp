@@ -9,6 +9,7 @@
 #include "light/EmissionCdf.h"
 #include "light/EnvironmentMap.h"
 #include "render/Limits.h"
+#include "render/SceneChecks.h"
 #include "render/vulkan/Spirv.h"
 #include "util/Error.h"
 
@@ -28,6 +29,12 @@ vk::Buffer storage_buffer(vk::Context& ctx, const std::vector<T>& values, const 
   return b;
 }
 
+// What every grid medium must satisfy once loaded (render/SceneChecks.h).
+void check_loaded_media(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes) {
+  for (size_t i = 0; i < volumes.size(); ++i)
+    if (volumes[i]) check_majorant_depth(scene, i, volumes[i]->density.grid);
+}
+
 std::string mib(double bytes) { return std::to_string(int(bytes / (1024.0 * 1024.0) + 0.5)) + " MiB"; }
 }  // namespace
 
@@ -43,6 +50,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                           range_binds ? "this device's maxStorageBufferRange" : "this device's maxMemoryAllocationSize");
   check_accumulation_fits_memory(scene.file.string(), settings.width, settings.height,
                                  sizeof(gpu::AccumTexel) + 6 * sizeof(double));
+  check_scene_ranges(scene);
   // Load only what the scene uses: the grids of its vdb media, each checked
   // against the device's texture limits before its dense array is allocated.
   volumes_.resize(scene.media.size());
@@ -51,6 +59,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
     volumes_[i] = load_stored_volume(scene.media[i], dense_limits());
     for (const auto& w : volumes_[i]->warnings) warnings_.push_back(w);
   }
+  check_loaded_media(scene, volumes_);
   gpu_scene_ = build_gpu_scene(scene, volumes_);
 
   frame_buffer_ = vk::Buffer(ctx, sizeof(gpu::FrameConstants), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
@@ -178,9 +187,11 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
     return false;
   // Load into locals first: a bad frame (or a different variant) leaves the
   // session as it was.
+  check_scene_ranges(scene);
   std::vector<std::optional<StoredVolume>> volumes(scene.media.size());
   for (size_t i = 0; i < scene.media.size(); ++i)
     if (scene.media[i].type == Medium::Type::Vdb) volumes[i] = load_stored_volume(scene.media[i], dense_limits());
+  check_loaded_media(scene, volumes);
   // The blackbody LUTs depend only on the emission's mode, observer and
   // adaptation: bake them once per sequence and reuse them frame after frame.
   GpuScene gpu_scene = build_gpu_scene(scene, volumes, /*with_luts=*/false);
@@ -304,6 +315,12 @@ void RenderSession::create_surfaces(const Scene& scene) {
                             VK_SAMPLER_ADDRESS_MODE_REPEAT, "unused texture slot");
   textures_2d_.back().upload(ctx_, white, sizeof white);
   for (const geometry::Texture& t : surfaces.textures) {
+    const uint32_t max_side = ctx_.properties().limits.maxImageDimension2D;
+    if (uint32_t(t.width()) > max_side || uint32_t(t.height()) > max_side)
+      throw input_error(t.file().string(), "",
+                        std::to_string(t.width()) + " x " + std::to_string(t.height()) +
+                            " texels exceed this device's 2D texture limit of " + std::to_string(max_side) +
+                            " per side; resize the texture (the CPU reference, --backend cpu, has no such limit)");
     if (t.srgb_source()) {
       std::vector<uint8_t> texels = t.rgba8_srgb();
       textures_2d_.emplace_back(ctx_, uint32_t(t.width()), uint32_t(t.height()), VK_FORMAT_R8G8B8A8_SRGB,

@@ -1,0 +1,33 @@
+#pragma once
+// What both backends check before rendering a scene, so that the float
+// arithmetic of the GPU (and the float images of both) stays finite by
+// construction (docs/robustness.md "Finite by construction"), and no medium
+// asks for more tracking steps than any render could take. Each failure is an
+// InputError "SCENE: KEY: REASON" naming the key to change (exit 2).
+#include <cstddef>
+
+#include "scene/Scene.h"
+#include "volume/DenseGrid.h"
+
+namespace pyrolume {
+
+// Every medium's emission: emission.scale times the brightest colour it can
+// take (its rgb, its temperature_k's blackbody colour, or for a grid the
+// brightest blackbody colour over the temperatures it renders) must stay
+// within gpu::MAX_EMITTED_RADIANCE; σa and σs (times density_scale) within
+// kMaxSigma.
+void check_scene_ranges(const Scene& scene);
+
+// The largest extinction coefficient accepted, per scene unit: far beyond any
+// medium (an optical depth of 1e30 per unit), well within float.
+inline constexpr double kMaxSigma = 1e30;
+
+// A grid medium's majorant optical depth, σ̄ (the largest σt its texels give,
+// per channel) times the diagonal of its world bounds: how many tentative
+// collisions a ray through it takes at the medium's global majorant (the CPU
+// reference's), and where the GPU's float free flights stop advancing. Past
+// kMaxMajorantDepth the medium is refused, naming density_scale.
+inline constexpr double kMaxMajorantDepth = 1e8;
+void check_majorant_depth(const Scene& scene, size_t medium, const DenseGrid& density);
+
+}  // namespace pyrolume
