@@ -16,6 +16,27 @@ namespace fs = std::filesystem;
 
 constexpr uint64_t kGiB = uint64_t(1) << 20;  // in KiB, as ulimit -v takes it
 
+// AddressSanitizer reserves terabytes of address space for its shadow memory,
+// so an ASan build of pyrolume cannot start under `ulimit -v` (tools/sanitize).
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kAddressSanitizer = true;
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+
+class CliMemoryLimits : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (kAddressSanitizer) GTEST_SKIP() << "ulimit -v and AddressSanitizer do not mix";
+  }
+};
+
 void expect_refused(const CliResult& r, const std::string& what, const std::vector<std::string>& expect,
                     const fs::path& out) {
   EXPECT_EQ(r.status, 2) << what << ": " << r.err;
@@ -25,7 +46,7 @@ void expect_refused(const CliResult& r, const std::string& what, const std::vect
   EXPECT_FALSE(fs::exists(out)) << what;
 }
 
-TEST(CliMemoryLimits, ASparseGridWhoseDenseArrayCannotFitIsRefused) {
+TEST_F(CliMemoryLimits, ASparseGridWhoseDenseArrayCannotFitIsRefused) {
   auto dir = temp_dir("mem-grid");
   // Two voxels 999 apart: a few hundred bytes of file, a 1002³-texel dense
   // array (1.0e9 texels: 4 GB as float, 2 GB as R16F).
@@ -43,7 +64,7 @@ TEST(CliMemoryLimits, ASparseGridWhoseDenseArrayCannotFitIsRefused) {
   fs::remove_all(dir);
 }
 
-TEST(CliMemoryLimits, AnAccumulationThatCannotFitIsRefused) {
+TEST_F(CliMemoryLimits, AnAccumulationThatCannotFitIsRefused) {
   auto dir = temp_dir("mem-accum");
   write_file(dir / "s.json", R"({"film": {"width": 8, "height": 8, "spp": 1}})");
   CliResult r = run_cli_with_memory_limit(
@@ -52,7 +73,7 @@ TEST(CliMemoryLimits, AnAccumulationThatCannotFitIsRefused) {
   fs::remove_all(dir);
 }
 
-TEST(CliMemoryLimits, EndlessStreamsAsInputsAreRefused) {
+TEST_F(CliMemoryLimits, EndlessStreamsAsInputsAreRefused) {
   auto dir = temp_dir("mem-zero");
   struct Case {
     std::string what, scene_file, scene;
@@ -73,7 +94,7 @@ TEST(CliMemoryLimits, EndlessStreamsAsInputsAreRefused) {
   fs::remove_all(dir);
 }
 
-TEST(CliMemoryLimits, AForgedCheckpointHeaderAllocatesNothing) {
+TEST_F(CliMemoryLimits, AForgedCheckpointHeaderAllocatesNothing) {
   auto dir = temp_dir("mem-ckpt");
   write_file(dir / "s.json", R"({"film": {"width": 8, "height": 8, "spp": 4}})");
   // A header claiming a 16384² CPU accumulation (12 GiB) in a file of a few bytes.
