@@ -20,9 +20,10 @@
 namespace {
 std::atomic<bool> g_cancel{false};
 std::atomic<int> g_signal{0};
-// The first SIGINT/SIGTERM asks the render to stop after its pass and save;
-// a second one (the pass itself is stuck, or the user will not wait) exits at
-// once with the same status, saving nothing more.
+// The first SIGINT/SIGTERM asks the render to stop (within the pass in
+// flight, which is dropped) and save the passes finished; a second one (the
+// user will not wait for the save) exits at once with the same status,
+// saving nothing more.
 extern "C" void on_signal(int sig) {
   if (g_cancel.exchange(true)) {
     static const char msg[] = "pyrolume: second signal: exiting without saving\n";
