@@ -78,9 +78,6 @@ void vdb_seeds(const fs::path& dir) {
   far->tree().setValue({0, 0, 0}, 1.0f);
   far->tree().setValue({999, 999, 999}, 1.0f);
   write_vdb(dir / "sparse_far.vdb", {far}, COMPRESS_NONE);
-  // A voxel of 1e-12 units: its world-to-index map heads beyond float range.
-  auto tiny = box_grid<openvdb::FloatGrid>("density", 2, 1e-12, 1.0f);
-  write_vdb(dir / "tiny_voxels.vdb", {tiny}, COMPRESS_NONE);
   // NanoVDB (the .nvdb path; load_volume detects the format by magic bytes).
   auto nano = nanovdb::openToNanoVDB(*d);
   nanovdb::io::writeGrid((dir / "density.nvdb").string(), nano, nanovdb::io::Codec::NONE);
