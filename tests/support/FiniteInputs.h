@@ -39,7 +39,6 @@ inline void write_finite_inputs(const std::filesystem::path& dir) {
   for (float& v : tex.rgb) v = 0.5f;
   tex.rgb[4] = std::numeric_limits<float>::infinity();
   write_image(dir / "inf_tex.exr", tex);
-  write_image(dir / "wide.png", make_image(65536, 1));
   write_vdb(dir / "ball.vdb", {make_float_grid("density", Lattice{0.25, {-1, 0, -1}}, VoxelBox{{0, 0, 0}, {7, 7, 7}},
                                                [](int, int, int) { return 1.0f; })});
 }
@@ -97,9 +96,31 @@ inline void expect_finite_case_refused(const std::filesystem::path& dir, const F
   EXPECT_FALSE(std::filesystem::exists(dir / "o.exr")) << c.label;
 }
 
+// Every case of refused_finite_cases on one backend.
+inline void expect_finite_cases_refused(const std::string& backend) {
+  const auto dir = temp_dir("finite-refused-" + backend);
+  write_finite_inputs(dir);
+  for (const FiniteCase& c : refused_finite_cases(dir)) expect_finite_case_refused(dir, c, backend);
+  std::filesystem::remove_all(dir);
+}
+
+// A 65536 × 1 albedo texture (wider than any GPU's 2D texture side) on a
+// plane: what rendering it with `backend` says. The folder is removed.
+inline CliResult render_wide_texture(const std::string& backend) {
+  const auto dir = temp_dir("finite-wide-" + backend);
+  write_image(dir / "wide.png", make_image(65536, 1));
+  write_file(dir / "w.json", "{" + std::string(kFiniteFilm) + R"(, "shapes": [{"plane": {"center": [0, 0, 0], "normal": [0, 1, 0]},
+                "material": {"diffuse": {"texture": "wide.png"}}}]})");
+  CliResult r = run_cli("render " + q(dir / "w.json") + " -o " + q(dir / "o.exr") + " --backend " + backend);
+  if (r.status != 0) EXPECT_FALSE(std::filesystem::exists(dir / "o.exr")) << "a refusal wrote the image";
+  std::filesystem::remove_all(dir);
+  return r;
+}
+
 // A plane whose normal's length overflows (its direction does not) renders:
 // finite, and the grey plane is seen against the white sky.
-inline void expect_overflowing_plane_normal_renders(const std::filesystem::path& dir, const std::string& backend) {
+inline void expect_overflowing_plane_normal_renders(const std::string& backend) {
+  const auto dir = temp_dir("finite-plane-" + backend);
   write_file(dir / "p.json", "{" + std::string(kFiniteFilm) + R"(, "background": {"rgb": [1, 1, 1]},
     "shapes": [{"plane": {"center": [0, 0, 0], "normal": [1e300, 1e300, 0]},
                 "material": {"diffuse": {"rgb": [0.5, 0.5, 0.5]}}}]})");
@@ -113,13 +134,15 @@ inline void expect_overflowing_plane_normal_renders(const std::filesystem::path&
   }
   EXPECT_GT(plane, 0u) << backend;
   EXPECT_LT(plane, img.rgb.size()) << backend;
+  std::filesystem::remove_all(dir);
 }
 
 // An albedo texture of 1e20 (finite, accepted) under a white sky: a path that
 // bounces off it carries ~1e20, past gpu::MAX_SAMPLE_RADIANCE, where 2^24
 // float squares could overflow. Such samples are recorded as 0 and counted;
 // the EXR (mean and variance) stays finite.
-inline void expect_samples_beyond_the_bound_counted(const std::filesystem::path& dir, const std::string& backend) {
+inline void expect_samples_beyond_the_bound_counted(const std::string& backend) {
+  const auto dir = temp_dir("finite-bound-" + backend);
   Image tex = make_image(2, 2);
   for (float& v : tex.rgb) v = 1e20f;
   write_image(dir / "huge.exr", tex);
@@ -140,6 +163,7 @@ inline void expect_samples_beyond_the_bound_counted(const std::filesystem::path&
     ASSERT_LE(img.rgb[i], 1.0f) << backend << ": a huge sample was accumulated";
     ASSERT_TRUE(std::isfinite(img.variance[i])) << backend << " variance " << i;
   }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace pyrolume::test

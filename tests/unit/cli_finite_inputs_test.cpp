@@ -4,35 +4,20 @@
 // tests/support/FiniteInputs.h, the Vulkan half: tests/vulkan/cli_finite_inputs_vulkan_test.cpp).
 #include "support/FiniteInputs.h"
 
-namespace pyrolume {
+namespace pyrolume::test {
 namespace {
-using namespace pyrolume::test;
-namespace fs = std::filesystem;
 
-TEST(CliFiniteInputs, ValuesBeyondFloatAreRefusedNamingTheKey) {
-  auto dir = temp_dir("finite-refused");
-  write_finite_inputs(dir);
-  for (const FiniteCase& c : refused_finite_cases(dir)) expect_finite_case_refused(dir, c, "cpu");
-  fs::remove_all(dir);
-}
+TEST(CliFiniteInputs, ValuesBeyondFloatAreRefusedNamingTheKey) { expect_finite_cases_refused("cpu"); }
 
 TEST(CliFiniteInputs, ExtremeButRepresentableValuesRenderFinite) {
-  auto dir = temp_dir("finite-rendered");
-  write_finite_inputs(dir);
-  expect_overflowing_plane_normal_renders(dir, "cpu");
-  // Wider than any GPU's 2D texture side: the CPU reference renders it.
-  write_file(dir / "w.json", "{" + std::string(kFiniteFilm) + R"(, "shapes": [{"plane": {"center": [0, 0, 0], "normal": [0, 1, 0]},
-                "material": {"diffuse": {"texture": "wide.png"}}}]})");
-  CliResult r = run_cli("render " + q(dir / "w.json") + " -o " + q(dir / "o.exr") + " --backend cpu");
+  expect_overflowing_plane_normal_renders("cpu");
+  const CliResult r = render_wide_texture("cpu");  // the CPU reference has no texture size limit
   EXPECT_EQ(r.status, 0) << r.err;
-  fs::remove_all(dir);
 }
 
 TEST(CliFiniteInputs, SamplesBeyondTheRadianceBoundAreCountedNotAccumulated) {
-  auto dir = temp_dir("finite-bound");
-  expect_samples_beyond_the_bound_counted(dir, "cpu");
-  fs::remove_all(dir);
+  expect_samples_beyond_the_bound_counted("cpu");
 }
 
 }  // namespace
-}  // namespace pyrolume
+}  // namespace pyrolume::test
