@@ -882,9 +882,9 @@ void kahan_add(inout vec3 s, inout vec3 c, vec3 x) {
 }
 
 void main() {
-  uvec2 pixel = gl_GlobalInvocationID.xy;
+  uvec2 pixel = gl_GlobalInvocationID.xy + uvec2(0u, pass_constants.row_begin);
   uint width = frame.image.x, height = frame.image.y;
-  if (pixel.x >= width || pixel.y >= height) return;
+  if (pixel.x >= width || pixel.y >= min(height, pass_constants.row_end)) return;
   uint pixel_index = pixel.y * width + pixel.x;
 
   vec3 pass_sum = vec3(0.0), pass_sq = vec3(0.0);
@@ -920,7 +920,8 @@ void main() {
       for (uint n = 0u; n < 16384u && k < last; ++n) {
         if (!path_step(p, span, rng, stats)) continue;
         vec3 L = p.L;
-        if (any(isnan(L)) || any(isinf(L))) {
+        // NaN and Inf fail the comparison too.
+        if (!all(lessThanEqual(abs(L), vec3(MAX_SAMPLE_RADIANCE)))) {
           nonfinite += 1.0;
           L = vec3(0.0);
         }

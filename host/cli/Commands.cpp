@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli/OutputCheck.h"
 #include "cli/Sequence.h"
 #include "color/Blackbody.h"
 #include "image/AtomicFile.h"
@@ -57,9 +58,11 @@ std::ostream* display_log(const std::filesystem::path& output) {
   return lower_extension(output) == ".png" ? &std::cerr : nullptr;
 }
 
-void check_folder(const std::filesystem::path& file, const std::string& what) {
-  if (file.has_parent_path() && !std::filesystem::is_directory(file.parent_path()))
-    throw input_error(file.string(), "", what + " folder does not exist");
+// One frame's outputs against its inputs, before it is rendered (cli/OutputCheck.h).
+void check_frame_outputs(const FrameOutputs& out, const Scene& frame_scene, CreatedFolders& folders) {
+  std::vector<NamedPath> outputs{{"-o", out.image}};
+  if (!out.stats.empty()) outputs.push_back({"--stats", out.stats});
+  check_outputs(outputs, {}, scene_inputs(frame_scene), folders);
 }
 
 // The stats JSON of one render (DESIGN.md "--stats").
@@ -135,6 +138,16 @@ std::vector<std::string> missing_inputs(const Scene& pattern_scene, const Scene&
   return missing;
 }
 
+// Notes and warnings about the scene as a whole, held back until the first
+// pass is done (or the render returns), then printed once.
+struct SceneRemarks {
+  std::vector<std::string> lines;
+  void say() {
+    for (const std::string& l : lines) std::cerr << l << "\n";
+    lines.clear();
+  }
+};
+
 // A missing input whose folder does not exist either usually means a
 // generated sequence was never generated: say how, for the one pyrolume ships.
 void print_how_to_make_inputs(const Scene& pattern_scene, const Scene& frame_scene) {
@@ -157,7 +170,7 @@ void print_how_to_make_inputs(const Scene& pattern_scene, const Scene& frame_sce
 // one pipeline and BVH) for every frame; each frame is rendered exactly as
 // `--frames N-N` would render it alone.
 int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesystem::path& output,
-                 const std::atomic<bool>& cancel) {
+                 const std::atomic<bool>& cancel, SceneRemarks& remarks) {
   if (args.checkpoint > 0.0 || args.resume)
     throw input_error(args.checkpoint > 0.0 ? "--checkpoint" : "--resume", "",
                       "is for single renders; a sequence resumes by frames with --skip-existing");
@@ -167,8 +180,14 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
                       "with --frames the output must be a frame pattern (#### or $F4), e.g. out_####.exr");
   if (!args.stats.empty() && !has_frame_pattern(args.stats))
     throw input_error(args.stats, "", "with --frames --stats must be a frame pattern too, e.g. stats_####.json");
-  check_folder(expand_frame_pattern(output.string(), range.first), "output");
-  if (!args.stats.empty()) check_folder(expand_frame_pattern(args.stats, range.first), "stats");
+  // The first frame's outputs before the backend starts; each frame's again before its render.
+  CreatedFolders folders;
+  auto frame_outputs = [&](int frame) {
+    return FrameOutputs{expand_frame_pattern(output.string(), frame),
+                        args.stats.empty() ? std::filesystem::path()
+                                           : std::filesystem::path(expand_frame_pattern(args.stats, frame))};
+  };
+  check_frame_outputs(frame_outputs(range.first), scene_at_frame(scene, range.first), folders);
 
   const auto t0 = std::chrono::steady_clock::now();
   BackendOptions options;
@@ -182,11 +201,10 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
   bool look_warned = false;
   int rendered = 0, skipped = 0, missing = 0;
   double load_seconds = 0.0, render_seconds = 0.0;
-  for (int frame : range.frames()) {
+  for (int frame : range) {
     if (cancel.load()) break;
     const std::string tag = "frame " + std::to_string(frame) + ": ";
-    FrameOutputs out{expand_frame_pattern(output.string(), frame),
-                     args.stats.empty() ? std::filesystem::path() : std::filesystem::path(expand_frame_pattern(args.stats, frame))};
+    const FrameOutputs out = frame_outputs(frame);
     // Outputs are written atomically (temp + rename), so an existing one is complete.
     std::error_code ec;
     if (args.skip_existing && std::filesystem::exists(out.image, ec)) {
@@ -207,13 +225,19 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
       continue;
     }
 
+    check_frame_outputs(out, frame_scene, folders);
+
     RenderSettings settings = settings_from(args, frame_scene);
     settings.frame = uint32_t(frame);
     ProgressBar bar("frame " + std::to_string(frame));
     RenderControl control;
-    control.progress = [&](int done, int target) { bar.update(done, target); };
+    control.progress = [&](int done, int target) {
+      remarks.say();
+      bar.update(done, target);
+    };
     control.cancel = &cancel;
     RenderResult result = backend->render(frame_scene, settings, control);
+    remarks.say();
     bar.finish();
     if (result.cancelled) {
       // A partly converged frame is not complete: write nothing, so that
@@ -224,8 +248,12 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
     }
     const Image image = image_from_render(result, args.variance);
     const double stops = exposure.stops(frame_scene.film, image, display_log(out.image));
-    write_image(out.image, image, stops, frame_scene.film.view);
-    if (!out.stats.empty()) write_stats(out.stats, args, out.image, result, frame);
+    {
+      OutputCommit both;  // the image and its stats, or neither
+      write_image(out.image, image, stops, frame_scene.film.view);
+      if (!out.stats.empty()) write_stats(out.stats, args, out.image, result, frame);
+      both.commit();
+    }
     print_warnings(result, tag);
     if (!look_warned)  // once per sequence, at the first frame it concerns
       if (const std::string w = film_look_warning(image, stops, frame_scene.film.view, ext == ".png"); !w.empty()) {
@@ -264,12 +292,15 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
                                           args.width || args.height || scene.film.size_given);
   const double aspect =
       double(args.width.value_or(scene.film.width)) / double(args.height.value_or(scene.film.height));
-  for (const std::string& note : setup.notes) std::cerr << "pyrolume: note: " << note << "\n";
+  // Said once the render is under way (every input check passed), so that a
+  // refused command prints its one error line and nothing else.
+  SceneRemarks remarks;
+  for (const std::string& note : setup.notes) remarks.lines.push_back("pyrolume: note: " + note);
   if (const std::string w = nothing_emits(scene); !w.empty())
-    std::cerr << "pyrolume: warning: " << scene.file.string() << ": " << w << "\n";
+    remarks.lines.push_back("pyrolume: warning: " + scene.file.string() + ": " + w);
   if (!scene.camera.framed_automatically)
     if (const std::string w = nothing_in_view(scene.camera, setup.boxes, aspect); !w.empty())
-      std::cerr << "pyrolume: warning: " << scene.file.string() << ": " << w << "\n";
+      remarks.lines.push_back("pyrolume: warning: " + scene.file.string() + ": " + w);
   std::filesystem::path output =
       !args.output.empty() ? std::filesystem::path(args.output)
       : sequence           ? std::filesystem::path(std::filesystem::path(args.scene).stem().string() + "_####.exr")
@@ -283,7 +314,7 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   if (const std::string w = light_strategy_warning(scene); !w.empty())
     std::cerr << "pyrolume: warning: " << scene.file.string() << ": " << w << "\n";
 
-  if (sequence) return run_sequence(args, scene, output, cancel);
+  if (sequence) return run_sequence(args, scene, output, cancel, remarks);
 
   if (args.skip_existing) throw input_error("--skip-existing", "", "needs --frames");
   if (args.strict) throw input_error("--strict", "", "needs --frames");
@@ -294,16 +325,22 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
     if (scene.media[i].type == Medium::Type::Vdb && has_frame_pattern(scene.media[i].file.string()))
       throw input_error(scene.file.string(), "media[" + std::to_string(i) + "].file",
                         "is a frame pattern: give --frames A-B (or one frame, --frames N)");
-  check_folder(output, "output");
-  if (!args.stats.empty()) check_folder(args.stats, "stats");
+  // Every output checked (and its folder made) before anything renders: none
+  // may be an input or another output, and each must be writable.
+  const std::filesystem::path checkpoint_file = checkpoint_path(output);
+  CreatedFolders folders;
+  {
+    std::vector<NamedPath> outputs{{"-o", output}};
+    if (!args.stats.empty()) outputs.push_back({"--stats", args.stats});
+    check_outputs(outputs, {{"the checkpoint (-o + .checkpoint)", checkpoint_file}}, scene_inputs(scene), folders);
+  }
 
   // Without --frames the render is frame 0: keys evaluate there (clamped) and
   // the RNG is keyed with frame 0, as before animation existed.
   RenderSettings settings = settings_from(args, scene);
   settings.frame = 0;
 
-  // Checkpoints: OUT.checkpoint carries the accumulation and what it belongs to.
-  const std::filesystem::path checkpoint_file = checkpoint_path(output);
+  // Checkpoints: OUT.checkpoint (checkpoint_file) carries the accumulation and what it belongs to.
   CheckpointIdentity identity{args.backend, args.scene,     scene_fingerprint(args.scene), settings.width,
                               settings.height, settings.seed, settings.frame,                 ""};
   std::optional<Checkpoint> resumed;
@@ -338,7 +375,10 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
 
   ProgressBar bar("rendering");
   RenderControl control;
-  control.progress = [&](int done, int target) { bar.update(done, target); };
+  control.progress = [&](int done, int target) {
+    remarks.say();
+    bar.update(done, target);
+  };
   control.cancel = &cancel;
   if (resumed) control.resume = &resumed->state;
   if (args.checkpoint > 0.0) {
@@ -351,8 +391,12 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   auto save = [&](const RenderResult& result, bool keep_checkpoint) {
     Image image = image_from_render(result, args.variance);
     const double stops = exposure.stops(scene.film, image, display_log(output));
-    write_image(output, image, stops, scene.film.view);
-    if (!args.stats.empty()) write_stats(args.stats, args, output, result, std::nullopt);
+    {
+      OutputCommit both;  // the image and the stats, or neither
+      write_image(output, image, stops, scene.film.view);
+      if (!args.stats.empty()) write_stats(args.stats, args, output, result, std::nullopt);
+      both.commit();
+    }
     if (result.spp >= settings.spp)  // a finished render: one the user will look at
       if (const std::string w = film_look_warning(image, stops, scene.film.view, ext == ".png"); !w.empty())
         std::cerr << "pyrolume: warning: " << output.string() << ": " << w << "\n";
@@ -372,6 +416,7 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   RenderResult result;
   try {
     result = backend->render(scene, settings, control);
+    remarks.say();
   } catch (const RenderFailed& e) {
     bar.finish();
     const RenderResult& partial = e.partial;
@@ -385,6 +430,10 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
     return 1;
   }
   bar.finish();
+  if (result.cancelled && result.spp == 0) {  // interrupted within the first pass: no image exists yet
+    std::cerr << "pyrolume: interrupted before the first pass finished; nothing is written\n";
+    return 0;
+  }
 
   const bool short_of_target = result.spp < settings.spp;
   const bool checkpointed = save(result, result.cancelled || args.checkpoint > 0.0);

@@ -22,12 +22,6 @@ bool parse_uint(const std::string& s, size_t begin, size_t end, int& out) {
 
 }  // namespace
 
-std::vector<int> FrameRange::frames() const {
-  std::vector<int> f;
-  for (long long k = first; k <= last; k += step) f.push_back(int(k));
-  return f;
-}
-
 FrameRange parse_frame_range(const std::string& text) {
   auto bad = [&](const std::string& why) {
     return input_error("--frames", "", "\"" + text + "\": " + why);

@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <new>
 
 #include <unistd.h>
 
@@ -19,9 +20,10 @@
 namespace {
 std::atomic<bool> g_cancel{false};
 std::atomic<int> g_signal{0};
-// The first SIGINT/SIGTERM asks the render to stop after its pass and save;
-// a second one (the pass itself is stuck, or the user will not wait) exits at
-// once with the same status, saving nothing more.
+// The first SIGINT/SIGTERM asks the render to stop (within the pass in
+// flight, which is dropped) and save the passes finished; a second one (the
+// user will not wait for the save) exits at once with the same status,
+// saving nothing more.
 extern "C" void on_signal(int sig) {
   if (g_cancel.exchange(true)) {
     static const char msg[] = "pyrolume: second signal: exiting without saving\n";
@@ -140,6 +142,11 @@ int main(int argc, char** argv) {
   } catch (const vk::NoDeviceError& e) {
     std::cerr << "pyrolume: " << e.what() << "\n";
     return 2;
+  } catch (const std::bad_alloc&) {
+    // Last resort: inputs are sized against the memory available before they
+    // are allocated (docs/robustness.md "Limits"); this is what slipped past.
+    std::cerr << "pyrolume: out of memory: an allocation failed (std::bad_alloc); nothing more was written\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "pyrolume: internal error: " << e.what() << "\n";
     return 1;

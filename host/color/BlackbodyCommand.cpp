@@ -40,8 +40,10 @@ int run_blackbody_command(double from_k, double to_k, double step_k, BlackbodyMo
     return bad("--step", num(rows, "%.0f") + " rows requested, at most " + std::to_string(kMaxBlackbodyRows));
 
   // --to is inclusive; the tolerance absorbs from + i·step rounding just above to.
+  // At most `rows`: where step is below the spacing of doubles (1e300 + 1 ==
+  // 1e300) t would never pass --to.
   std::vector<double> temperatures;
-  for (long i = 0;; ++i) {
+  for (long i = 0; i < long(rows); ++i) {
     const double t = from_k + double(i) * step_k;
     if (!(t <= to_k + 1e-9 * step_k)) break;
     temperatures.push_back(t);

@@ -1,7 +1,9 @@
 #include "geometry/Mesh.h"
 
+#include <cerrno>
+#include <cfloat>
 #include <cmath>
-#include <fstream>
+#include <cstdlib>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -11,6 +13,7 @@
 #include <tiny_obj_loader.h>
 
 #include "util/Error.h"
+#include "util/InputFile.h"
 
 namespace pyrolume::geometry {
 namespace {
@@ -26,6 +29,27 @@ std::string first_line(const std::string& text) {
 
 bool finite(float x) { return std::isfinite(x); }
 
+// Every number of a v, vn or vt statement must be finite as a float.
+// tinyobjloader reads "nan" and "inf" as 0 without a word (its number parser
+// knows only digits) and 1e39 as an infinite float, so they are refused here
+// with their line. Tokens that are not numbers at all are left to it.
+void check_finite_numbers(const std::string& text, size_t begin, size_t end, size_t line, const std::string& name) {
+  for (size_t i = begin; i < end;) {
+    const size_t a = text.find_first_not_of(" \t", i);
+    if (a == std::string::npos || a >= end) break;
+    size_t b = text.find_first_of(" \t", a);
+    if (b == std::string::npos || b > end) b = end;
+    const std::string token(text, a, b - a);
+    char* stop = nullptr;
+    errno = 0;
+    const double v = std::strtod(token.c_str(), &stop);
+    if (stop == token.c_str() + token.size() && !(std::abs(v) <= double(FLT_MAX)))
+      throw input_error(name, "line " + std::to_string(line),
+                        "\"" + token + "\" is not a finite number (coordinates must be finite floats)");
+    i = b;
+  }
+}
+
 // Keeps only the statements a mesh needs (v, vn, vt, f, o, g) and blanks every
 // other line, so line numbers in tinyobjloader's messages still match the
 // file. What is dropped (materials, smoothing groups, lines, points, skin
@@ -33,11 +57,12 @@ bool finite(float x) { return std::isfinite(x); }
 // of it unsafely: "vw 1 1e35 0.5" converts a float joint id to int out of
 // range (undefined behaviour; fuzz_obj found it). Line ends are \n, \r\n or a
 // lone \r, as tinyobjloader's own line splitter reads them.
-std::string mesh_statements(const std::string& text) {
+std::string mesh_statements(const std::string& text, const std::string& name) {
   std::string out;
   out.reserve(text.size());
-  size_t i = 0;
+  size_t i = 0, line = 0;
   while (i < text.size()) {
+    ++line;
     size_t end = text.find_first_of("\r\n", i);
     if (end == std::string::npos) end = text.size();
     size_t a = text.find_first_not_of(" \t", i);  // stops at the line end at the latest
@@ -45,6 +70,7 @@ std::string mesh_statements(const std::string& text) {
     size_t b = text.find_first_of(" \t", a);
     if (b == std::string::npos || b > end) b = end;
     const std::string_view keyword(text.data() + a, b - a);
+    if (keyword == "v" || keyword == "vn" || keyword == "vt") check_finite_numbers(text, b, end, line, name);
     if (keyword == "v" || keyword == "vn" || keyword == "vt" || keyword == "f" || keyword == "o" || keyword == "g")
       out.append(text, i, end - i);
     out.push_back('\n');
@@ -60,16 +86,9 @@ Mesh load_obj(const std::filesystem::path& file) {
   const std::string name = file.string();
   std::error_code ec;
   if (!std::filesystem::exists(file, ec)) throw input_error(name, "", "no such file");
-  if (std::filesystem::is_directory(file, ec)) throw input_error(name, "", "is a directory, not an OBJ file");
-  std::string text;
-  {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw input_error(name, "", "cannot open for reading");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    if (in.bad()) throw input_error(name, "", "cannot read");
-    text = ss.str();
-  }
+  // The text, its filtered copy and tinyobjloader's arrays: about four times
+  // the file's size at once.
+  const std::string text = read_input_file(file, kMaxObjBytes, "OBJ", 4.0);
 
   // From memory, with no material reader: materials are ignored anyway, and
   // reading them would open whatever path a `mtllib` line names (a FIFO or
@@ -78,7 +97,7 @@ Mesh load_obj(const std::filesystem::path& file) {
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
   std::string warn, err;
-  std::istringstream stream(mesh_statements(text));
+  std::istringstream stream(mesh_statements(text, name));
   const bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream, /*readMatFn=*/nullptr,
                                    /*triangulate=*/true, /*default_vcols_fallback=*/false);
   if (!ok) throw input_error(name, "", "not a valid OBJ file: " + first_line(err));

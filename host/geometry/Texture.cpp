@@ -1,6 +1,7 @@
 #include "geometry/Texture.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <glm/gtc/packing.hpp>
 #include <stdexcept>
@@ -36,8 +37,24 @@ Texture::Texture(int width, int height, std::vector<float> rgb, bool srgb_source
 Texture Texture::load(const std::filesystem::path& file) {
   Image img = read_image(file);  // InputError "FILE: REASON" on failure
   if (img.width <= 0 || img.height <= 0) throw input_error(file.string(), "", "empty image");
+  // A NaN or infinite albedo makes every path that meets it non-finite. Test
+  // hook (no scene key): PYROLUME_TEST_NONFINITE_TEXTURES=1 lets them through,
+  // the one way tests have to make samples non-finite on purpose and check
+  // that the accumulation records them as 0 and counts them.
+  if (std::getenv("PYROLUME_TEST_NONFINITE_TEXTURES") == nullptr) {
+    size_t bad = 0, first = 0;
+    for (size_t i = 0; i < img.rgb.size(); ++i)
+      if (!std::isfinite(img.rgb[i]) && bad++ == 0) first = i / 3;
+    if (bad > 0)
+      throw input_error(file.string(), "",
+                        std::to_string(bad) + " texel values are NaN or infinite (the first at x " +
+                            std::to_string(first % size_t(img.width)) + ", y " + std::to_string(first / size_t(img.width)) +
+                            "); an albedo texture must be finite");
+  }
   const bool srgb = !is_linear_file(file);
-  return Texture(img.width, img.height, std::move(img.rgb), srgb);
+  Texture t(img.width, img.height, std::move(img.rgb), srgb);
+  t.file_ = file;
+  return t;
 }
 
 glm::dvec3 Texture::texel(int x, int y) const {

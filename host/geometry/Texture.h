@@ -29,8 +29,11 @@ class Texture {
   Texture(int width, int height, std::vector<float> rgb, bool srgb_source = false);
 
   // PNG/JPG/…: 8/16-bit sRGB, decoded to linear; EXR and .hdr: linear (via
-  // image/ImageIo.h). Missing or unreadable file → InputError naming it.
+  // image/ImageIo.h). Missing or unreadable file, or a NaN/Inf texel →
+  // InputError naming it (docs/robustness.md "Finite by construction").
   static Texture load(const std::filesystem::path& file);
+  // The file it was loaded from (empty when built in memory), for messages.
+  const std::filesystem::path& file() const { return file_; }
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -53,6 +56,7 @@ class Texture {
   int width_ = 0, height_ = 0;
   std::vector<float> rgb_;
   bool srgb_source_ = false;
+  std::filesystem::path file_;
 };
 
 }  // namespace pyrolume::geometry

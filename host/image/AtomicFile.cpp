@@ -1,12 +1,14 @@
 #include "image/AtomicFile.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <sstream>
 
 #include "util/Error.h"
 
@@ -18,33 +20,220 @@ namespace {
 
 std::string errno_text(int e) { return e ? std::strerror(e) : "unknown error"; }
 
+// The commit group of this thread, if any (OutputCommit).
+thread_local OutputCommit* active_commit = nullptr;
+
+// `path` with every symlink in its last component followed (up to 40 hops, as
+// the kernel allows): the file that would really be written. A dangling link
+// leads to the missing path it names, which is then created.
+fs::path follow_symlinks(const fs::path& path) {
+  fs::path p = path;
+  for (int hops = 0;; ++hops) {
+    std::error_code ec;
+    if (!fs::is_symlink(fs::symlink_status(p, ec))) return p;
+    if (hops == 40) throw input_error(path.string(), "", "too many levels of symbolic links");
+    const fs::path target = fs::read_symlink(p, ec);
+    if (ec) throw input_error(path.string(), "", "cannot read the symbolic link: " + ec.message());
+    p = target.is_absolute() ? target : p.parent_path() / target;
+  }
+}
+
+// What sits at a destination, and the path to write: the file a regular
+// destination's symlinks lead to (renamed over, so the links stay), the path
+// itself for a FIFO or device (opened, which follows the links).
+enum class DestKind { Missing, Regular, Stream };
+struct Dest {
+  fs::path target;
+  DestKind kind = DestKind::Missing;
+  int fd = -1;  // a Stream that is one of this process's descriptors
+};
+
+// /dev/stdout, /dev/stderr, /dev/fd/N, /proc/self/fd/N: this process's own
+// descriptor N (else -1). Written through that descriptor itself, so what is
+// written shares its offset with everything else the command prints there
+// (reopening the path would start a new offset at 0 in a redirected file).
+int own_descriptor(const fs::path& dest) {
+  const std::string s = dest.lexically_normal().string();
+  if (s == "/dev/stdout") return 1;
+  if (s == "/dev/stderr") return 2;
+  for (const char* prefix : {"/dev/fd/", "/proc/self/fd/"}) {
+    const std::string p = prefix;
+    if (s.size() > p.size() && s.compare(0, p.size(), p) == 0 &&
+        s.find_first_not_of("0123456789", p.size()) == std::string::npos && s.size() - p.size() < 6)
+      return std::stoi(s.substr(p.size()));
+  }
+  return -1;
+}
+
+bool under_system_folder(const fs::path& p) {
+  const std::string s = p.string();
+  return s.rfind("/proc/", 0) == 0 || s.rfind("/dev/", 0) == 0 || s.rfind("/sys/", 0) == 0;
+}
+
+// Refuses what may never take an output: a folder, a socket, a block device.
+Dest resolve_dest(const fs::path& dest) {
+  const std::string file = dest.string();
+  if (const int fd = own_descriptor(dest); fd >= 0) {
+    if (::fcntl(fd, F_GETFD) < 0) throw input_error(file, "", "descriptor " + std::to_string(fd) + " is not open");
+    return {dest, DestKind::Stream, fd};
+  }
+  struct stat st {};
+  if (::stat(dest.c_str(), &st) != 0) {
+    const int e = errno;
+    if (e != ENOENT) throw input_error(file, "", "cannot write: " + errno_text(e));
+    return {follow_symlinks(dest), DestKind::Missing};  // a dangling link: the file it names is created
+  }
+  if (S_ISDIR(st.st_mode)) throw input_error(file, "", "is a folder, not a file");
+  if (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode)) return {dest, DestKind::Stream};
+  if (!S_ISREG(st.st_mode))
+    throw input_error(file, "",
+                      std::string("is ") + (S_ISSOCK(st.st_mode) ? "a socket" : S_ISBLK(st.st_mode) ? "a block device"
+                                                                                                 : "not a regular file") +
+                          "; only a regular file is replaced");
+  std::error_code ec;
+  fs::path target = fs::canonical(dest, ec);
+  if (ec) throw input_error(file, "", "cannot resolve: " + ec.message());
+  // /dev/stdout, /dev/fd/N, /proc/self/fd/N lead to a regular file when the
+  // shell redirected into one: that file is open already, so it is appended
+  // to, not replaced (and nothing is ever renamed into /dev or /proc).
+  if (under_system_folder(target) || under_system_folder(fs::absolute(dest, ec)))
+    return {dest, DestKind::Stream};
+  return {target, DestKind::Regular};
+}
+
 // Keep the extension last: some writers pick a format from it.
 fs::path temp_path_for(const fs::path& dest) {
   static std::atomic<unsigned> counter{0};
-  std::string name = "." + dest.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                     std::to_string(counter++) + dest.extension().string();
+  std::string name = ".";
+  name += dest.filename().string();
+  name += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+  name += dest.extension().string();
   return dest.parent_path() / name;
 }
 
+fs::path folder_of(const fs::path& file) { return file.parent_path().empty() ? fs::path(".") : file.parent_path(); }
+
 // Why the temp file could not be created, phrased about dest's folder.
 std::string open_failure_reason(const fs::path& dest, int e) {
-  fs::path dir = dest.parent_path().empty() ? fs::path(".") : dest.parent_path();
+  const fs::path dir = folder_of(dest);
   std::error_code ec;
   if (e == ENOENT && !fs::exists(dir, ec)) return "cannot write: folder " + dir.string() + " does not exist";
   if (e == ENOTDIR) return "cannot write: " + dir.string() + " is not a folder";
   return "cannot write in " + dir.string() + ": " + errno_text(e);
 }
 
+// Writes all of `bytes` to a FIFO or device in place, or to one of this
+// process's descriptors (own_fd >= 0).
+void write_stream(const fs::path& dest, const fs::path& target, int own_fd, const std::string& bytes) {
+  const int fd = own_fd >= 0 ? own_fd : ::open(target.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) throw input_error(dest.string(), "", "cannot open for writing: " + errno_text(errno));
+  auto close_it = [&] {
+    if (own_fd < 0) ::close(fd);
+  };
+  for (size_t done = 0; done < bytes.size();) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int e = errno;
+      close_it();
+      throw input_error(dest.string(), "", "write failed: " + errno_text(e));
+    }
+    done += size_t(n);
+  }
+  close_it();
+}
+
 }  // namespace
+
+// One output finished but not yet in place: a temp file to rename over
+// `target`, or (for a FIFO or device) the bytes to write into it.
+struct OutputCommit::Staged {
+  fs::path dest, target, tmp;
+  bool stream = false;
+  int fd = -1;  // a stream that is this process's descriptor
+  std::string bytes;
+};
+
+FileIdentity identify_file(const fs::path& path) {
+  FileIdentity id;
+  std::error_code ec;
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) {
+    id.exists = true;
+    id.device = uint64_t(st.st_dev);
+    id.inode = uint64_t(st.st_ino);
+  }
+  fs::path p = path;
+  try {
+    p = follow_symlinks(path);
+  } catch (const InputError&) {
+  }
+  id.resolved = fs::weakly_canonical(fs::absolute(p, ec), ec);
+  if (ec) id.resolved = fs::absolute(p, ec).lexically_normal();
+  return id;
+}
+
+bool same_file(const FileIdentity& a, const FileIdentity& b) {
+  if (a.exists && b.exists) return a.device == b.device && a.inode == b.inode;
+  return a.resolved == b.resolved;
+}
+
+FileIdentity prepare_output(const fs::path& dest, std::vector<fs::path>* created) {
+  const std::string file = dest.string();
+  if (dest.filename().empty() || dest.filename() == "." || dest.filename() == "..")
+    throw input_error(file, "", "names a folder, not a file");
+  const auto [target, kind, fd] = resolve_dest(dest);
+  if (kind == DestKind::Stream) {
+    if (fd < 0 && ::access(target.c_str(), W_OK) != 0) throw input_error(file, "", "cannot write: " + errno_text(errno));
+    return identify_file(dest);
+  }
+  // A regular file or a missing one: its folder must exist (made here) and
+  // take the temp file the rename needs.
+  const fs::path dir = folder_of(target);
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) {
+    std::vector<fs::path> missing;  // innermost first
+    for (fs::path d = dir; !d.empty() && !fs::exists(d, ec); d = d.parent_path()) {
+      missing.push_back(d);
+      if (d == d.parent_path()) break;
+    }
+    for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+      if (!fs::create_directory(*it, ec) && ec)
+        throw input_error(file, "", "cannot create the folder " + it->string() + ": " + ec.message());
+      if (created && it->filename() != "." && it->filename() != "..") created->push_back(*it);
+    }
+  } else if (!fs::is_directory(dir, ec)) {
+    throw input_error(file, "", "cannot write: " + dir.string() + " is not a folder");
+  }
+  // A probe file: permissions, read-only mounts and ACLs all answer here, as
+  // they will for the temp file after the render.
+  const fs::path probe = temp_path_for(target);
+  const int probe_fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (probe_fd < 0) throw input_error(file, "", open_failure_reason(target, errno));
+  ::close(probe_fd);
+  ::unlink(probe.c_str());
+  return identify_file(dest);
+}
 
 void write_file_atomic(const fs::path& dest, const std::function<void(std::ostream&)>& write) {
   const std::string file = dest.string();
   if (dest.filename().empty()) throw input_error(file, "", "output path names a folder, not a file");
-  fs::path tmp = temp_path_for(dest);
+  const auto [target, kind, own_fd] = resolve_dest(dest);
+  OutputCommit* group = active_commit;
 
+  if (kind == DestKind::Stream) {
+    std::ostringstream os(std::ios::binary);
+    write(os);
+    OutputCommit::Staged s{dest, target, {}, true, own_fd, std::move(os).str()};
+    if (group) group->staged_.push_back(std::move(s));
+    else write_stream(dest, target, own_fd, s.bytes);
+    return;
+  }
+
+  fs::path tmp = temp_path_for(target);
   // O_EXCL reserves the name and gives a clean errno; the stream then reopens it.
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd < 0) throw input_error(file, "", open_failure_reason(dest, errno));
+  if (fd < 0) throw input_error(file, "", open_failure_reason(target, errno));
   ::close(fd);
 
   auto discard = [&] {
@@ -54,7 +243,7 @@ void write_file_atomic(const fs::path& dest, const std::function<void(std::ostre
   try {
     {
       std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
-      if (!os) throw input_error(file, "", open_failure_reason(dest, errno));
+      if (!os) throw input_error(file, "", open_failure_reason(target, errno));
       errno = 0;
       write(os);
       os.flush();
@@ -70,8 +259,12 @@ void write_file_atomic(const fs::path& dest, const std::function<void(std::ostre
       throw input_error(file, "", "write failed: " + errno_text(e));
     }
     ::close(sfd);
+    if (group) {
+      group->staged_.push_back(OutputCommit::Staged{dest, target, tmp, false, -1, {}});
+      return;
+    }
     std::error_code ec;
-    fs::rename(tmp, dest, ec);
+    fs::rename(tmp, target, ec);
     if (ec) throw input_error(file, "", "cannot replace: " + ec.message());
   } catch (...) {
     discard();
@@ -81,6 +274,40 @@ void write_file_atomic(const fs::path& dest, const std::function<void(std::ostre
 
 void write_text_atomic(const fs::path& dest, const std::string& text) {
   write_file_atomic(dest, [&](std::ostream& os) { os.write(text.data(), std::streamsize(text.size())); });
+}
+
+OutputCommit::OutputCommit() : outer_(active_commit) { active_commit = this; }
+
+OutputCommit::~OutputCommit() {
+  active_commit = outer_;
+  for (const Staged& s : staged_) {
+    std::error_code ec;
+    if (!s.stream) fs::remove(s.tmp, ec);
+  }
+}
+
+void OutputCommit::commit() {
+  active_commit = outer_;  // from here on writes go straight to their files
+  std::vector<Staged> staged = std::move(staged_);
+  staged_.clear();
+  for (size_t i = 0; i < staged.size(); ++i) {
+    const Staged& s = staged[i];
+    try {
+      if (s.stream) {
+        write_stream(s.dest, s.target, s.fd, s.bytes);
+        continue;
+      }
+      std::error_code ec;
+      fs::rename(s.tmp, s.target, ec);
+      if (ec) throw input_error(s.dest.string(), "", "cannot replace: " + ec.message());
+    } catch (...) {
+      for (size_t j = i; j < staged.size(); ++j) {
+        std::error_code ec;
+        if (!staged[j].stream) fs::remove(staged[j].tmp, ec);
+      }
+      throw;
+    }
+  }
 }
 
 }  // namespace pyrolume

@@ -27,6 +27,8 @@
 #include "image/DisplayTransform.h"
 #include "shared/view_transform.h"
 #include "util/Error.h"
+#include "util/InputFile.h"
+#include "util/Memory.h"
 
 namespace pyrolume {
 
@@ -273,6 +275,8 @@ Image read_exr(const fs::path& file, const std::vector<unsigned char>& bytes) {
   Image img;
   img.width = dw.max.x - dw.min.x + 1;
   img.height = dw.max.y - dw.min.y + 1;
+  require_memory(file.string(), "", std::to_string(img.width) + " x " + std::to_string(img.height) + " pixels",
+                 uint64_t(img.width) * uint64_t(img.height) * 3 * sizeof(float) * (var_count == 3 ? 2 : 1));
   const size_t row_floats = size_t(img.width) * 3, xs = 3 * sizeof(float), ys = xs * size_t(img.width);
   const int rows_per_block = int(std::max<size_t>(1, (size_t(16) << 20) / ys));
   for (int y0 = 0; y0 < img.height; y0 += rows_per_block) {
@@ -319,6 +323,9 @@ Image read_stb(const fs::path& file, const std::vector<unsigned char>& bytes) {
       throw input_error(file.string(), "",
                         "image header claims " + std::to_string(w) + " x " + std::to_string(h) + " pixels for a " +
                             std::to_string(bytes.size()) + "-byte file (corrupt or truncated)");
+    // The decoded pixels as stb returns them (up to 4 floats each) and as floats here.
+    require_memory(file.string(), "", std::to_string(w) + " x " + std::to_string(h) + " pixels",
+                   uint64_t(pixels) * (3 + 4) * sizeof(float));
   }
   if (stbi_is_hdr_from_memory(data, len)) {
     float* px = stbi_loadf_from_memory(data, len, &w, &h, &n, 3);
@@ -373,10 +380,11 @@ Image read_image(const fs::path& file) {
   const std::string name = file.string();
   std::error_code ec;
   if (fs::is_directory(file, ec)) throw input_error(name, "", "is a folder, not an image");
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw input_error(name, "", std::string("cannot open: ") + std::strerror(errno));
-  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw input_error(name, "", std::string("cannot read: ") + std::strerror(errno));
+  std::vector<unsigned char> bytes;
+  {
+    const std::string text = read_input_file(file, kMaxImageBytes, "image", 2.0);  // and its copy below
+    bytes.assign(text.begin(), text.end());
+  }
   if (bytes.empty()) throw input_error(name, "", "file is empty");
 
   // EXR magic number 20000630 (little-endian 76 2f 31 01).

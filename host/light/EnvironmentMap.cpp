@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "color/ColorSpace.h"
 #include "image/ImageIo.h"
+#include "shared/gpu_types.h"
 #include "light/PiecewiseConstant.h"
 #include "util/Error.h"
 
@@ -29,6 +31,24 @@ EnvironmentMap EnvironmentMap::load(const std::filesystem::path& file, double sc
     throw input_error(file.string(), "", "environment map not found");
   Image img = read_image(file);  // names the file in its InputError
   if (img.width < 1 || img.height < 1) throw input_error(file.string(), "", "environment map has no pixels");
+  // NaN and Inf texels are refused (from_image would read them as no light,
+  // silently); radiance beyond gpu::MAX_EMITTED_RADIANCE would overflow the
+  // renderers' float sums (docs/robustness.md "Finite by construction").
+  size_t nonfinite = 0;
+  float brightest = 0.0f;
+  for (float v : img.rgb) {
+    if (!std::isfinite(v)) ++nonfinite;
+    else brightest = std::max(brightest, v);
+  }
+  if (nonfinite > 0)
+    throw input_error(file.string(), "",
+                      std::to_string(nonfinite) + " texel values are NaN or infinite; an environment map must be finite");
+  if (double(brightest) * scale > double(gpu::MAX_EMITTED_RADIANCE)) {
+    char why[160];
+    std::snprintf(why, sizeof why, "texels up to %.3g times environment.scale %.3g exceed %.3g, the most a render "
+                  "can sum in float without overflowing", double(brightest), scale, double(gpu::MAX_EMITTED_RADIANCE));
+    throw input_error(file.string(), "", why);
+  }
   try {
     return from_image(img, scale, rotation_deg, zenith_y, file.string());
   } catch (const std::invalid_argument& e) {

@@ -11,13 +11,18 @@
 #include "image/AtomicFile.h"
 #include "shared/gpu_types.h"
 #include "util/Error.h"
+#include "util/InputFile.h"
+#include "util/Json.h"
+#include "util/Memory.h"
 
 namespace pyrolume {
 namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kMagic = "pyrolume-checkpoint 1";
+constexpr const char* kMagic = "pyrolume-checkpoint 2";
+constexpr const char* kMagicV1 = "pyrolume-checkpoint 1";  // still read: its checksum covers the payload only
+constexpr size_t kMaxHeaderChars = 64 * 1024;  // the JSON line; a real one is ~300 characters
 
 uint64_t fnv1a(const void* data, size_t n, uint64_t h = 0xcbf29ce484222325ull) {
   const auto* p = static_cast<const unsigned char*>(data);
@@ -38,6 +43,13 @@ uint64_t payload_bytes(const std::string& backend, int width, int height) {
   return 0;
 }
 
+// FNV-1a 64 of the magic line and the JSON line, each with its '\n': where a
+// version 2 checksum starts before it goes on over the payload.
+uint64_t header_hash(const std::string& magic, const std::string& header) {
+  const std::string lines = magic + "\n" + header + "\n";
+  return fnv1a(lines.data(), lines.size());
+}
+
 }  // namespace
 
 fs::path checkpoint_path(const fs::path& output) {
@@ -47,9 +59,7 @@ fs::path checkpoint_path(const fs::path& output) {
 }
 
 uint64_t scene_fingerprint(const fs::path& scene_file) {
-  std::ifstream in(scene_file, std::ios::binary);
-  if (!in) throw input_error(scene_file.string(), "", "cannot open");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text = read_input_file(scene_file, kMaxSceneBytes, "scene", 10.0);
   std::string canonical = text;
   try {
     canonical = nlohmann::json::parse(text, nullptr, true, /*ignore_comments=*/true).dump();
@@ -72,10 +82,11 @@ void write_checkpoint(const fs::path& file, const CheckpointIdentity& id, int sp
   j["spp"] = state.spp;
   j["spp_target"] = spp_target;
   j["payload_bytes"] = state.data.size();
-  const std::string header = std::string(kMagic) + "\n" + j.dump() + "\n";
+  const std::string json_line = j.dump();
+  const std::string header = std::string(kMagic) + "\n" + json_line + "\n";
   if (state.backend != id.backend || state.width != id.width || state.height != id.height)
     throw std::logic_error("write_checkpoint: the state does not match the identity");
-  const uint64_t sum = fnv1a(state.data.data(), state.data.size());
+  const uint64_t sum = fnv1a(state.data.data(), state.data.size(), header_hash(kMagic, json_line));
   unsigned char trailer[8];
   for (int i = 0; i < 8; ++i) trailer[i] = static_cast<unsigned char>(sum >> (8 * i));
   write_file_atomic(file, [&](std::ostream& os) {
@@ -87,15 +98,33 @@ void write_checkpoint(const fs::path& file, const CheckpointIdentity& id, int sp
 
 Checkpoint read_checkpoint(const fs::path& file) {
   const std::string name = file.string();
+  std::error_code ec;
+  const fs::file_status status = fs::status(file, ec);
+  if (fs::exists(status) && !fs::is_regular_file(status))
+    throw input_error(name, "", "is not a regular file, so not a checkpoint");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw input_error(name, "", std::string("cannot open checkpoint: ") + std::strerror(errno));
+  const uint64_t file_size = fs::file_size(file, ec);
+  if (ec) throw input_error(name, "", "cannot read checkpoint: " + ec.message());
+  // Both lines are read with a bound: a file of zeros has no line end.
+  auto read_line = [&](size_t max_chars, std::string& line) {
+    line.clear();
+    for (char c; in.get(c);) {
+      if (c == '\n') return true;
+      if (line.size() == max_chars) return false;
+      line.push_back(c);
+    }
+    return false;
+  };
   std::string magic, header;
-  if (!std::getline(in, magic) || magic != kMagic) throw input_error(name, "", "not a pyrolume checkpoint (version 1)");
-  if (!std::getline(in, header) || in.eof()) throw input_error(name, "", "truncated checkpoint (no complete header)");
+  if (!read_line(64, magic) || (magic != kMagic && magic != kMagicV1))
+    throw input_error(name, "", "not a pyrolume checkpoint (version 1 or 2)");
+  if (!read_line(kMaxHeaderChars, header)) throw input_error(name, "", "truncated checkpoint (no complete header)");
+  const bool v1 = magic == kMagicV1;
   Checkpoint c;
   uint64_t bytes = 0;
   try {
-    const auto j = nlohmann::json::parse(header);
+    const auto j = parse_json_unique_keys(header, name);
     CheckpointIdentity& id = c.identity;
     id.backend = j.at("backend").get<std::string>();
     id.device = j.at("device").get<std::string>();
@@ -121,6 +150,16 @@ Checkpoint read_checkpoint(const fs::path& file) {
     throw input_error(name, "", "corrupt checkpoint: " + std::to_string(bytes) + " payload bytes for a " +
                                     std::to_string(id.width) + "x" + std::to_string(id.height) + " " + id.backend +
                                     " render");
+  // The header's claim against the file before anything is allocated by it: a
+  // forged 16384² header in a small file is refused here, not after 12 GiB.
+  const uint64_t expected = magic.size() + 1 + header.size() + 1 + bytes + 8;
+  if (file_size < expected)
+    throw input_error(name, "", "truncated checkpoint: the header describes " + std::to_string(expected) +
+                                    " bytes, the file has " + std::to_string(file_size));
+  if (file_size > expected)
+    throw input_error(name, "", "corrupt checkpoint: " + std::to_string(file_size - expected) +
+                                    " trailing bytes past what the header describes");
+  require_memory(name, "", "this checkpoint's accumulation", bytes);
   c.state.backend = id.backend;
   c.state.width = id.width;
   c.state.height = id.height;
@@ -132,8 +171,11 @@ Checkpoint read_checkpoint(const fs::path& file) {
   if (in.peek() != std::char_traits<char>::eof()) throw input_error(name, "", "corrupt checkpoint: trailing bytes");
   uint64_t sum = 0;
   for (int i = 0; i < 8; ++i) sum |= uint64_t(trailer[i]) << (8 * i);
-  if (sum != fnv1a(c.state.data.data(), c.state.data.size()))
-    throw input_error(name, "", "corrupt checkpoint: checksum mismatch");
+  // Version 2 sums the two header lines too (a flipped bit in "spp" is
+  // caught); version 1 summed the payload only.
+  const uint64_t expect = v1 ? fnv1a(c.state.data.data(), c.state.data.size())
+                             : fnv1a(c.state.data.data(), c.state.data.size(), header_hash(magic, header));
+  if (sum != expect) throw input_error(name, "", "corrupt checkpoint: checksum mismatch (header or payload damaged)");
   return c;
 }
 

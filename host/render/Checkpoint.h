@@ -4,10 +4,12 @@
 // (e.g. out.exr.checkpoint), written atomically, with what identifies the
 // render so that a resume with another scene, size, seed or backend is refused.
 //
-// File layout (version 1): the line "pyrolume-checkpoint 1", one line of JSON
+// File layout (version 2): the line "pyrolume-checkpoint 2", one line of JSON
 // (the identity, spp and the payload's size), the backend's AccumulationState
-// bytes, then their FNV-1a 64 checksum (8 bytes, little-endian). The payload is
-// in host byte order: a checkpoint resumes on the machine type that wrote it.
+// bytes, then the FNV-1a 64 checksum of everything before it, both lines
+// included (8 bytes, little-endian). Version 1 files (the same, with "1" and a
+// checksum of the payload alone) are still read. The payload is in host byte
+// order: a checkpoint resumes on the machine type that wrote it.
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -47,7 +49,8 @@ void write_checkpoint(const std::filesystem::path& file, const CheckpointIdentit
                       const AccumulationState& state);
 
 // Missing, truncated, corrupt or foreign files throw InputError naming the file
-// and the reason.
+// and the reason; the header's size is checked against the file's before the
+// payload is allocated.
 Checkpoint read_checkpoint(const std::filesystem::path& file);
 
 // Throws InputError "FILE: KEY: REASON" naming the first identity field that

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <string>
 
+#include "util/Memory.h"
+
 namespace pyrolume {
 
 // Throws InputError "FILE: film.width x film.height: ..." when width·height
@@ -13,7 +15,8 @@ namespace pyrolume {
 void check_accumulation_size(const std::string& file, int width, int height, uint64_t bytes_per_pixel,
                              uint64_t limit, const std::string& limit_what);
 
-// The machine's physical memory in bytes (0 if unknown: no check then).
-uint64_t physical_memory_bytes();
+// The same against what this process can still allocate (util/Memory.h:
+// MemAvailable, `ulimit -v`, the cgroup's limit).
+void check_accumulation_fits_memory(const std::string& file, int width, int height, uint64_t bytes_per_pixel);
 
 }  // namespace pyrolume

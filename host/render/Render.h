@@ -51,7 +51,9 @@ using ProgressFn = std::function<void(int spp_done, int spp_target)>;
 
 struct RenderControl {
   ProgressFn progress;
-  const std::atomic<bool>* cancel = nullptr;  // set by SIGINT/SIGTERM: stop after the current pass
+  // Set by SIGINT/SIGTERM: stop within the pass in flight (polled inside it;
+  // that pass is dropped) and return what the finished passes hold.
+  const std::atomic<bool>* cancel = nullptr;
   // Continue from this state (same backend and image size, checked by the
   // caller's checkpoint) instead of from 0 spp: the passes go on with sample
   // index `resume->spp`, so the result equals an uninterrupted render's.

@@ -1,6 +1,7 @@
 // Scene JSON (format v1) -> Scene, with strict validation: unknown keys, wrong
 // types and out-of-range values are errors that name the file and key path, so a
 // typo never silently renders something else.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -10,6 +11,8 @@
 
 #include "scene/Scene.h"
 #include "util/Error.h"
+#include "util/InputFile.h"
+#include "util/Json.h"
 
 namespace pyrolume {
 namespace {
@@ -317,7 +320,11 @@ Shape read_shape(Reader r, const std::filesystem::path& base) {
     Reader pl = r.child("plane");
     s.center = pl.vec3("center", s.center);
     s.normal = pl.vec3("normal", s.normal);
-    if (glm::length(s.normal) == 0) pl.fail("normal", "must not be zero");
+    // Scaled by its largest component first: [1e300, 1e300, 0] is a direction
+    // too, but its length overflows to infinity.
+    const double largest = std::max({std::abs(s.normal.x), std::abs(s.normal.y), std::abs(s.normal.z)});
+    if (!(largest > 0)) pl.fail("normal", "must not be zero");
+    s.normal /= largest;
     if (pl.has("size")) {
       const auto& v = pl.raw("size");
       if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number() || v[0].get<double>() < 0 ||
@@ -348,7 +355,7 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
   const std::string fname = file.string();
   json root;
   try {
-    root = json::parse(json_text);
+    root = parse_json_unique_keys(json_text, fname);  // a repeated key is an InputError
   } catch (const json::exception& e) {
     // parse_error, and out_of_range for a number beyond double (1e400: found
     // by fuzz_scene). nlohmann's message carries the byte offset; keep it on one line.
@@ -451,15 +458,10 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
 }
 
 Scene load_scene(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) {
-    std::error_code ec;
-    bool exists = std::filesystem::exists(file, ec);
-    throw input_error(file.string(), "", exists ? "cannot be read" : "no such file");
-  }
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_scene(ss.str(), file);
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) throw input_error(file.string(), "", "no such file");
+  // nlohmann::json holds about ten times the text's size while parsing.
+  return parse_scene(read_input_file(file, kMaxSceneBytes, "scene", 10.0), file);
 }
 
 }  // namespace pyrolume

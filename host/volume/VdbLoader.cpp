@@ -30,6 +30,7 @@
 #include <openvdb/openvdb.h>
 
 #include "util/Error.h"
+#include "util/Memory.h"
 #include "volume/VdbFile.h"
 
 namespace pyrolume {
@@ -125,6 +126,7 @@ GridChoice choose_grids(const std::vector<GridEntry>& entries, const Medium& m, 
 }
 
 uint64_t max_dense_texels = uint64_t(1) << 32;
+constexpr uint64_t kHostBytesPerTexel = 12;  // 4 (float array) + 4 (texture copy) + 4 (its upload)
 
 int64_t floor_div(int64_t a, int64_t k) { return a >= 0 ? a / k : -((-a + k - 1) / k); }
 
@@ -175,6 +177,25 @@ class DenseBuilder {
       std::ostringstream s;
       s << "active bounding box of " << dims.x - 2 << " x " << dims.y - 2 << " x " << dims.z - 2
         << " voxels is too large for a dense texture; use \"downsample\": k (box filter by k)";
+      throw input_error(file, role_key(role, out.name), s.str());
+    }
+    // The host's memory, before the array exists: the dense floats, the
+    // texture copy the renderers store beside them and its upload (R32F at
+    // worst), kHostBytesPerTexel in all. Past it the grid is refused with the
+    // downsample that would fit, not allocated into std::bad_alloc.
+    const uint64_t room = memory_available_bytes();
+    auto host_fits = [&](const glm::i64vec3& d) {
+      return room == 0 || uint64_t(d.x) * uint64_t(d.y) * uint64_t(d.z) * kHostBytesPerTexel <= room;
+    };
+    if (!host_fits(dims)) {
+      int64_t suggest = k;
+      while (suggest <= 64 && !host_fits(dims_at(suggest, nullptr))) ++suggest;
+      std::ostringstream s;
+      s << dims.x << "x" << dims.y << "x" << dims.z << " texels (with downsample " << k << ") need "
+        << format_bytes(texels * kHostBytesPerTexel) << " of host memory (" << kHostBytesPerTexel
+        << " B per texel: the dense array, its texture copy and upload), more than the " << format_bytes(room)
+        << " this process can still allocate";
+      if (suggest <= 64) s << "; add \"downsample\": " << suggest << " to the medium";
       throw input_error(file, role_key(role, out.name), s.str());
     }
     out_.origin = glm::ivec3(cmin - int64_t(1));
@@ -231,6 +252,27 @@ class DenseBuilder {
   float lo_ = std::numeric_limits<float>::infinity(), hi_ = -std::numeric_limits<float>::infinity();
 };
 
+// The renderers map rays into the grid with these matrices (the GPU in
+// float): entries beyond kMaxMapEntry, or non-finite ones, lose the grid and
+// turn samples non-finite (a transform scale of 1e-300 gave voxels of 1e-300
+// and a world-to-index map of 1e300). Voxels from 1e-15 to 1e15 scene units pass.
+constexpr double kMaxMapEntry = 1e15;
+
+void check_index_maps(const DenseGrid& g, const std::string& file, Role role) {
+  auto within = [](const glm::dmat4& M) {
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r)
+        if (!(std::abs(M[c][r]) <= kMaxMapEntry)) return false;
+    return true;
+  };
+  if (within(g.index_to_world) && within(g.world_to_index)) return;
+  std::ostringstream s;
+  s << "its index-to-world map with the medium's transform on top is degenerate or beyond float range (a voxel is "
+    << glm::length(glm::dvec3(g.index_to_world[0])) << " units along x; at most " << kMaxMapEntry
+    << " either way): check the medium's transform.scale";
+  throw input_error(file, role_key(role, g.name), s.str());
+}
+
 void report_counts(const DenseBuilder& b, const std::string& file, Role role, const std::string& grid,
                    std::vector<std::string>& warnings) {
   if (b.nonfinite)
@@ -258,6 +300,7 @@ DenseGrid dense_from_openvdb(const GridT& grid, const Medium& m, Role role, cons
   if (grid.activeVoxelCount() == 0 || bbox.empty()) {
     out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world;
     out.world_to_index = glm::inverse(out.index_to_world);
+    check_index_maps(out, file, role);
     warn_empty(file, role, out.name, warnings);
     return out;
   }
@@ -280,6 +323,7 @@ DenseGrid dense_from_openvdb(const GridT& grid, const Medium& m, Role role, cons
   report_counts(b, file, role, out.name, warnings);
   out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world * b.index_map();
   out.world_to_index = glm::inverse(out.index_to_world);
+  check_index_maps(out, file, role);
   return out;
 }
 
@@ -353,6 +397,7 @@ DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Medium
   if (grid.activeVoxelCount() == 0 || bbox.empty()) {
     out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world;
     out.world_to_index = glm::inverse(out.index_to_world);
+    check_index_maps(out, file, role);
     warn_empty(file, role, out.name, warnings);
     return out;
   }
@@ -370,6 +415,7 @@ DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Medium
   report_counts(b, file, role, out.name, warnings);
   out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world * b.index_map();
   out.world_to_index = glm::inverse(out.index_to_world);
+  check_index_maps(out, file, role);
   return out;
 }
 

@@ -15,6 +15,15 @@ PYRO_CONST uint WORKGROUP_SIZE_Y = 8;
 PYRO_CONST uint MAX_MEDIA = 16;
 PYRO_CONST uint MAX_GRIDS = 4;  // grid (vdb) media; each has its own texture slots
 
+// Radiance bounds that keep every float sum finite (docs/robustness.md,
+// "Finite by construction"). A sample beyond MAX_SAMPLE_RADIANCE in any
+// channel is recorded as 0 and counted as non-finite, so 2^24 samples of at
+// most 1e15 keep Σ L² below FLT_MAX (3.4e38) on both backends. Emission and
+// environment texels past MAX_EMITTED_RADIANCE are refused at load: a
+// thousandth of the sample bound, the room path weights (MIS, roulette) need.
+PYRO_CONST float MAX_SAMPLE_RADIANCE = 1e15;
+PYRO_CONST float MAX_EMITTED_RADIANCE = 1e12;
+
 // Descriptor bindings of render.comp (set 0).
 PYRO_CONST uint BINDING_FRAME = 0;     // uniform FrameConstants
 PYRO_CONST uint BINDING_MEDIA = 1;     // uniform GpuMedium[MAX_MEDIA]
@@ -120,8 +129,8 @@ struct FrameConstants {
 struct PassConstants {
   uint sample_offset;  // index of this pass's first sample per pixel
   uint spp;            // samples per pixel in this pass
-  uint pad0;
-  uint pad1;
+  uint row_begin;      // this dispatch's rows: row_begin <= y < row_end. A pass is dispatched in
+  uint row_end;        // bands sized to finish well under a second (RenderSession::run_pass)
 };
 
 // What one pass reports back (zeroed before every pass). llvmpipe ends every

@@ -3,6 +3,7 @@
 // purpose: libFuzzer mutates small inputs much faster, and each one here
 // reaches a different reader path (grid types, half storage, tiles, NanoVDB;
 // EXR pixel types, compressions, tiled files, Y-only, variance; PNG/HDR).
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -70,6 +71,13 @@ void vdb_seeds(const fs::path& dir) {
   auto empty = openvdb::FloatGrid::create(0);
   empty->setName("density");
   write_vdb(dir / "empty.vdb", {empty}, COMPRESS_NONE);
+  // Two voxels 999 apart: a tiny file whose dense box (1002^3) is past any
+  // memory the loader may take (docs/robustness.md "Limits").
+  auto far = openvdb::FloatGrid::create(0);
+  far->setName("density");
+  far->tree().setValue({0, 0, 0}, 1.0f);
+  far->tree().setValue({999, 999, 999}, 1.0f);
+  write_vdb(dir / "sparse_far.vdb", {far}, COMPRESS_NONE);
   // NanoVDB (the .nvdb path; load_volume detects the format by magic bytes).
   auto nano = nanovdb::openToNanoVDB(*d);
   nanovdb::io::writeGrid((dir / "density.nvdb").string(), nano, nanovdb::io::Codec::NONE);
@@ -113,6 +121,21 @@ void image_seeds(const fs::path& dir) {
   stbi_write_png((dir / "tiny.png").c_str(), 2, 2, 3, px, 6);
   const float hdr[2 * 1 * 3] = {0.5f, 1.0f, 2.0f, 4.0f, 8.0f, 16.0f};
   stbi_write_hdr((dir / "tiny.hdr").c_str(), 2, 1, 3, hdr);
+  // Values no render can sum (NaN, Inf, 3e38) and a 65536 x 1 strip, past
+  // every GPU's 2D texture side (docs/robustness.md "Finite by construction").
+  {
+    Imf::Header header(3, 1);
+    for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+    float px[3][3] = {{std::nanf(""), 1.0f, 2.0f}, {INFINITY, -INFINITY, 0.5f}, {3e38f, 3e38f, 3e38f}};
+    Imf::FrameBuffer fb;
+    for (int c = 0; c < 3; ++c)
+      fb.insert(c == 0 ? "R" : c == 1 ? "G" : "B", Imf::Slice(Imf::FLOAT, (char*)&px[0][c], 3 * sizeof(float), 0));
+    Imf::OutputFile out((dir / "nonfinite.exr").c_str(), header);
+    out.setFrameBuffer(fb);
+    out.writePixels(1);
+  }
+  std::vector<unsigned char> strip(65536 * 3, 100);
+  stbi_write_png((dir / "strip_65536x1.png").c_str(), 65536, 1, 3, strip.data(), 65536 * 3);
 }
 
 void text(const fs::path& p, const std::string& s) { std::ofstream(p, std::ios::binary) << s; }
@@ -126,6 +149,8 @@ void obj_seeds(const fs::path& dir) {
   text(dir / "polygon_mtl.obj",
        "mtllib none.mtl\nusemtl x\nv 0 0 0\nv 2 0 0\nv 2 2 0\nv 1 3 0\nv 0 2 0\nvt 0.5 0.5\n"
        "s 1\nf 1/1 2/1 3/1 4/1 5/1\nl 1 2\np 3\n");
+  // Numbers tinyobjloader would read as 0 or as an infinite float: refused by line.
+  text(dir / "nonfinite.obj", "v 0 0 0\nv nan 0 0\nv 0 inf 0\nv 0 0 1e39\nvn -inf 0 0\nvt NaN 0\nf 1 2 3\n");
 }
 
 void scene_seeds(const fs::path& dir) {
@@ -154,6 +179,19 @@ void scene_seeds(const fs::path& dir) {
     {"sphere": {"center": [0, 0, 0], "radius": 1}},
     {"plane": {"center": [0, 0, 0], "normal": [0, 1, 0], "size": [4, 4]}}
   ]
+})");
+  // The shapes of issue 28's battery: a repeated key, values beyond float.
+  text(dir / "duplicate_keys.json",
+       R"({"media": [{"type": "homogeneous", "bounds": {"sphere": {"center": [0, 1, 0], "radius": 1, "radius": 2}}}],
+  "film": {"width": 8}, "media": []})");
+  text(dir / "beyond_float.json", R"({
+  "film": {"width": 8, "height": 8, "spp": 1},
+  "media": [{"type": "homogeneous", "bounds": {"sphere": {"center": [0, 1, 0], "radius": 1}},
+             "sigma_a": [1e35, 1, 1], "emission": {"temperature_k": 1500, "scale": 1e38}},
+            {"type": "vdb", "file": "fire.vdb", "density_scale": 1e20,
+             "transform": {"scale": [1e-300, 1e-300, 1e-300]}}],
+  "shapes": [{"plane": {"center": [0, 0, 0], "normal": [1e300, 1e300, 0]}},
+             {"mesh": "m.obj", "transform": {"scale": [1e300, 1e300, 1e300]}}]
 })");
 }
 

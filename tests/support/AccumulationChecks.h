@@ -10,6 +10,7 @@
 
 #include "render/Backend.h"
 #include "support/AccumulationScenes.h"
+#include "support/VdbScenes.h"
 
 namespace pyrolume::test {
 
@@ -191,6 +192,54 @@ inline void expect_cli_sigterm_saves(const std::string& backend) {
                            " --spp " + std::to_string(part.spp));
   ASSERT_EQ(same.status, 0) << same.err;
   expect_same_image(part, read_image(dir / "again.exr"));
+  std::filesystem::remove_all(dir);
+}
+
+// A pathologically dense medium: a grid whose one hot voxel (1e7 per unit)
+// sets a global majorant that every ray through it steps at, while the rest
+// is nearly empty (1e-3), so a ray crossing it takes ~3e7 null collisions and
+// a pass never ends on its own. SIGTERM ~1 s in must end the render within
+// 2 s (cancellation inside passes: the CPU polls its tracking loops, the GPU
+// dispatches bands that finish well under a second), exit 143, and leave
+// either nothing (no pass finished) or a whole image of the passes that did.
+inline void expect_sigterm_ends_a_pathological_pass(const std::string& backend) {
+  auto dir = temp_dir("cli-dense-" + backend);
+  write_vdb(dir / "dense.vdb", {make_float_grid("density", Lattice{0.25}, VoxelBox{{0, 0, 0}, {7, 7, 7}},
+                                                [](int i, int j, int k) { return i + j + k == 0 ? 1e7f : 1e-3f; })});
+  write_file(dir / "s.json", R"({
+  "camera": {"position": [0.875, 0.875, -5], "look_at": [0.875, 0.875, 0.875], "up": [0, 1, 0], "fov_deg": 20},
+  "film": {"width": 64, "height": 64, "spp": 64},
+  "integrator": {"mis": false, "majorant": "global"},
+  "media": [{"type": "vdb", "file": "dense.vdb", "sigma_a": [1, 1, 1], "sigma_s": [0, 0, 0]}]})");
+  const auto out = dir / "o.exr";
+  CliProcess p = start_cli({"render", (dir / "s.json").string(), "-o", out.string(), "--backend", backend}, dir);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  int raw = 0;
+  ASSERT_EQ(waitpid(p.pid, &raw, WNOHANG), 0) << "the render ended on its own: " << read_file(p.err);
+  const auto t0 = std::chrono::steady_clock::now();
+  kill(p.pid, SIGTERM);
+  // Waits at most 10 s, then kills it, so a regression fails instead of hanging.
+  for (;;) {
+    if (waitpid(p.pid, &raw, WNOHANG) == p.pid) break;
+    if (std::chrono::steady_clock::now() - t0 > std::chrono::seconds(10)) {
+      kill(p.pid, SIGKILL);
+      waitpid(p.pid, &raw, 0);
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("%s: SIGTERM answered in %.3f s\n", backend.c_str(), seconds);
+  EXPECT_LT(seconds, 2.0) << read_file(p.err);
+  EXPECT_EQ(exit_status_of(raw), 143) << read_file(p.err);
+  const std::string err = read_file(p.err);
+  if (std::filesystem::exists(out)) {
+    const Image part = read_image(out);
+    EXPECT_GT(part.spp, 0);
+    EXPECT_NE(err.find("interrupted after " + std::to_string(part.spp)), std::string::npos) << err;
+  } else {
+    EXPECT_NE(err.find("interrupted before the first pass finished; nothing is written"), std::string::npos) << err;
+  }
   std::filesystem::remove_all(dir);
 }
 

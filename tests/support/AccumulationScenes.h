@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <string>
@@ -30,8 +31,8 @@ inline Scene constant_background_scene(int width, int height, int spp, glm::dvec
   return s;
 }
 
-// A plane whose albedo texture is all +Inf (an EXR can hold it; nothing
-// sanitises albedo textures) covers exactly the left half of the
+// A plane whose albedo texture is all +Inf (an EXR can hold it) covers
+// exactly the left half of the
 // image (world x > 0: image x grows along cross(forward, up) = -x here;
 // its edge x = 0 projects onto the centre column boundary for an even
 // width); the right half sees the background. Every camera sample that hits
@@ -39,7 +40,12 @@ inline Scene constant_background_scene(int width, int height, int spp, glm::dvec
 // (Inf, or NaN where a bilinear weight is 0), so exactly width/2 · height · spp
 // samples are non-finite. (A NaN albedo would not do: the walks end a path
 // whose throughput is not > 0.)
+//
+// Texture::load refuses non-finite texels; the test hook
+// PYROLUME_TEST_NONFINITE_TEXTURES (set here, for this process and the CLI
+// runs it starts) lets this one through.
 inline Scene inf_texture_scene(const std::filesystem::path& dir, int width, int height, int spp) {
+  setenv("PYROLUME_TEST_NONFINITE_TEXTURES", "1", 1);
   Image inf_img = make_image(2, 2);
   for (float& v : inf_img.rgb) v = std::numeric_limits<float>::infinity();
   write_image(dir / "inf.exr", inf_img);

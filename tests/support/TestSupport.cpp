@@ -12,10 +12,11 @@
 
 namespace pyrolume::test {
 
-CliResult run_cli(const std::string& args) {
+namespace {
+CliResult run_shell(const std::string& prefix, const std::string& args) {
   auto dir = temp_dir("cli");
   auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-  std::string cmd = std::string(PYROLUME_BIN) + " " + args + " >" + out.string() + " 2>" + err.string();
+  std::string cmd = prefix + std::string(PYROLUME_BIN) + " " + args + " >" + out.string() + " 2>" + err.string();
   int raw = std::system(cmd.c_str());
   CliResult r;
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
@@ -23,6 +24,13 @@ CliResult run_cli(const std::string& args) {
   r.err = read_file(err);
   std::filesystem::remove_all(dir);
   return r;
+}
+}  // namespace
+
+CliResult run_cli(const std::string& args) { return run_shell("", args); }
+
+CliResult run_cli_with_memory_limit(uint64_t kib, const std::string& args) {
+  return run_shell("ulimit -v " + std::to_string(kib) + "; ", args);
 }
 
 std::filesystem::path temp_dir(const std::string& tag) {

@@ -1,5 +1,6 @@
 #pragma once
 // Shared helpers for the ctest suites: run the CLI, make temp folders, write files.
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
@@ -12,6 +13,9 @@ struct CliResult {
 
 // Runs PYROLUME_BIN with the given argument string (shell-quoted by the caller).
 CliResult run_cli(const std::string& args);
+// The same with address space limited to `kib` KiB (`ulimit -v`), as a render
+// farm limits a job: what a memory check must refuse before allocating.
+CliResult run_cli_with_memory_limit(uint64_t kib, const std::string& args);
 
 // A fresh, empty folder under the system temp dir, unique per test.
 std::filesystem::path temp_dir(const std::string& tag);

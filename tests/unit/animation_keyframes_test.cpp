@@ -137,10 +137,25 @@ TEST(AnimationFrameRange, ParsesAndRejects) {
   FrameRange r = parse_frame_range("1-120");
   EXPECT_EQ(r.first, 1);
   EXPECT_EQ(r.last, 120);
-  EXPECT_EQ(r.frames().size(), 120u);
-  EXPECT_EQ(parse_frame_range("1-10:4").frames(), (std::vector<int>{1, 5, 9}));
-  EXPECT_EQ(parse_frame_range("7").frames(), (std::vector<int>{7}));
-  EXPECT_EQ(parse_frame_range("0-0").frames(), (std::vector<int>{0}));
+  EXPECT_EQ(r.count(), 120u);
+  auto frames = [](const FrameRange& range) {
+    std::vector<int> v;
+    for (int f : range) v.push_back(f);
+    EXPECT_EQ(v.size(), range.count());
+    return v;
+  };
+  EXPECT_EQ(frames(r).size(), 120u);
+  EXPECT_EQ(frames(parse_frame_range("1-10:4")), (std::vector<int>{1, 5, 9}));
+  EXPECT_EQ(frames(parse_frame_range("1-9:4")), (std::vector<int>{1, 5, 9}));
+  EXPECT_EQ(frames(parse_frame_range("7")), (std::vector<int>{7}));
+  EXPECT_EQ(frames(parse_frame_range("0-0")), (std::vector<int>{0}));
+  // The widest range: counted, not listed (it used to build a 4 GB vector
+  // before frame 0), and the last frame's successor does not overflow.
+  const FrameRange huge = parse_frame_range("0-999999999");
+  EXPECT_EQ(huge.count(), 1000000000u);
+  EXPECT_EQ(*huge.begin(), 0);
+  const FrameRange top = parse_frame_range("999999998-999999999:7");
+  EXPECT_EQ(frames(top), (std::vector<int>{999999998}));
   for (const char* bad : {"", "a-b", "5-1", "1-5:0", "1-5:", "-3", "1-", "1-5:x", "1--5", "1.5-3"}) {
     try {
       parse_frame_range(bad);

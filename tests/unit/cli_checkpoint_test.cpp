@@ -14,6 +14,10 @@ TEST(CliCheckpointCpu, SigintSavesThenResumeCompletesIdentically) { expect_cli_i
 
 TEST(CliCheckpointCpu, SigtermSavesAndExits143) { expect_cli_sigterm_saves("cpu"); }
 
+TEST(CliCheckpointCpu, SigtermEndsAPassThroughAPathologicallyDenseMedium) {
+  expect_sigterm_ends_a_pathological_pass("cpu");
+}
+
 TEST(CliCheckpointCpu, MismatchedResumeIsRefused) {
   auto dir = temp_dir("cli-mismatch");
   write_file(dir / "s.json", kSlowBallJson);

@@ -74,6 +74,18 @@ TEST(BlackbodyCommand, HeaderAndInclusiveRange) {
   EXPECT_EQ(lines(r.out).size(), 3u) << "1000, 1500 (2000 is beyond --to)";
 }
 
+TEST(BlackbodyCommand, AStepBelowTheSpacingOfDoublesEnds) {
+  // 1e300 + 1 == 1e300: stepping by 1 never passes --to. This used to loop,
+  // growing its list until std::bad_alloc; the row count bounds it.
+  CommandRun r = run(1e300, 1e300, 1);
+  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_EQ(lines(r.out).size(), 2u) << r.out;
+  EXPECT_EQ(fields(lines(r.out)[1])[0], "1e+300");
+  r = run(1e300, 2e300, 1);  // 1e300 rows asked for: refused, naming the limit
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("rows requested, at most"), std::string::npos) << r.err;
+}
+
 TEST(BlackbodyCommand, RowsMatchTheLibrary) {
   CommandRun r = run(3000, 3000, 1, BlackbodyMode::Peak, 10);
   ASSERT_EQ(r.status, 0);

@@ -157,6 +157,66 @@ TEST_F(CheckpointFile, CorruptTruncatedAndForeignFilesAreRefused) {
   EXPECT_NE(read_error().find(file_.string()), std::string::npos);
 }
 
+TEST_F(CheckpointFile, TheChecksumCoversTheHeader) {
+  write_checkpoint(file_, id_, 100, state_);
+  const std::string bytes = test::read_file(file_);
+  // One bit of "spp":12 flipped to "spp":13: a valid header that resumes a
+  // render with one spp it does not have. Caught by the checksum.
+  const size_t at = bytes.find("\"spp\":12");
+  ASSERT_NE(at, std::string::npos) << bytes.substr(0, 300);
+  std::string flipped = bytes;
+  flipped[at + 7] ^= 0x01;  // '2' -> '3'
+  ASSERT_NE(flipped.find("\"spp\":13"), std::string::npos);
+  test::write_file(file_, flipped);
+  EXPECT_NE(read_error().find(file_.string() + ": corrupt checkpoint: checksum mismatch"), std::string::npos)
+      << read_error();
+  // The first line too.
+  flipped = bytes;
+  flipped[0] ^= 0x20;
+  test::write_file(file_, flipped);
+  EXPECT_NE(read_error().find("not a pyrolume checkpoint"), std::string::npos) << read_error();
+}
+
+TEST_F(CheckpointFile, VersionOneFilesAreStillRead) {
+  // Version 1: the same layout with "1" and a checksum of the payload alone
+  // (FNV-1a 64), as earlier builds wrote it.
+  write_checkpoint(file_, id_, 100, state_);
+  std::string bytes = test::read_file(file_);
+  bytes[std::string("pyrolume-checkpoint ").size()] = '1';
+  uint64_t h = 0xcbf29ce484222325ull;
+  for (uint8_t b : state_.data) h = (h ^ b) * 0x100000001b3ull;
+  for (int i = 0; i < 8; ++i) bytes[bytes.size() - 8 + size_t(i)] = char(uint8_t(h >> (8 * i)));
+  test::write_file(file_, bytes);
+  const Checkpoint c = read_checkpoint(file_);
+  EXPECT_EQ(c.state.data, state_.data);
+  EXPECT_EQ(c.state.spp, 12);
+}
+
+TEST_F(CheckpointFile, AHeaderClaimingMoreThanTheFileHoldsAllocatesNothing) {
+  // 16384² CPU pixels (12 GiB) claimed by a header in a file of a few bytes:
+  // refused from the file's size before the payload is allocated (this test
+  // would otherwise need 12 GiB).
+  write_checkpoint(file_, id_, 100, state_);
+  std::string bytes = test::read_file(file_);
+  const uint64_t claimed = uint64_t(16384) * 16384 * 48 + 24;
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"\"width\":4", "\"width\":16384"},
+                                 {"\"height\":2", "\"height\":16384"},
+                                 {"\"payload_bytes\":" + std::to_string(state_.data.size()),
+                                  "\"payload_bytes\":" + std::to_string(claimed)}}) {
+    const size_t at = bytes.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    bytes.replace(at, from.size(), to);
+  }
+  test::write_file(file_, bytes);
+  EXPECT_NE(read_error().find("truncated checkpoint: the header describes " +
+                              std::to_string(bytes.find('\n', 30) + 1 + claimed + 8)),
+            std::string::npos)
+      << read_error();
+  // A file of zeros (no line end at all) is read with a bound, not to its end.
+  test::write_file(file_, std::string(1 << 20, '\0'));
+  EXPECT_NE(read_error().find("not a pyrolume checkpoint"), std::string::npos) << read_error();
+}
+
 TEST_F(CheckpointFile, MismatchedRendersAreRefusedNamingTheKey) {
   write_checkpoint(file_, id_, 100, state_);
   const Checkpoint c = read_checkpoint(file_);

@@ -190,7 +190,14 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"json syntax", R"({"film": {"spp": 4,}})", "invalid JSON"},
         // nlohmann throws out_of_range, not parse_error, for these (found by fuzz_scene).
         BadCase{"number beyond double", R"({"film": {"exposure": 1e400}})", "invalid JSON"},
-        BadCase{"negative beyond double", R"({"camera": {"position": [0, -1e3080, 0]}})", "invalid JSON"}),
+        BadCase{"negative beyond double", R"({"camera": {"position": [0, -1e3080, 0]}})", "invalid JSON"},
+        // nlohmann keeps the last of two equal keys; a second "media" replaced the first silently.
+        BadCase{"duplicate top-level key", R"({"media": [], "film": {}, "media": []})", "bad.json: media: duplicate key"},
+        BadCase{"duplicate key in an array element",
+                R"({"media": [{}, {"type": "homogeneous", "g": 0.1, "g": 0.2}]})", "bad.json: media[1].g: duplicate key"},
+        BadCase{"duplicate key nested in arrays",
+                R"({"camera": {"position": {"keys": [[0, [0, 0, 1]]], "keys": []}}})",
+                "bad.json: camera.position.keys: duplicate key"}),
     [](const ::testing::TestParamInfo<BadCase>& info) {
       std::string n = info.param.label;
       for (auto& ch : n)

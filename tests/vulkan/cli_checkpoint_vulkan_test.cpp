@@ -18,6 +18,10 @@ TEST(CliCheckpointVulkan, SigintSavesThenResumeCompletesIdentically) { expect_cl
 
 TEST(CliCheckpointVulkan, SigtermSavesAndExits143) { expect_cli_sigterm_saves("vulkan"); }
 
+TEST(CliCheckpointVulkan, SigtermEndsAPassThroughAPathologicallyDenseMedium) {
+  expect_sigterm_ends_a_pathological_pass("vulkan");
+}
+
 // Runs the CLI with PYROLUME_TEST_FAIL_PASS=fault set.
 CliResult run_with_fault(const std::string& fault, const std::string& args) {
   setenv("PYROLUME_TEST_FAIL_PASS", fault.c_str(), 1);

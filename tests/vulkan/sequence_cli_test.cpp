@@ -194,9 +194,10 @@ TEST(SequenceCli, BadInputExitsTwoWithAClearMessage) {
       {"--frames 3-1 -o " + q(dir / "o_####.exr"), "--frames"},
       {"--frames 1-x -o " + q(dir / "o_####.exr"), "--frames"},
       {"-o " + q(dir / "o.exr"), "media[0].file"},                   // a pattern scene needs --frames
-      {"--frames 1 -o " + q(dir / "nofolder/o_####.exr"), "folder"},
+      {"--frames 1 -o " + q(dir / "taken_####.exr"), "taken_0001.exr: is a folder"},  // made below
       {"--skip-existing -o " + q(dir / "o.exr"), "--frames"},
   };
+  fs::create_directory(dir / "taken_0001.exr");
   for (const Case& c : cases) {
     CliResult r = run_cli("render " + scene + " --backend cpu " + c.args);
     EXPECT_EQ(r.status, 2) << c.args << "\n" << r.err;

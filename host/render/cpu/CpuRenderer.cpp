@@ -20,10 +20,12 @@
 #include "light/EnvironmentMap.h"
 #include "light/LightSelection.h"
 #include "render/Limits.h"
+#include "render/SceneChecks.h"
 #include "render/cpu/Media.h"
 #include "render/cpu/Rng.h"
 #include "render/cpu/Sampling.h"
 #include "render/cpu/Transmittance.h"
+#include "shared/gpu_types.h"
 
 namespace pyrolume {
 namespace cpu {
@@ -47,11 +49,27 @@ struct Scratch {
   }
 };
 
+// SIGINT/SIGTERM inside a pass (RenderControl::cancel): one path in a
+// pathologically dense medium may take minutes of null collisions, so the
+// flag is polled every kCancelPollSteps tracking steps (and samples), not only
+// between passes, and the pass is abandoned by this exception.
+struct PassCancelled {};
+constexpr uint32_t kCancelPollSteps = 4096;
+
 struct ThreadCounters {
   uint64_t collisions = 0;       // real collisions (absorption + scattering)
   uint64_t density_lookups = 0;  // trilinear density-texture samples
   uint64_t majorant_violations = 0;
   uint64_t nonfinite = 0;
+  const std::atomic<bool>* cancel = nullptr;
+  uint32_t until_poll = kCancelPollSteps;
+  // One step of work (a tentative collision, a sample): throws PassCancelled
+  // once the cancel flag is seen.
+  void step() {
+    if (--until_poll != 0) return;
+    until_poll = kCancelPollSteps;
+    if (cancel && cancel->load(std::memory_order_relaxed)) throw PassCancelled{};
+  }
 };
 
 // What next-event estimation samples (host/light/LightSelection.h).
@@ -83,6 +101,7 @@ struct WalkScene {
 // s.rho keeps each one's density for the phase mixture and the emission.
 void coefficients_at(const MediaData& md, int c, const glm::dvec3& x, Scratch& s, ThreadCounters& cnt,
                      double& sigma_a, double& sigma_s) {
+  cnt.step();  // once per tentative collision, the unit every tracking loop advances by
   sigma_a = sigma_s = 0.0;
   s.rho.resize(s.present.size());
   for (size_t j = 0; j < s.present.size(); ++j) {
@@ -532,14 +551,17 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
     if (!(glm::length(glm::cross(f, scene.camera.up)) > 0.0))
       throw std::invalid_argument("cpu reference: camera up is parallel to the view direction");
   }
-  // Σ L and Σ L² in double, and one copy of them for a checkpoint.
-  check_accumulation_size(scene.file.string(), settings.width, settings.height, 2 * 6 * sizeof(double),
-                          physical_memory_bytes(), "this machine's memory");
+  // Σ L and Σ L² in double, the pass being accumulated beside them, and one
+  // copy of them for a checkpoint.
+  check_accumulation_fits_memory(scene.file.string(), settings.width, settings.height, 3 * 6 * sizeof(double));
   const std::string& estimator = scene.integrator.emission_estimator;
   if (estimator != "absorption" && estimator != "collision")
     throw std::invalid_argument("cpu reference: unknown emission_estimator \"" + estimator + "\"");
   const bool collision_estimator = estimator == "collision";
+  check_scene_ranges(scene);
   const MediaData media = prepare_media(scene);  // loads the vdb media's grids
+  for (size_t i = 0; i < media.media.size(); ++i)
+    if (media.media[i].volume) check_loaded_medium(scene, i, *media.media[i].volume);
   const geometry::Surfaces surfaces = geometry::build_surfaces(scene);  // meshes, textures, BVH
   std::optional<EnvironmentMap> environment;
   if (scene.environment)
@@ -587,19 +609,30 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   uint64_t total_violations = 0;
   auto last_checkpoint = render_start;
   int spp_done = res.spp;
+  // A pass accumulates into `next` (the sums so far plus its samples, added in
+  // sample order as before, so results are bit-identical) and is swapped in
+  // only when complete: a pass abandoned by a signal leaves res as the passes
+  // before it made it.
+  std::vector<double> next_sum(res.sum.size()), next_sum_sq(res.sum_sq.size());
   while (spp_done < settings.spp) {
     const int s_begin = spp_done, s_end = std::min(settings.spp, spp_done + kPassSpp);
     std::atomic<int> next_tile{0};
+    std::atomic<bool> abandoned{false};
     std::vector<ThreadCounters> counters(n_threads);
-    auto worker = [&](int tid) {
-      Scratch scratch;
-      ThreadCounters& cnt = counters[tid];
-      for (int tile; (tile = next_tile.fetch_add(1)) < n_tiles;) {
+    // The pass's tiles, taken from a shared counter until none are left.
+    auto render_tiles = [&](ThreadCounters& cnt, Scratch& scratch) {
+      for (int tile; !abandoned.load(std::memory_order_relaxed) && (tile = next_tile.fetch_add(1)) < n_tiles;) {
         int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
         for (int y = y0; y < std::min(H, y0 + kTile); ++y)
           for (int x = x0; x < std::min(W, x0 + kTile); ++x) {
             size_t pix = size_t(y) * W + x;
+            double sum[3], sum_sq[3];
+            for (int c = 0; c < 3; ++c) {
+              sum[c] = res.sum[pix * 3 + c];
+              sum_sq[c] = res.sum_sq[pix * 3 + c];
+            }
             for (int si = s_begin; si < s_end; ++si) {
+              cnt.step();
               Pcg32 rng = Pcg32::for_sample(settings.seed, settings.frame, pix, uint64_t(si));
               // Box filter: a uniform point in the pixel.
               double fx = x + rng.uniform(), fy = y + rng.uniform();
@@ -607,22 +640,45 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
               glm::dvec3 L;
               for (int c = 0; c < 3; ++c)
                 L[c] = walk_channel(walk_scene, c, scene.camera.position, dir, rng, cnt, scratch, max_depth);
-              if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z)) {
+              // NaN, Inf and beyond MAX_SAMPLE_RADIANCE (where float sums of
+              // squares could overflow): recorded as 0, counted in nonfinite_samples.
+              const double kMaxL = gpu::MAX_SAMPLE_RADIANCE;
+              if (!(std::abs(L.x) <= kMaxL && std::abs(L.y) <= kMaxL && std::abs(L.z) <= kMaxL)) {
                 ++cnt.nonfinite;
-                L = glm::dvec3(0.0);  // recorded as 0, counted in nonfinite_samples
+                L = glm::dvec3(0.0);
               }
               for (int c = 0; c < 3; ++c) {
-                res.sum[pix * 3 + c] += L[c];
-                res.sum_sq[pix * 3 + c] += L[c] * L[c];
+                sum[c] += L[c];
+                sum_sq[c] += L[c] * L[c];
               }
             }
+            for (int c = 0; c < 3; ++c) {
+              next_sum[pix * 3 + c] = sum[c];
+              next_sum_sq[pix * 3 + c] = sum_sq[c];
+            }
           }
+      }
+    };
+    auto worker = [&](int tid) {
+      Scratch scratch;
+      ThreadCounters& cnt = counters[tid];
+      cnt.cancel = control.cancel;
+      try {
+        render_tiles(cnt, scratch);
+      } catch (const PassCancelled&) {
+        abandoned = true;  // the other threads stop at their next poll or tile
       }
     };
     std::vector<std::thread> pool;
     for (int t = 1; t < n_threads; ++t) pool.emplace_back(worker, t);
     worker(0);
     for (auto& th : pool) th.join();
+    if (abandoned) {  // interrupted within the pass: it never happened
+      res.cancelled = true;
+      break;
+    }
+    res.sum.swap(next_sum);
+    res.sum_sq.swap(next_sum_sq);
     for (const auto& cnt : counters) {
       totals.collisions += cnt.collisions;
       totals.nonfinite += cnt.nonfinite;

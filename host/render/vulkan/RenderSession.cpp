@@ -1,6 +1,7 @@
 #include "render/vulkan/RenderSession.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
 
@@ -8,6 +9,7 @@
 #include "light/EmissionCdf.h"
 #include "light/EnvironmentMap.h"
 #include "render/Limits.h"
+#include "render/SceneChecks.h"
 #include "render/vulkan/Spirv.h"
 #include "util/Error.h"
 
@@ -27,6 +29,12 @@ vk::Buffer storage_buffer(vk::Context& ctx, const std::vector<T>& values, const 
   return b;
 }
 
+// What every grid medium must satisfy once loaded (render/SceneChecks.h).
+void check_loaded_media(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes) {
+  for (size_t i = 0; i < volumes.size(); ++i)
+    if (volumes[i]) check_loaded_medium(scene, i, *volumes[i]);
+}
+
 std::string mib(double bytes) { return std::to_string(int(bytes / (1024.0 * 1024.0) + 0.5)) + " MiB"; }
 }  // namespace
 
@@ -40,9 +48,9 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   check_accumulation_size(scene.file.string(), settings.width, settings.height, sizeof(gpu::AccumTexel),
                           range_binds ? range : ctx.max_allocation_size(),
                           range_binds ? "this device's maxStorageBufferRange" : "this device's maxMemoryAllocationSize");
-  check_accumulation_size(scene.file.string(), settings.width, settings.height,
-                          sizeof(gpu::AccumTexel) + 6 * sizeof(double), physical_memory_bytes(),
-                          "this machine's memory");
+  check_accumulation_fits_memory(scene.file.string(), settings.width, settings.height,
+                                 sizeof(gpu::AccumTexel) + 6 * sizeof(double));
+  check_scene_ranges(scene);
   // Load only what the scene uses: the grids of its vdb media, each checked
   // against the device's texture limits before its dense array is allocated.
   volumes_.resize(scene.media.size());
@@ -51,6 +59,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
     volumes_[i] = load_stored_volume(scene.media[i], dense_limits());
     for (const auto& w : volumes_[i]->warnings) warnings_.push_back(w);
   }
+  check_loaded_media(scene, volumes_);
   gpu_scene_ = build_gpu_scene(scene, volumes_);
 
   frame_buffer_ = vk::Buffer(ctx, sizeof(gpu::FrameConstants), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
@@ -178,9 +187,11 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
     return false;
   // Load into locals first: a bad frame (or a different variant) leaves the
   // session as it was.
+  check_scene_ranges(scene);
   std::vector<std::optional<StoredVolume>> volumes(scene.media.size());
   for (size_t i = 0; i < scene.media.size(); ++i)
     if (scene.media[i].type == Medium::Type::Vdb) volumes[i] = load_stored_volume(scene.media[i], dense_limits());
+  check_loaded_media(scene, volumes);
   // The blackbody LUTs depend only on the emission's mode, observer and
   // adaptation: bake them once per sequence and reuse them frame after frame.
   GpuScene gpu_scene = build_gpu_scene(scene, volumes, /*with_luts=*/false);
@@ -304,6 +315,12 @@ void RenderSession::create_surfaces(const Scene& scene) {
                             VK_SAMPLER_ADDRESS_MODE_REPEAT, "unused texture slot");
   textures_2d_.back().upload(ctx_, white, sizeof white);
   for (const geometry::Texture& t : surfaces.textures) {
+    const uint32_t max_side = ctx_.properties().limits.maxImageDimension2D;
+    if (uint32_t(t.width()) > max_side || uint32_t(t.height()) > max_side)
+      throw input_error(t.file().string(), "",
+                        std::to_string(t.width()) + " x " + std::to_string(t.height()) +
+                            " texels exceed this device's 2D texture limit of " + std::to_string(max_side) +
+                            " per side; resize the texture (the CPU reference, --backend cpu, has no such limit)");
     if (t.srgb_source()) {
       std::vector<uint8_t> texels = t.rgba8_srgb();
       textures_2d_.emplace_back(ctx_, uint32_t(t.width()), uint32_t(t.height()), VK_FORMAT_R8G8B8A8_SRGB,
@@ -408,6 +425,11 @@ void RenderSession::reset() {
 }
 
 void RenderSession::record_pass(VkCommandBuffer cmd, int spp) {
+  record_band(cmd, spp, 0, settings_.height);
+  spp_done_ += spp;
+}
+
+void RenderSession::record_band(VkCommandBuffer cmd, int spp, int row_begin, int row_end) {
   vkCmdFillBuffer(cmd, pass_status_.buffer(), 0, VK_WHOLE_SIZE, 0u);
   vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
@@ -417,17 +439,24 @@ void RenderSession::record_pass(VkCommandBuffer cmd, int spp) {
                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     needs_clear_ = false;
   }
-  gpu::PassConstants pass{uint32_t(spp_done_), uint32_t(spp), 0u, 0u};
+  gpu::PassConstants pass{uint32_t(spp_done_), uint32_t(spp), uint32_t(row_begin), uint32_t(row_end)};
   pipeline_->bind(cmd, set_->set());
   pipeline_->push(cmd, pass);
   const uint32_t groups_x = (uint32_t(settings_.width) + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X;
-  const uint32_t groups_y = (uint32_t(settings_.height) + gpu::WORKGROUP_SIZE_Y - 1) / gpu::WORKGROUP_SIZE_Y;
+  const uint32_t groups_y = (uint32_t(row_end - row_begin) + gpu::WORKGROUP_SIZE_Y - 1) / gpu::WORKGROUP_SIZE_Y;
   vkCmdDispatch(cmd, groups_x, groups_y, 1);
   // The next pass, a readback copy or a display shader reads what this one wrote.
   vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT);
-  spp_done_ += spp;
+}
+
+int RenderSession::first_band_rows(int spp) const {
+  // About 2^14 paths: a few milliseconds for an ordinary scene, and bounded
+  // for a pathological one (on llvmpipe each invocation stops after 65535
+  // loop iterations, PassStatus); band_rows_ then adapts to what was measured.
+  const int64_t rows = (int64_t(1) << 14) / std::max<int64_t>(1, int64_t(settings_.width) * spp);
+  return int(std::clamp<int64_t>(rows, 1, settings_.height));
 }
 
 namespace {
@@ -455,51 +484,81 @@ VkResult injected_failure() {
 }
 }  // namespace
 
-void RenderSession::run_pass(int spp) {
+bool RenderSession::run_pass(int spp, const std::atomic<bool>* cancel) {
   // What the accumulation holds after the last sub-pass that completed: a
   // failure restores it, so the counters never claim samples it lacks.
   int spp_ok = spp_done_;
   bool clear_ok = needs_clear_;
+  const VkBufferCopy all{0, 0, accum_.size()};
+  // The accumulation as it was before the pass in flight (a pass that cleared
+  // it just needs clearing again).
+  auto restore = [&](bool clears) {
+    if (clears) {
+      needs_clear_ = true;
+      return;
+    }
+    ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
+      vkCmdCopyBuffer(cmd, accum_backup_.buffer(), accum_.buffer(), 1, &all);
+      vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                         VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT);
+    });
+  };
   try {
     if (VkResult r = injected_failure(); r != VK_SUCCESS)
       vk::throw_vk_error("vkQueueSubmit (PYROLUME_TEST_FAIL_PASS)", r, __FILE__, __LINE__);
     // A pass the device cannot finish (llvmpipe's loop budget, PassStatus) is
     // undone from the copy taken before it and redone in halves; the size that
     // works is kept for the passes after it. Each sample keeps its index, so
-    // the result is the same as with passes that fit.
+    // the result is the same as with passes that fit, and as with one dispatch
+    // for the whole image: the bands below only split the pixels.
     for (int remaining = spp; remaining > 0;) {
       const int n = std::min(remaining, max_pass_spp_);
       const bool clears = needs_clear_;
-      ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
-        if (!clears) {
-          const VkBufferCopy all{0, 0, accum_.size()};
-          vkCmdCopyBuffer(cmd, accum_.buffer(), accum_backup_.buffer(), 1, &all);
-          vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT,
-                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+      if (band_rows_ == 0) band_rows_ = first_band_rows(n);
+      uint32_t unfinished = 0;
+      bool interrupted = false;
+      for (int row = 0; row < settings_.height;) {
+        const int rows = std::min(band_rows_, settings_.height - row);
+        const bool first_band = row == 0;
+        const auto t0 = std::chrono::steady_clock::now();
+        ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
+          if (first_band && !clears) {
+            vkCmdCopyBuffer(cmd, accum_.buffer(), accum_backup_.buffer(), 1, &all);
+            vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT,
+                               VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+          }
+          record_band(cmd, n, row, row + rows);
+        });
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        pass_status_.invalidate();
+        unfinished += pass_status_.data<gpu::PassStatus>()->counts.x;
+        row += rows;
+        // Dispatches long enough to hide their overhead, short enough that a
+        // signal is answered at once and no GPU watchdog fires.
+        if (seconds < kBandFastSeconds) band_rows_ = std::min(settings_.height, band_rows_ * 2);
+        else if (seconds > kBandSlowSeconds) band_rows_ = std::max(1, band_rows_ / 2);
+        if (row < settings_.height && cancel && cancel->load()) {
+          interrupted = true;
+          break;
         }
-        record_pass(cmd, n);
-      });
-      pass_status_.invalidate();
-      const uint32_t unfinished = pass_status_.data<gpu::PassStatus>()->counts.x;
+        if (unfinished > 0 && n > 1) break;  // redone in halves anyway: the other bands would be wasted
+      }
+      if (interrupted) {
+        restore(clears);
+        spp_ok = spp_done_;
+        clear_ok = needs_clear_;
+        return false;
+      }
       if (unfinished == 0 || n == 1) {
         dropped_samples_ += unfinished;  // at 1 spp per pass there is nothing left to split
+        spp_done_ += n;
         remaining -= n;
         spp_ok = spp_done_;
         clear_ok = needs_clear_;
         continue;
       }
-      spp_done_ -= n;
-      if (clears) {
-        needs_clear_ = true;
-      } else {
-        ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
-          const VkBufferCopy all{0, 0, accum_.size()};
-          vkCmdCopyBuffer(cmd, accum_backup_.buffer(), accum_.buffer(), 1, &all);
-          vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                             VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT);
-        });
-      }
+      restore(clears);
       max_pass_spp_ = n / 2;
     }
   } catch (const vk::VulkanError&) {
@@ -507,6 +566,7 @@ void RenderSession::run_pass(int spp) {
     needs_clear_ = clear_ok;
     throw;
   }
+  return true;
 }
 
 AccumulationState RenderSession::save_state() {

@@ -3,6 +3,7 @@
 // media, grid textures, majorant cells and blackbody LUTs, the pipeline
 // specialised to the scene, and the per-pixel accumulation buffer. `render` and
 // the preview window both drive it, pass by pass.
+#include <atomic>
 #include <optional>
 #include <vector>
 
@@ -43,9 +44,17 @@ class RenderSession {
   // Record one pass of `spp` samples per pixel into cmd (the caller submits).
   // Passes must be submitted in the order they were recorded.
   void record_pass(VkCommandBuffer cmd, int spp);
-  // Record, submit and wait. If the submission fails (VulkanError), spp_done()
-  // stays as it was: the accumulation holds the passes before this one.
-  void run_pass(int spp);
+  // Record, submit and wait, in bands of rows, each dispatch sized to finish
+  // well under a second (band_rows()). `cancel` (SIGINT/SIGTERM) is checked
+  // between bands: a pass it interrupts is undone (the accumulation restored
+  // from the copy taken before it) and false is returned. If a submission
+  // fails (VulkanError), spp_done() stays as it was: the accumulation holds
+  // the passes before this one.
+  bool run_pass(int spp, const std::atomic<bool>* cancel = nullptr);
+  // The rows one dispatch covers now: starts small, grows while dispatches
+  // take under kBandFastSeconds and shrinks when one takes over kBandSlowSeconds.
+  int band_rows() const { return band_rows_; }
+  static constexpr double kBandFastSeconds = 0.05, kBandSlowSeconds = 0.25;
 
   int spp_done() const { return spp_done_; }
   // Passes are split when the device cannot finish them (PassStatus): the
@@ -124,6 +133,12 @@ class RenderSession {
   std::vector<std::pair<uint32_t, uint32_t>> spec_;  // the variant pipeline_ was compiled for
   vk::Buffer pass_status_, accum_backup_;  // PassStatus; the accumulation before the pass in flight
   int max_pass_spp_ = 1 << 30;
+  int band_rows_ = 0;  // 0: not measured yet (first_band_rows)
+  // Rows for one dispatch of `spp` samples per pixel before anything is measured.
+  int first_band_rows(int spp) const;
+  // One dispatch of rows [row_begin, row_end) into cmd (the first after a
+  // reset clears the accumulation); spp_done_ unchanged.
+  void record_band(VkCommandBuffer cmd, int spp, int row_begin, int row_end);
   uint64_t dropped_samples_ = 0;
   int spp_done_ = 0;
   bool needs_clear_ = true;

@@ -88,7 +88,10 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
   auto last_save = render_start, last_checkpoint = render_start;
   try {
     while (session.spp_done() < settings.spp) {
-      session.run_pass(std::min(per_pass, settings.spp - session.spp_done()));
+      if (!session.run_pass(std::min(per_pass, settings.spp - session.spp_done()), control.cancel)) {
+        result.cancelled = true;  // within the pass: it was undone
+        break;
+      }
       if (control.progress) control.progress(session.spp_done(), settings.spp);
       if (session.spp_done() >= settings.spp) break;
       const bool checkpoint_due = control.checkpoint && control.checkpoint_seconds > 0.0 &&

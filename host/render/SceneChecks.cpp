@@ -1,0 +1,102 @@
+#include "render/SceneChecks.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "color/Blackbody.h"
+#include "shared/gpu_types.h"
+#include "util/Error.h"
+
+namespace pyrolume {
+namespace {
+
+std::string sci(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+double max3(const glm::dvec3& v) { return std::max({v.x, v.y, v.z}); }
+
+// The brightest channel a temperature-driven emission takes between 100 K
+// (the lowest the renderers evaluate) and hottest_k (the grid's hottest
+// voxel, at most 1e6 K, where they clamp): "physical" and "stefan_boltzmann"
+// grow with T, "chromaticity" and "peak" are normalised curves, so the
+// range is sampled every 2 % of temperature, its top included.
+double brightest_blackbody(const Emission& e, double hottest_k) {
+  hottest_k = std::min(hottest_k, 1e6);
+  double best = 0.0;
+  for (double T = 100.0; T < hottest_k; T *= 1.02) best = std::max(best, max3(color::blackbody_rgb(T, e.blackbody, e.observer, e.adapt_to_k)));
+  return std::max(best, max3(color::blackbody_rgb(hottest_k, e.blackbody, e.observer, e.adapt_to_k)));
+}
+
+void check_emitted_radiance(const std::string& file, const std::string& at, double scale, double brightest,
+                            const std::string& what) {
+  const double radiance = scale * brightest;
+  if (!(radiance <= double(gpu::MAX_EMITTED_RADIANCE)))
+    throw input_error(file, at + ".emission.scale",
+                      "emission.scale " + sci(scale) + " × " + what + " (" + sci(brightest) + ") gives radiance " +
+                          sci(radiance) + ", beyond " + sci(gpu::MAX_EMITTED_RADIANCE) +
+                          ", the most a render can sum in float without overflowing; lower emission.scale");
+}
+
+}  // namespace
+
+void check_scene_ranges(const Scene& scene) {
+  const std::string file = scene.file.string();
+  for (size_t i = 0; i < scene.media.size(); ++i) {
+    const Medium& m = scene.media[i];
+    const std::string at = "media[" + std::to_string(i) + "]";
+    const bool grid = m.type == Medium::Type::Vdb;
+    const double density_scale = grid ? m.density_scale : 1.0;
+    if (max3(m.sigma_a + m.sigma_s) * density_scale > kMaxSigma)
+      throw input_error(file, at + (grid ? ".density_scale" : ".sigma_a"),
+                        "σa + σs" + std::string(grid ? " × density_scale" : "") + " reaches " +
+                            sci(max3(m.sigma_a + m.sigma_s) * density_scale) + " per unit, beyond " + sci(kMaxSigma));
+    const Emission& e = m.emission;
+    if (!e.emits()) continue;
+    // A grid's temperatures are known once it is loaded: check_loaded_medium.
+    if (e.rgb) check_emitted_radiance(file, at, e.scale, max3(*e.rgb), "emission.rgb");
+    else if (e.temperature_k)
+      check_emitted_radiance(file, at, e.scale,
+                             max3(color::blackbody_rgb(*e.temperature_k, e.blackbody, e.observer, e.adapt_to_k)),
+                             "the blackbody colour of emission.temperature_k");
+  }
+}
+
+void check_loaded_medium(const Scene& scene, size_t medium, const StoredVolume& volume) {
+  check_majorant_depth(scene, medium, volume.density.grid);
+  const Medium& m = scene.media[medium];
+  const Emission& e = m.emission;
+  if (!e.emits() || !e.is_grid || !volume.temperature || volume.temperature->grid.empty()) return;
+  const DenseGrid& t = volume.temperature->grid;
+  const TemperatureMapping& map = m.temperature;
+  const double hottest_k = std::max((double(t.min_value) - map.offset) * map.scale, (double(t.max_value) - map.offset) * map.scale);
+  if (!(hottest_k > map.cutoff_k)) return;  // nothing glows (the loader warns)
+  char what[160];
+  std::snprintf(what, sizeof what, "the brightest %s blackbody colour up to the grid's hottest voxel, %.4g K",
+                color::to_string(e.blackbody), std::min(hottest_k, 1e6));
+  check_emitted_radiance(scene.file.string(), "media[" + std::to_string(medium) + "]", e.scale,
+                         brightest_blackbody(e, hottest_k), what);
+}
+
+void check_majorant_depth(const Scene& scene, size_t medium, const DenseGrid& density) {
+  if (density.empty()) return;
+  const Medium& m = scene.media[medium];
+  double max_rho = 0.0;
+  for (float v : density.values) max_rho = std::max(max_rho, double(v));
+  const double sigma_bar = max3(m.sigma_a + m.sigma_s) * m.density_scale * max_rho;
+  glm::dvec3 lo, hi;
+  density.world_bounds(lo, hi);
+  const double diagonal = glm::length(hi - lo);
+  const double depth = sigma_bar * diagonal;
+  if (!(depth <= kMaxMajorantDepth))
+    throw input_error(scene.file.string(), "media[" + std::to_string(medium) + "].density_scale",
+                      "the grid's majorant optical depth is " + sci(depth) + " (σt up to " + sci(sigma_bar) +
+                          " per unit across " + sci(diagonal) + " units): a ray through it would take that many "
+                          "tracking steps, more than " + sci(kMaxMajorantDepth) +
+                          "; lower density_scale (or sigma_a, sigma_s)");
+}
+
+}  // namespace pyrolume

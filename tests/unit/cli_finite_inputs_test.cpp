@@ -1,0 +1,23 @@
+// Values beyond what the renderers can carry are refused at load (exit 2, one
+// line naming the file and the key) or rendered finite, on the CPU reference
+// (docs/robustness.md "Finite by construction"; the cases:
+// tests/support/FiniteInputs.h, the Vulkan half: tests/vulkan/cli_finite_inputs_vulkan_test.cpp).
+#include "support/FiniteInputs.h"
+
+namespace pyrolume::test {
+namespace {
+
+TEST(CliFiniteInputs, ValuesBeyondFloatAreRefusedNamingTheKey) { expect_finite_cases_refused("cpu"); }
+
+TEST(CliFiniteInputs, ExtremeButRepresentableValuesRenderFinite) {
+  expect_overflowing_plane_normal_renders("cpu");
+  const CliResult r = render_wide_texture("cpu");  // the CPU reference has no texture size limit
+  EXPECT_EQ(r.status, 0) << r.err;
+}
+
+TEST(CliFiniteInputs, SamplesBeyondTheRadianceBoundAreCountedNotAccumulated) {
+  expect_samples_beyond_the_bound_counted("cpu");
+}
+
+}  // namespace
+}  // namespace pyrolume::test

@@ -1,0 +1,116 @@
+// Inputs that would exhaust memory are refused before anything is allocated
+// (docs/robustness.md "Limits"): one line naming the file, what it needs and
+// what there is, exit 2, no output. Each run is limited with `ulimit -v`, as a
+// render farm limits a job, so "what there is" is small and known; without
+// the checks these ended in "internal error: std::bad_alloc" (exit 1).
+#include <gtest/gtest.h>
+
+#include "render/Checkpoint.h"
+#include "support/AccumulationChecks.h"
+#include "support/VdbScenes.h"
+
+namespace pyrolume {
+namespace {
+using namespace pyrolume::test;
+namespace fs = std::filesystem;
+
+constexpr uint64_t kGiB = uint64_t(1) << 20;  // in KiB, as ulimit -v takes it
+
+// AddressSanitizer reserves terabytes of address space for its shadow memory,
+// so an ASan build of pyrolume cannot start under `ulimit -v` (tools/sanitize).
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kAddressSanitizer = true;
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+
+class CliMemoryLimits : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (kAddressSanitizer) GTEST_SKIP() << "ulimit -v and AddressSanitizer do not mix";
+  }
+};
+
+void expect_refused(const CliResult& r, const std::string& what, const std::vector<std::string>& expect,
+                    const fs::path& out) {
+  EXPECT_EQ(r.status, 2) << what << ": " << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << what << ": " << r.err;
+  for (const std::string& e : expect) EXPECT_NE(r.err.find(e), std::string::npos) << what << ": '" << e << "' in " << r.err;
+  EXPECT_EQ(r.err.find("bad_alloc"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out)) << what;
+}
+
+TEST_F(CliMemoryLimits, ASparseGridWhoseDenseArrayCannotFitIsRefused) {
+  auto dir = temp_dir("mem-grid");
+  // Two voxels 999 apart: a few hundred bytes of file, a 1002³-texel dense
+  // array (1.0e9 texels: 4 GB as float, 2 GB as R16F).
+  const fs::path vdb = write_two_voxels_vdb(dir / "cube.vdb", {999, 999, 999});
+  write_file(dir / "s.json", R"({"film": {"width": 8, "height": 8, "spp": 1},
+    "media": [{"type": "vdb", "file": "cube.vdb"}]})");
+  for (const char* backend : {"cpu", "vulkan"}) {
+    CliResult r = run_cli_with_memory_limit(
+        kGiB * 3 / 2, "render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --backend " + backend);
+    expect_refused(r, backend,
+                   {vdb.string() + ": ", "density", "1002x1002x1002 texels (with downsample 1) need", "host memory",
+                    "this process can still allocate", "add \"downsample\": "},
+                   dir / "o.exr");
+  }
+  fs::remove_all(dir);
+}
+
+TEST_F(CliMemoryLimits, AnAccumulationThatCannotFitIsRefused) {
+  auto dir = temp_dir("mem-accum");
+  write_file(dir / "s.json", R"({"film": {"width": 8, "height": 8, "spp": 1}})");
+  CliResult r = run_cli_with_memory_limit(
+      2 * kGiB, "render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --backend cpu --width 8192 --height 8192");
+  expect_refused(r, "8192²", {"film.width x film.height", "8192x8192 pixels need", "can still allocate"}, dir / "o.exr");
+  fs::remove_all(dir);
+}
+
+TEST_F(CliMemoryLimits, EndlessStreamsAsInputsAreRefused) {
+  auto dir = temp_dir("mem-zero");
+  struct Case {
+    std::string what, scene_file, scene;
+  } cases[] = {
+      {"scene", "/dev/zero", ""},
+      {"OBJ", "s.json", R"({"film": {"width": 8, "height": 8, "spp": 1}, "shapes": [{"mesh": "/dev/zero"}]})"},
+      {"texture", "s.json",
+       R"({"film": {"width": 8, "height": 8, "spp": 1}, "shapes": [{"plane": {"center": [0, 0, 0], "normal": [0, 1, 0]},
+           "material": {"diffuse": {"texture": "/dev/zero"}}}]})"},
+      {"environment", "s.json", R"({"film": {"width": 8, "height": 8, "spp": 1}, "environment": {"file": "/dev/zero"}})"},
+  };
+  for (const Case& c : cases) {
+    if (!c.scene.empty()) write_file(dir / c.scene_file, c.scene);
+    const fs::path scene = c.scene_file == "/dev/zero" ? fs::path("/dev/zero") : dir / c.scene_file;
+    CliResult r = run_cli_with_memory_limit(kGiB, "render " + q(scene) + " -o " + q(dir / "o.exr") + " --backend cpu");
+    expect_refused(r, c.what, {"pyrolume: /dev/zero: "}, dir / "o.exr");
+  }
+  fs::remove_all(dir);
+}
+
+TEST_F(CliMemoryLimits, AForgedCheckpointHeaderAllocatesNothing) {
+  auto dir = temp_dir("mem-ckpt");
+  write_file(dir / "s.json", R"({"film": {"width": 8, "height": 8, "spp": 4}})");
+  // A header claiming a 16384² CPU accumulation (12 GiB) in a file of a few bytes.
+  const uint64_t claimed = uint64_t(16384) * 16384 * 48 + 24;
+  write_file(dir / "o.exr.checkpoint",
+             "pyrolume-checkpoint 2\n{\"backend\":\"cpu\",\"device\":\"x\",\"scene\":\"s.json\",\"scene_hash\":" +
+                 std::to_string(scene_fingerprint(dir / "s.json")) +
+                 ",\"width\":16384,\"height\":16384,\"seed\":1,\"frame\":0,\"spp\":1,\"spp_target\":4,"
+                 "\"payload_bytes\":" +
+                 std::to_string(claimed) + "}\nabc");
+  CliResult r = run_cli_with_memory_limit(
+      kGiB, "render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --backend cpu --resume");
+  expect_refused(r, "checkpoint", {(dir / "o.exr.checkpoint").string() + ": truncated checkpoint: the header describes"},
+                 dir / "o.exr");
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace pyrolume
