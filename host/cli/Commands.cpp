@@ -1,5 +1,4 @@
 #include "cli/Commands.h"
-#include "light/LightSelection.h"
 
 #include <chrono>
 #include <cmath>
@@ -75,6 +74,8 @@ void write_stats(const std::filesystem::path& file, const RenderArgs& args, cons
   j["backend"] = result.backend;
   j["device"] = result.device;
   j["scene"] = args.scene;
+  j["light_strategy"] = result.light_strategy;
+  j["emission_estimator"] = result.emission_estimator;
   j["output"] = output.string();
   if (frame) j["frame"] = *frame;
   j["width"] = result.width;
@@ -309,10 +310,6 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   if (ext != ".exr" && ext != ".png")
     throw input_error(output.string(), "", "unknown image type \"" + ext + "\" (use .exr or .png)");
   if (args.variance && ext != ".exr") throw input_error(output.string(), "", "--variance needs an .exr output");
-
-  // Asked for but not possible with these settings: say so rather than ignore silently.
-  if (const std::string w = light_strategy_warning(scene); !w.empty())
-    std::cerr << "pyrolume: warning: " << scene.file.string() << ": " << w << "\n";
 
   if (sequence) return run_sequence(args, scene, output, cancel, remarks);
 

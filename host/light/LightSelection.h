@@ -19,6 +19,29 @@ enum class LightStrategy {
   LightOnly,  // debug (integrator.light_only): next-event estimation only
 };
 
+// The emission estimator a render uses (integrator.emission_estimator with
+// "auto" resolved; docs/rendering.md "Emission estimators").
+enum class EmissionEstimator { Absorption, Collision };
+// "absorption" | "collision"
+const char* estimator_name(EmissionEstimator e);
+// "bsdf" | "mis" | "light_only"
+const char* strategy_name(LightStrategy k);
+
+// Which kinds of light next-event estimation may sample, from the scene's keys
+// alone (before any light is built; a backend builds emission CDFs only for
+// `media`). Empty with "mis": false, the absorption estimator or max_depth 0.
+//   "mis" absent (the default): the environment map where something can be
+//     lit by it (surfaces or scattering media), the emissive grids only where
+//     there are surfaces: a fire alone lights only itself, and light sampling
+//     its own emission for its in-scattering costs more than it saves
+//     (docs/mis.md "When light sampling runs by default").
+//   "mis": true or "light_only": true: both, wherever something scatters.
+struct LightCandidates {
+  bool environment = false;
+  bool media = false;
+};
+LightCandidates light_candidates(const Scene& scene);
+
 // With next-event estimation, the share of continuations drawn from the
 // vertex's own lobe (docs/mis.md "Guided continuation": the best of 1, 1/2
 // and 1/4 on terrain_explosion).
@@ -30,6 +53,10 @@ struct LightSelection {
   // Per scene medium: probability of picking its emission CDF (0: not a light).
   std::vector<double> p_medium;
   LightStrategy strategy = LightStrategy::Bsdf;
+  // What both backends render with: the file's estimator, or for "auto" the
+  // collision estimator with light sampling (what MIS is written for) and
+  // the absorption estimator without (the fastest for BSDF/phase sampling).
+  EmissionEstimator estimator = EmissionEstimator::Absorption;
   // With next-event estimation, the probability that a vertex's continuation
   // is drawn from its own lobe; otherwise from the lights, by the same
   // distribution as next-event estimation (docs/mis.md "Guided continuation").
@@ -54,22 +81,21 @@ struct LightSelection {
 
 // env: the loaded environment map or null; cdfs: per scene medium, its emission
 // CDF or null (homogeneous media and grids that emit nothing are not lights).
+// Only the kinds light_candidates allows are sampled: every other light gets
+// probability 0, so a backend that built it anyway still agrees.
 //
 // Continuation: p_continue_own = kContinueOwn with next-event estimation, 1 without.
 //
 // Choice between lights: the environment and the emissive media get 1/2 each
-// when both exist (their powers, ∫Y dω and ∫Y(σa Le) dV, have different units,
-// so their ratio means nothing without a distance); among the emissive media,
-// by power ∫ w dV (EmissionCdf::power).
+// when both are sampled (their powers, ∫Y dω and ∫Y(σa Le) dV, have different
+// units, so their ratio means nothing without a distance); among the emissive
+// media, by power ∫ w dV (EmissionCdf::power).
 //
-// Strategy: Mis or LightOnly needs integrator.mis, the collision emission
-// estimator (what the renderers' MIS is written and tested for; docs/mis.md),
-// max_depth ≥ 1 and at least one light.
+// Strategy: Mis (LightOnly with integrator.light_only) when at least one light
+// is sampled, otherwise Bsdf. Estimator: as the file says, "auto" resolved by
+// the strategy. Throws std::invalid_argument for integrator keys that
+// contradict each other (integrator_conflict; the loader refuses such files).
 LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs);
-
-// One line for stderr when the scene file asks for MIS ("mis": true written
-// out) but cannot get it with the absorption estimator (empty: none).
-std::string light_strategy_warning(const Scene& scene);
 
 // Power heuristic, β = 2 (Veach 1997, eq. 9.13), for the strategy with pdf
 // p_this against p_other; 1 when p_other is 0.

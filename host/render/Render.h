@@ -72,6 +72,10 @@ struct RenderResult {
   // Interleaved RGB, width*height*3, row 0 = top.
   std::vector<double> sum, sum_sq;
   std::string backend, device;
+  // What the render resolved from integrator.mis / emission_estimator
+  // (host/light/LightSelection.h): "bsdf" | "mis" | "light_only" and
+  // "absorption" | "collision". Both backends fill them the same way.
+  std::string light_strategy, emission_estimator;
   double seconds = 0.0;       // first dispatch to finished readback
   double load_seconds = 0.0;  // device/pipeline creation, uploads, bakes
   // Counters summed over all camera samples.

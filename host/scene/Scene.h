@@ -65,13 +65,21 @@ struct Film {
 
 struct Integrator {
   int max_depth = 8;
-  bool mis = true;  // next-event estimation + MIS (needs the collision estimator; docs/mis.md)
-  bool mis_in_file = false;  // the scene file says "mis" (the warning about MIS's needs is for those who asked)
+  // Light sampling: next-event estimation + MIS (docs/mis.md "When light
+  // sampling runs by default"). Absent: wherever something can be lit; true:
+  // whenever a light can reach a scattering vertex; false: never. The choice is
+  // resolved by select_lights (host/light/LightSelection.h), for both backends.
+  std::optional<bool> mis;
   int surface_light_samples = 1;  // next-event samples per surface vertex (with MIS; docs/mis.md)
   // With MIS: a surface vertex's continuation collects its first segment by a ratio-tracked ray (docs/mis.md)
   bool ratio_tracked_continuation = false;
-  bool light_only = false;  // debug: next-event estimation only, no BSDF/phase-found light (docs/mis.md)
-  std::string emission_estimator = "absorption";  // "absorption" | "collision"
+  // Debug: next-event estimation only, no BSDF/phase-found light (docs/mis.md);
+  // asks for light sampling as "mis": true does.
+  bool light_only = false;
+  // As the file writes it: "auto" | "absorption" | "collision". "auto" is
+  // "collision" where lights are sampled (what MIS needs), otherwise
+  // "absorption"; LightSelection::estimator is the value a render uses.
+  std::string emission_estimator = "auto";
   std::string majorant = "grid";                  // "grid" | "global"
   std::optional<glm::ivec3> majorant_grid;
 };
@@ -184,6 +192,16 @@ struct Scene {
   std::vector<Medium> media;
   std::vector<Shape> shapes;
 };
+
+// Integrator keys that contradict each other ("mis": true with the absorption
+// estimator; "light_only": true with "mis": false or with absorption): the key
+// to name and why. Nullopt: none. The loader refuses such a file; select_lights
+// refuses such a Scene built in code.
+struct IntegratorConflict {
+  std::string key;  // under "integrator"
+  std::string reason;
+};
+std::optional<IntegratorConflict> integrator_conflict(const Integrator& integrator);
 
 // Parse and validate. Throws InputError("FILE: key.path: reason").
 // Keyframed values are also stored evaluated at frame 0 (clamped), the frame

@@ -351,6 +351,19 @@ Shape read_shape(Reader r, const std::filesystem::path& base) {
 
 }  // namespace
 
+std::optional<IntegratorConflict> integrator_conflict(const Integrator& in) {
+  const bool absorption = in.emission_estimator == "absorption";
+  if (in.light_only && in.mis == false)
+    return IntegratorConflict{"light_only", "true asks for light sampling, which \"mis\": false turns off"};
+  if (in.light_only && absorption)
+    return IntegratorConflict{"light_only", "true asks for light sampling, which needs the collision estimator, "
+                                            "not \"emission_estimator\": \"absorption\" (write \"auto\" or leave it out)"};
+  if (in.mis == true && absorption)
+    return IntegratorConflict{"emission_estimator", "\"absorption\" contradicts \"mis\": true (light sampling needs "
+                                                    "the collision estimator: write \"auto\" or leave it out)"};
+  return std::nullopt;
+}
+
 Scene parse_scene(const std::string& json_text, const std::filesystem::path& file) {
   const std::string fname = file.string();
   json root;
@@ -403,14 +416,14 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
   if (r.has("integrator")) {
     Reader i = r.child("integrator");
     s.integrator.max_depth = i.integer("max_depth", s.integrator.max_depth, 0, 100000);
-    s.integrator.mis_in_file = i.has("mis");
-    s.integrator.mis = i.boolean("mis", s.integrator.mis);
+    if (i.has("mis")) s.integrator.mis = i.boolean("mis", true);
     s.integrator.light_only = i.boolean("light_only", s.integrator.light_only);
     s.integrator.surface_light_samples =
         i.integer("surface_light_samples", s.integrator.surface_light_samples, 1, 64);
     s.integrator.ratio_tracked_continuation =
         i.boolean("ratio_tracked_continuation", s.integrator.ratio_tracked_continuation);
-    s.integrator.emission_estimator = i.choice("emission_estimator", "absorption", {"absorption", "collision"});
+    s.integrator.emission_estimator = i.choice("emission_estimator", "auto", {"auto", "absorption", "collision"});
+    if (const std::optional<IntegratorConflict> c = integrator_conflict(s.integrator)) i.fail(c->key, c->reason);
     s.integrator.majorant = i.choice("majorant", "grid", {"grid", "global"});
     if (i.has("majorant_grid")) {
       glm::dvec3 g = i.vec3("majorant_grid", {});

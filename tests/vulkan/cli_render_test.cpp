@@ -60,6 +60,10 @@ TEST_P(CliRender, WritesExrWithVarianceStatsAndSummary) {
   EXPECT_EQ(stats["spp"], 16);
   EXPECT_GT(stats["events_per_path"].get<double>(), 0.0);
   EXPECT_EQ(stats["nonfinite_samples"], 0);
+  // What the render resolved: no lights to sample here (a homogeneous emitter
+  // is not one), so BSDF/phase sampling with the absorption estimator.
+  EXPECT_EQ(stats["light_strategy"], "bsdf");
+  EXPECT_EQ(stats["emission_estimator"], "absorption");
   std::filesystem::remove_all(dir);
 }
 

@@ -554,10 +554,6 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   // Σ L and Σ L² in double, the pass being accumulated beside them, and one
   // copy of them for a checkpoint.
   check_accumulation_fits_memory(scene.file.string(), settings.width, settings.height, 3 * 6 * sizeof(double));
-  const std::string& estimator = scene.integrator.emission_estimator;
-  if (estimator != "absorption" && estimator != "collision")
-    throw std::invalid_argument("cpu reference: unknown emission_estimator \"" + estimator + "\"");
-  const bool collision_estimator = estimator == "collision";
   check_scene_ranges(scene);
   const MediaData media = prepare_media(scene);  // loads the vdb media's grids
   for (size_t i = 0; i < media.media.size(); ++i)
@@ -572,17 +568,20 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   const int W = settings.width, H = settings.height;
   const int max_depth = std::max(0, scene.integrator.max_depth);
   // Lights for next-event estimation: the environment map and every grid
-  // medium that emits (its emission CDF over the grid as stored).
+  // medium that emits (its emission CDF over the grid as stored), where the
+  // scene may sample them (light_candidates). The selection also resolves the
+  // emission estimator ("auto"), as it does for the Vulkan backend.
   std::vector<std::optional<EmissionCdf>> cdfs(scene.media.size());
   WalkLights lights;
   lights.cdf.assign(scene.media.size(), nullptr);
-  if (scene.integrator.mis && collision_estimator)
+  if (light_candidates(scene).media)
     for (size_t i = 0; i < scene.media.size(); ++i)
       if (media.media[i].is_vdb() && media.media[i].volume && scene.media[i].emission.emits()) {
         cdfs[i] = EmissionCdf::build_light(scene.media[i], *media.media[i].volume);
         if (!cdfs[i]->empty()) lights.cdf[i] = &*cdfs[i];
       }
   lights.selection = select_lights(scene, environment ? &*environment : nullptr, lights.cdf);
+  const bool collision_estimator = lights.selection.estimator == EmissionEstimator::Collision;
   const WalkScene walk_scene{media,     surfaces,           environment ? &*environment : nullptr, scene.background,
                              max_depth, collision_estimator, lights};
   RenderResult res;
@@ -591,6 +590,8 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   res.height = H;
   res.backend = name();
   res.device = device_name();
+  res.light_strategy = strategy_name(lights.selection.strategy);
+  res.emission_estimator = estimator_name(lights.selection.estimator);
   res.spp_target = settings.spp;
   res.sum.assign(size_t(W) * H * 3, 0.0);
   res.sum_sq.assign(size_t(W) * H * 3, 0.0);

@@ -150,7 +150,7 @@ std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const S
   return {{gpu::SPEC_HAS_GRIDS, flag(g.has_grids)},
           {gpu::SPEC_HAS_SCATTERING, flag(g.has_scattering && scene.integrator.max_depth > 0)},
           {gpu::SPEC_HAS_EMISSION, flag(g.has_emission)},
-          {gpu::SPEC_COLLISION_ESTIMATOR, flag(scene.integrator.emission_estimator == "collision")},
+          {gpu::SPEC_COLLISION_ESTIMATOR, flag(lights.estimator == EmissionEstimator::Collision)},
           {gpu::SPEC_DEBUG_MODE, settings.debug_mode},
           {gpu::SPEC_MEDIUM_COUNT, uint32_t(g.media.size())},
           {gpu::SPEC_GRID_COUNT, uint32_t(g.grids.size())},
@@ -358,7 +358,7 @@ void RenderSession::create_environment(const Scene& scene) {
 
 // Each emissive grid medium as a light: its emission CDF over the grid as
 // stored (host/light/EmissionCdf), packed one after another. Built only when
-// the scene can use next-event estimation. The preview's live edits of the
+// next-event estimation may sample the grids (light_candidates). The preview's live edits of the
 // emission (update) keep these CDFs: a stale distribution is still a valid
 // light sampler, because MIS evaluates the same tables it samples from.
 RenderSession::EmissionLights RenderSession::build_emission_lights(
@@ -367,7 +367,7 @@ RenderSession::EmissionLights RenderSession::build_emission_lights(
   out.headers.assign(gpu::MAX_GRIDS, gpu::GpuEmissionCdf{});
   std::vector<std::optional<EmissionCdf>> cdfs(scene.media.size());
   std::vector<const EmissionCdf*> by_medium(scene.media.size(), nullptr);
-  if (scene.integrator.mis && scene.integrator.emission_estimator == "collision")
+  if (light_candidates(scene).media)
     for (const GpuGridSource& src : g.grid_sources) {
       const Medium& m = scene.media[src.medium];
       if (!m.emission.emits() || !volumes[src.medium]) continue;
