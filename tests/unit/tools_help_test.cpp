@@ -22,7 +22,7 @@ TEST(ToolsHelp, EveryToolAnswersHelpWritesNothingAndExitsZero) {
                                 tools / "gen_explosion_sequence",     tools / "bench",
                                 tools / "readme_images",              tools / "cycles/compare_blender_fire"};
   int built = 0;
-  for (const char* name : {"gen_sky", "gen_fire_vdb", "gen_terrain", "bench_mis"})
+  for (const char* name : {"gen_sky", "gen_fire_vdb", "gen_terrain", "bench_mis", "bench_lookup"})
     if (fs::exists(bin / name)) list.push_back(bin / name), ++built;
   if (built == 0) std::printf("C++ tools not built here (sanitizer build): only the scripts are checked\n");
   for (const fs::path& tool : list) {
