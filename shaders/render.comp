@@ -35,6 +35,9 @@ layout(constant_id = SPEC_SURFACE_HAS_TRIANGLES) const bool SURFACE_HAS_TRIANGLE
 layout(constant_id = SPEC_HAS_ENVIRONMENT) const bool HAS_ENVIRONMENT = false;
 layout(constant_id = SPEC_LIGHT_STRATEGY) const uint LIGHT_STRATEGY = LIGHT_STRATEGY_BSDF;
 const bool NEE = LIGHT_STRATEGY != LIGHT_STRATEGY_BSDF;  // next-event estimation (with the collision estimator)
+// Continuations drawn from the lights with probability 1 − frame.lights.y; off
+// (frame.lights.y = 1) compiles that code out: llvmpipe runs every branch.
+layout(constant_id = SPEC_GUIDED_CONTINUATION) const bool GUIDED_CONTINUATION = false;
 
 layout(std140, set = 0, binding = BINDING_FRAME) uniform FrameBlock { FrameConstants frame; };
 // Media and grids are uniform blocks: every lane reads the same entries, which
@@ -556,7 +559,7 @@ bool ray_ends(inout PathState p) {
 bool continue_toward_light(vec3 o, vec4 norm, inout uint rng, out vec3 dir, out bool none) {
   dir = vec3(0.0, 0.0, 1.0);
   none = false;
-  if (!NEE || rng_next(rng) < frame.lights.y) return false;
+  if (!NEE || !GUIDED_CONTINUATION || rng_next(rng) < frame.lights.y) return false;
   none = !sample_light_direction(o, norm, rng, dir);
   return true;
 }

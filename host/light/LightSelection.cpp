@@ -67,7 +67,8 @@ LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, cons
                 : in.emission_estimator == "absorption"
                     ? EmissionEstimator::Absorption
                     : (s.strategy == LightStrategy::Bsdf ? EmissionEstimator::Absorption : EmissionEstimator::Collision);
-  s.p_continue_own = s.strategy == LightStrategy::Bsdf ? 1.0 : kContinueOwn;
+  s.p_continue_own =
+      s.strategy == LightStrategy::Bsdf ? 1.0 : 1.0 - in.guided_continuation.value_or(1.0 - kContinueOwn);
   s.surface_light_samples = s.strategy == LightStrategy::Bsdf ? 1 : in.surface_light_samples;
   s.ratio_tracked_continuation = s.strategy != LightStrategy::Bsdf && in.ratio_tracked_continuation;
   return s;

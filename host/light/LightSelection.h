@@ -43,9 +43,10 @@ struct LightCandidates {
 LightCandidates light_candidates(const Scene& scene);
 
 // With next-event estimation, the share of continuations drawn from the
-// vertex's own lobe (docs/mis.md "Guided continuation": the best of 1, 1/2
-// and 1/4 on terrain_explosion).
-inline constexpr double kContinueOwn = 0.5;
+// vertex's own lobe unless integrator.guided_continuation says otherwise
+// (docs/mis.md "Guided continuation": all of them, since drawing half from
+// the lights no longer paid at equal time once light sampling got cheaper).
+inline constexpr double kContinueOwn = 1.0;
 
 struct LightSelection {
   // Probability that one next-event sample picks the environment map.

@@ -73,6 +73,9 @@ struct Integrator {
   int surface_light_samples = 1;  // next-event samples per surface vertex (with MIS; docs/mis.md)
   // With MIS: a surface vertex's continuation collects its first segment by a ratio-tracked ray (docs/mis.md)
   bool ratio_tracked_continuation = false;
+  // With MIS: the share of continuations drawn from the lights instead of the
+  // vertex's own lobe, in [0, 1) (unset: 1 − kContinueOwn; docs/mis.md "Guided continuation")
+  std::optional<double> guided_continuation;
   // Debug: next-event estimation only, no BSDF/phase-found light (docs/mis.md);
   // asks for light sampling as "mis": true does.
   bool light_only = false;

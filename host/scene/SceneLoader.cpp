@@ -418,6 +418,11 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
     s.integrator.max_depth = i.integer("max_depth", s.integrator.max_depth, 0, 100000);
     if (i.has("mis")) s.integrator.mis = i.boolean("mis", true);
     s.integrator.light_only = i.boolean("light_only", s.integrator.light_only);
+    if (i.has("guided_continuation")) {
+      const double g = i.number("guided_continuation", 0.0);
+      if (!(g >= 0.0 && g < 1.0)) i.fail("guided_continuation", "expected a number in [0, 1)");
+      s.integrator.guided_continuation = g;
+    }
     s.integrator.surface_light_samples =
         i.integer("surface_light_samples", s.integrator.surface_light_samples, 1, 64);
     s.integrator.ratio_tracked_continuation =

@@ -168,6 +168,9 @@ TEST_F(LightResolution, FireOverPlane) {
   EXPECT_EQ(a.estimator, EmissionEstimator::Collision);
   EXPECT_DOUBLE_EQ(a.p_medium[0], 1.0);
   EXPECT_DOUBLE_EQ(a.p_continue_own, kContinueOwn);
+  Scene guided = fire_over_plane();
+  guided.integrator.guided_continuation = 0.25;  // a quarter of the continuations from the lights
+  EXPECT_DOUBLE_EQ(resolve(guided).p_continue_own, 0.75);
 
   Scene off = fire_over_plane();
   off.integrator.mis = false;

@@ -180,6 +180,10 @@ INSTANTIATE_TEST_SUITE_P(
                 "integrator.surface_light_samples: expected an integer"},
         BadCase{"ratio_tracked_continuation not bool", R"({"integrator": {"ratio_tracked_continuation": 1}})",
                 "integrator.ratio_tracked_continuation: expected"},
+        BadCase{"guided_continuation 1", R"({"integrator": {"guided_continuation": 1}})",
+                "integrator.guided_continuation: expected a number in [0, 1)"},
+        BadCase{"guided_continuation negative", R"({"integrator": {"guided_continuation": -0.5}})",
+                "integrator.guided_continuation: expected a number in [0, 1)"},
         BadCase{"background", R"({"background": {"rgb": [0, 0, -1]}})", "background.rgb"},
         BadCase{"duplicate names",
                 R"({"media": [{"name": "a", "type": "homogeneous", "bounds": {"sphere": {"center": [0,0,0], "radius": 1}}},
@@ -208,6 +212,13 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(Scene, SurfaceLightSamples) {
   EXPECT_EQ(parse_scene("{}", "a.json").integrator.surface_light_samples, 1);
   EXPECT_EQ(parse_scene(R"({"integrator": {"surface_light_samples": 4}})", "a.json").integrator.surface_light_samples, 4);
+}
+
+TEST(Scene, GuidedContinuation) {
+  EXPECT_FALSE(parse_scene("{}", "a.json").integrator.guided_continuation.has_value());
+  EXPECT_DOUBLE_EQ(*parse_scene(R"({"integrator": {"guided_continuation": 0.5}})", "a.json")
+                        .integrator.guided_continuation,
+                   0.5);
 }
 
 TEST(Scene, RatioTrackedContinuation) {

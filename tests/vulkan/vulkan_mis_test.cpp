@@ -103,6 +103,15 @@ TEST_F(VulkanMis, SurfaceLightSamplesMatchCpu) {
   test::expect_same_image(gpu(s), cpu(s, 256), 0.02, "GPU vs CPU, MIS, 3 light samples per surface vertex");
 }
 
+// Continuations drawn half from the lights (integrator.guided_continuation;
+// docs/mis.md "Guided continuation"): GPU against the CPU reference.
+TEST_F(VulkanMis, GuidedContinuationMatchesCpu) {
+  const auto dir = test::temp_dir("vk_mis_plane");
+  Scene s = test::fire_over_plane_scene(dir, Strategy::Mis, true, true, 24, 18, 256);
+  s.integrator.guided_continuation = 0.5;
+  test::expect_same_image(gpu(s), cpu(s, 256), 0.02, "GPU vs CPU, MIS, guided continuation");
+}
+
 // The ratio-tracked continuation (a light ray along the continuation, which
 // then skips its first segment) on the scattering fire over a plane: GPU
 // against the CPU reference.

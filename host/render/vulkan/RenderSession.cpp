@@ -160,7 +160,8 @@ std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const S
           {gpu::SPEC_HAS_ENVIRONMENT, flag(scene.environment.has_value())},
           {gpu::SPEC_LIGHT_STRATEGY, lights.strategy == LightStrategy::Mis         ? gpu::LIGHT_STRATEGY_MIS
                                      : lights.strategy == LightStrategy::LightOnly ? gpu::LIGHT_STRATEGY_LIGHT_ONLY
-                                                                                   : gpu::LIGHT_STRATEGY_BSDF}};
+                                                                                   : gpu::LIGHT_STRATEGY_BSDF},
+          {gpu::SPEC_GUIDED_CONTINUATION, flag(lights.p_continue_own < 1.0)}};
 }
 
 // The bindings that change with the media's grids.
