@@ -85,7 +85,8 @@ struct LightSelection {
 // Only the kinds light_candidates allows are sampled: every other light gets
 // probability 0, so a backend that built it anyway still agrees.
 //
-// Continuation: p_continue_own = kContinueOwn with next-event estimation, 1 without.
+// Continuation: p_continue_own = 1 − integrator.guided_continuation (unset:
+// kContinueOwn) with next-event estimation, 1 without.
 //
 // Choice between lights: the environment and the emissive media get 1/2 each
 // when both are sampled (their powers, ∫Y dω and ∫Y(σa Le) dV, have different

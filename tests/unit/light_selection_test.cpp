@@ -40,6 +40,15 @@ LightSelection resolve(const Scene& s) {
   return select_lights(s, env ? &*env : nullptr, by_medium);
 }
 
+// The strategy, the resolved estimator and the first medium's light probability.
+void expect_resolution(const LightSelection& l, LightStrategy strategy, EmissionEstimator estimator, double p_medium0,
+                       const char* what) {
+  SCOPED_TRACE(what);
+  EXPECT_EQ(l.strategy, strategy);
+  EXPECT_EQ(l.estimator, estimator);
+  EXPECT_DOUBLE_EQ(l.p_medium[0], p_medium0);
+}
+
 // The integrator keys as a file that writes none of them leaves them.
 void file_defaults(Scene& s) {
   s.integrator.mis.reset();
@@ -135,38 +144,29 @@ TEST(LightDefaults, CandidatesFromTheKeys) {
 // not a light; "mis": true written out samples it.
 TEST_F(LightResolution, FireAlone) {
   const LightSelection a = resolve(fire_alone());
-  EXPECT_EQ(a.strategy, LightStrategy::Bsdf);
-  EXPECT_EQ(a.estimator, EmissionEstimator::Absorption);
-  EXPECT_DOUBLE_EQ(a.p_medium[0], 0.0);
+  expect_resolution(a, LightStrategy::Bsdf, EmissionEstimator::Absorption, 0.0, "fire alone");
   EXPECT_DOUBLE_EQ(a.p_continue_own, 1.0);
 
   Scene asked = fire_alone();
   asked.integrator.mis = true;
-  const LightSelection m = resolve(asked);
-  EXPECT_EQ(m.strategy, LightStrategy::Mis);
-  EXPECT_EQ(m.estimator, EmissionEstimator::Collision);
-  EXPECT_DOUBLE_EQ(m.p_medium[0], 1.0);
+  expect_resolution(resolve(asked), LightStrategy::Mis, EmissionEstimator::Collision, 1.0, "mis true");
 
   Scene debug = fire_alone();
   debug.integrator.light_only = true;
-  EXPECT_EQ(resolve(debug).strategy, LightStrategy::LightOnly);
-  EXPECT_EQ(resolve(debug).estimator, EmissionEstimator::Collision);
+  const LightSelection d = resolve(debug);
+  EXPECT_EQ(d.strategy, LightStrategy::LightOnly);
+  EXPECT_EQ(d.estimator, EmissionEstimator::Collision);
 
   // The collision estimator written out keeps the automatic rule.
   Scene collision = fire_alone();
   collision.integrator.emission_estimator = "collision";
-  const LightSelection c = resolve(collision);
-  EXPECT_EQ(c.strategy, LightStrategy::Bsdf);
-  EXPECT_EQ(c.estimator, EmissionEstimator::Collision);
-  EXPECT_DOUBLE_EQ(c.p_medium[0], 0.0);
+  expect_resolution(resolve(collision), LightStrategy::Bsdf, EmissionEstimator::Collision, 0.0, "collision");
 }
 
 // A fire over a plane: MIS with the collision estimator, the grid a light.
 TEST_F(LightResolution, FireOverPlane) {
   const LightSelection a = resolve(fire_over_plane());
-  EXPECT_EQ(a.strategy, LightStrategy::Mis);
-  EXPECT_EQ(a.estimator, EmissionEstimator::Collision);
-  EXPECT_DOUBLE_EQ(a.p_medium[0], 1.0);
+  expect_resolution(a, LightStrategy::Mis, EmissionEstimator::Collision, 1.0, "fire over plane");
   EXPECT_DOUBLE_EQ(a.p_continue_own, kContinueOwn);
   Scene guided = fire_over_plane();
   guided.integrator.guided_continuation = 0.25;  // a quarter of the continuations from the lights
@@ -174,17 +174,15 @@ TEST_F(LightResolution, FireOverPlane) {
 
   Scene off = fire_over_plane();
   off.integrator.mis = false;
-  const LightSelection o = resolve(off);
-  EXPECT_EQ(o.strategy, LightStrategy::Bsdf);
-  EXPECT_EQ(o.estimator, EmissionEstimator::Absorption);
-  EXPECT_DOUBLE_EQ(o.p_medium[0], 0.0);
+  expect_resolution(resolve(off), LightStrategy::Bsdf, EmissionEstimator::Absorption, 0.0, "mis false");
   off.integrator.emission_estimator = "collision";
   EXPECT_EQ(resolve(off).estimator, EmissionEstimator::Collision);
 
   Scene absorption = fire_over_plane();
   absorption.integrator.emission_estimator = "absorption";
-  EXPECT_EQ(resolve(absorption).strategy, LightStrategy::Bsdf);
-  EXPECT_EQ(resolve(absorption).estimator, EmissionEstimator::Absorption);
+  const LightSelection ab = resolve(absorption);
+  EXPECT_EQ(ab.strategy, LightStrategy::Bsdf);
+  EXPECT_EQ(ab.estimator, EmissionEstimator::Absorption);
 
   Scene depth0 = fire_over_plane();
   depth0.integrator.max_depth = 0;
