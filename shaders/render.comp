@@ -7,6 +7,7 @@
 // and the emissive grids at every scattering and surface vertex, combined with
 // phase/BSDF sampling by the power heuristic (docs/mis.md).
 #extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_ballot : require
 
 #include "shared/gpu_types.h"
 #include "rng.glsl"
@@ -38,6 +39,11 @@ const bool NEE = LIGHT_STRATEGY != LIGHT_STRATEGY_BSDF;  // next-event estimatio
 // Continuations drawn from the lights with probability 1 − frame.lights.y; off
 // (frame.lights.y = 1) compiles that code out: llvmpipe runs every branch.
 layout(constant_id = SPEC_GUIDED_CONTINUATION) const bool GUIDED_CONTINUATION = false;
+// The free-flight loop in path_step leaves once half of the SIMD group's lanes
+// have found their event, instead of waiting for the last one (the device
+// supports subgroup ballots; the host sets it where it pays: media without
+// surfaces, BSDF/phase sampling; docs/benchmarks.md).
+layout(constant_id = SPEC_EARLY_EVENT_EXIT) const bool EARLY_EVENT_EXIT = false;
 
 layout(std140, set = 0, binding = BINDING_FRAME) uniform FrameBlock { FrameConstants frame; };
 // Media and grids are uniform blocks: every lane reads the same entries, which
@@ -691,84 +697,104 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   // with one step per path_step call each null collision also paid for the
   // vertex code (while-while, Aila & Laine 2009). No return inside the loop
   // (docs/mis.md: llvmpipe lost returns from inside loops).
+  //
+  // Each pass of the loop is one free flight of every lane still looking for
+  // its event (the do-while(false) body: `continue` and `break` there end the
+  // flight). The lanes that have theirs wait, masked, for the others: the
+  // loop ran at 26–35 % lane use on the lookup-bound scene. With
+  // EARLY_EVENT_EXIT the group leaves once half of its lanes are done; the
+  // others keep their ray and position and go on at the next call (free
+  // flights are memoryless). Each path sees the same random numbers either
+  // way, so the image is bit-identical.
   const uint EVENT_NONE = 0u, EVENT_ESCAPE = 1u, EVENT_SURFACE = 2u, EVENT_ABSORB = 3u, EVENT_SCATTER = 4u,
              EVENT_END = 5u;
   uint event = EVENT_NONE;
   float sigma_bar = 0.0, p_a = 0.0, p_s = 0.0;
   vec3 x = vec3(0.0), sigma_a = vec3(0.0), sigma_s = vec3(0.0);
   float rho[MEDIA_N];
-  while (event == EVENT_NONE) {
-    float t_next;
-    bool any_ahead;
-    sigma_bar = majorant_at(p.o, p.d, p.t, span, t_next, any_ahead);
-    if (!any_ahead) t_next = INF;
-    // Media beyond the closest surface do not matter: free flights end there.
-    const float t_surface = p.has_hit ? p.hit.t : INF;
-    if (isinf(t_next) && !p.has_hit) {
-      event = EVENT_ESCAPE;
-      break;
-    }
-    const float t_end = min(t_next, t_surface);
-    float dt = sigma_bar > 0.0 ? sample_free_flight(sigma_bar, rng_next(rng)) : INF;
-    if (p.t + dt >= t_end) {
-      if (p.has_hit && t_surface <= t_next) {
-        event = EVENT_SURFACE;
+  for (;;) {
+    if (event == EVENT_NONE) do {
+      float t_next;
+      bool any_ahead;
+      sigma_bar = majorant_at(p.o, p.d, p.t, span, t_next, any_ahead);
+      if (!any_ahead) t_next = INF;
+      // Media beyond the closest surface do not matter: free flights end there.
+      const float t_surface = p.has_hit ? p.hit.t : INF;
+      if (isinf(t_next) && !p.has_hit) {
+        event = EVENT_ESCAPE;
         break;
       }
-      p.t = t_next;
-      continue;
-    }
-    p.t += dt;
-    x = p.o + p.t * p.d;
-    coefficients_at(x, p.t, span, sigma_a, sigma_s, rho, stats);
-    if (HAS_EMISSION && COLLISION_ESTIMATOR && !p.skip_segment) {
-      // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.
-      // With next-event estimation the ray's own MIS weight (light rays: 1). A skipped
-      // segment (ratio-tracked continuation) was already collected: no lookup.
-      vec3 e = emission_at(x, p.t, span, rho);
-      if (max3(e) > 0.0) p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_bar) * p.w * e;
-    }
-    vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
-    if (NEE && p.light_ray) {
-      // Light rays: ratio tracking (docs/mis.md "Light rays"): no event is
-      // chosen, the weight takes the null fraction, Russian roulette once the
-      // ray's transmittance estimate is below RATIO_TRACKING_ROULETTE_BELOW.
-      const vec3 null_fraction = sigma_n / sigma_bar;
-      p.w *= null_fraction;
-      p.light_T *= max3(null_fraction);
-      if (p.light_T < RATIO_TRACKING_ROULETTE_BELOW) {
-        if (rng_next(rng) >= p.light_T) {
-          event = EVENT_END;
+      const float t_end = min(t_next, t_surface);
+      float dt = sigma_bar > 0.0 ? sample_free_flight(sigma_bar, rng_next(rng)) : INF;
+      if (p.t + dt >= t_end) {
+        if (p.has_hit && t_surface <= t_next) {
+          event = EVENT_SURFACE;
           break;
         }
-        p.w /= p.light_T;
-        p.light_T = 1.0;
+        p.t = t_next;
+        continue;
       }
-      continue;
+      p.t += dt;
+      x = p.o + p.t * p.d;
+      coefficients_at(x, p.t, span, sigma_a, sigma_s, rho, stats);
+      if (HAS_EMISSION && COLLISION_ESTIMATOR && !p.skip_segment) {
+        // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.
+        // With next-event estimation the ray's own MIS weight (light rays: 1). A skipped
+        // segment (ratio-tracked continuation) was already collected: no lookup.
+        vec3 e = emission_at(x, p.t, span, rho);
+        if (max3(e) > 0.0) p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_bar) * p.w * e;
+      }
+      vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
+      if (NEE && p.light_ray) {
+        // Light rays: ratio tracking (docs/mis.md "Light rays"): no event is
+        // chosen, the weight takes the null fraction, Russian roulette once the
+        // ray's transmittance estimate is below RATIO_TRACKING_ROULETTE_BELOW.
+        const vec3 null_fraction = sigma_n / sigma_bar;
+        p.w *= null_fraction;
+        p.light_T *= max3(null_fraction);
+        if (p.light_T < RATIO_TRACKING_ROULETTE_BELOW) {
+          if (rng_next(rng) >= p.light_T) {
+            event = EVENT_END;
+            break;
+          }
+          p.w /= p.light_T;
+          p.light_T = 1.0;
+        }
+        continue;
+      }
+      float c = sigma_bar * avg3(p.w);
+      p_a = avg3(sigma_a * p.w) / c;
+      p_s = HAS_SCATTERING ? avg3(sigma_s * p.w) / c : 0.0;
+      // With next-event estimation a real collision scatters whenever it can
+      // (docs/mis.md "No absorption events"): the collision estimator has already
+      // collected the emission here, and the scattering's weight
+      // sigma_s / (sigma_bar·(P_a + P_s)) keeps the expectation.
+      if (NEE && COLLISION_ESTIMATOR && p_s > 0.0) {
+        p_s += p_a;
+        p_a = 0.0;
+      }
+      float u = rng_next(rng);
+      if (u < p_a) {
+        event = EVENT_ABSORB;
+        break;
+      }
+      if (HAS_SCATTERING && u < p_a + p_s) {
+        event = EVENT_SCATTER;
+        break;
+      }
+      p.w *= sigma_n / (sigma_bar * (1.0 - p_a - p_s));
+      if (max3(p.w) <= 0.0) event = EVENT_END;
+    } while (false);
+    if (!EARLY_EVENT_EXIT) {
+      if (event != EVENT_NONE) break;
+    } else {
+      // Uniform across the group: every active lane counts the same ballots.
+      const uint lanes = subgroupBallotBitCount(subgroupBallot(true));
+      const uint tracking = subgroupBallotBitCount(subgroupBallot(event == EVENT_NONE));
+      if (2u * tracking <= lanes) break;
     }
-    float c = sigma_bar * avg3(p.w);
-    p_a = avg3(sigma_a * p.w) / c;
-    p_s = HAS_SCATTERING ? avg3(sigma_s * p.w) / c : 0.0;
-    // With next-event estimation a real collision scatters whenever it can
-    // (docs/mis.md "No absorption events"): the collision estimator has already
-    // collected the emission here, and the scattering's weight
-    // sigma_s / (sigma_bar·(P_a + P_s)) keeps the expectation.
-    if (NEE && COLLISION_ESTIMATOR && p_s > 0.0) {
-      p_s += p_a;
-      p_a = 0.0;
-    }
-    float u = rng_next(rng);
-    if (u < p_a) {
-      event = EVENT_ABSORB;
-      break;
-    }
-    if (HAS_SCATTERING && u < p_a + p_s) {
-      event = EVENT_SCATTER;
-      break;
-    }
-    p.w *= sigma_n / (sigma_bar * (1.0 - p_a - p_s));
-    if (max3(p.w) <= 0.0) event = EVENT_END;
   }
+  if (event == EVENT_NONE) return false;  // EARLY_EVENT_EXIT: still in free flight
   if (event == EVENT_ESCAPE) {
     escape(p);
     return ray_ends(p);

@@ -44,6 +44,10 @@ struct RenderSettings {
   // Test hook (no scene key): 1 = camera rays return the ratio-tracking
   // transmittance through the media, 2 = the delta-tracking one (per channel).
   uint32_t debug_mode = 0;
+  // Test hook (no scene key): false keeps every lane of a SIMD group in the
+  // free-flight loop until the group's last event, as before the early exit
+  // (Vulkan; the image is the same bit for bit either way).
+  bool early_event_exit = true;
 };
 
 // Called after each progressive pass: samples per pixel done so far, target.

@@ -258,6 +258,36 @@ TEST_F(VulkanVdb, AgreesWithCpuOnProceduralFire) {
   std::printf("deliberately wrong (3 %% brighter): %s\n", wrong.summary().c_str());
 }
 
+// The free-flight loop's early exit (render.comp EARLY_EVENT_EXIT: the SIMD
+// group leaves once half its lanes have their event, the rest go on at the
+// next call) changes only the schedule: each path draws the same random
+// numbers, so the image is the same bit for bit, on the lookup-bound shape
+// of the shipped fire (dense, scattering, long flights) and with the
+// absorption estimator's emission at absorptions.
+TEST_F(VulkanVdb, EarlyEventExitRendersTheSameImageBitForBit) {
+  Scene s = load_scene(std::filesystem::path(PYROLUME_SOURCE_DIR) / "assets/scenes/fire.json");
+  s.film.width = 24;
+  s.film.height = 32;
+  s.film.spp = 16;
+  s.integrator.max_depth = 16;
+  s.integrator.emission_estimator = "absorption";
+  s.media[0].density_scale = 8.0;
+  s.media[0].sigma_a = glm::dvec3(0.5);
+  s.media[0].sigma_s = glm::dvec3(4.0);
+  RenderSettings waiting = settings_for(s);
+  waiting.early_event_exit = false;
+  const RenderResult early = render(s), late = backend_->render(s, waiting, {});
+  ASSERT_EQ(early.light_strategy, "bsdf");
+  ASSERT_EQ(early.sum.size(), late.sum.size());
+  size_t differing = 0;
+  for (size_t i = 0; i < early.sum.size(); ++i)
+    differing += early.sum[i] != late.sum[i] || early.sum_sq[i] != late.sum_sq[i];
+  EXPECT_EQ(differing, 0u) << "of " << early.sum.size() << " channel sums";
+  EXPECT_EQ(early.density_lookups, late.density_lookups);
+  EXPECT_EQ(early.events, late.events);
+  EXPECT_GT(early.events, 0.0);
+}
+
 // An all-zero grid and a grid with no active voxels render the background
 // exactly, read no texel and have no events.
 TEST_F(VulkanVdb, ZeroAndEmptyGridsRenderTheBackground) {

@@ -187,10 +187,14 @@ Context::Context(const Options& options) {
     throw VulkanError("Vulkan device " + std::to_string(chosen) + " (" + info_.name + ") supports only Vulkan " +
                       api_version_string(properties_.apiVersion) +
                       "; pyrolume needs 1.2: choose another with --device or use --backend cpu");
-  VkPhysicalDeviceMaintenance3Properties m3{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES};
+  VkPhysicalDeviceSubgroupProperties subgroup{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+  VkPhysicalDeviceMaintenance3Properties m3{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES,
+                                            .pNext = &subgroup};
   VkPhysicalDeviceProperties2 props2{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &m3};
   vkGetPhysicalDeviceProperties2(physical_device_, &props2);
   max_allocation_size_ = m3.maxMemoryAllocationSize;
+  features_.subgroup_ballot = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+                              (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_BALLOT_BIT);
 
   // --- queue family: prefer graphics+compute (the preview presents from it), else any compute ---
   uint32_t nfam = 0;

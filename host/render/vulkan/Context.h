@@ -29,6 +29,8 @@ class Context {
     bool shader_int64 = false;
     bool shader_buffer_int64_atomics = false;
     bool host_query_reset = false;
+    // Compute shaders may count a subgroup's lanes (subgroupBallot, subgroupBallotBitCount).
+    bool subgroup_ballot = false;
   };
 
   explicit Context(const Options& options);

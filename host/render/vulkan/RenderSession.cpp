@@ -161,7 +161,16 @@ std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const S
           {gpu::SPEC_LIGHT_STRATEGY, lights.strategy == LightStrategy::Mis         ? gpu::LIGHT_STRATEGY_MIS
                                      : lights.strategy == LightStrategy::LightOnly ? gpu::LIGHT_STRATEGY_LIGHT_ONLY
                                                                                    : gpu::LIGHT_STRATEGY_BSDF},
-          {gpu::SPEC_GUIDED_CONTINUATION, flag(lights.p_continue_own < 1.0)}};
+          {gpu::SPEC_GUIDED_CONTINUATION, flag(lights.p_continue_own < 1.0)},
+          // Leaving the free-flight loop early pays where flights are long
+          // and an event's code is short: media alone with BSDF/phase
+          // sampling, 1.04–1.28×. With next-event estimation (0.8–0.95×) or
+          // surfaces (0.96–0.98×) the extra pass through the event code
+          // costs more than the wait (docs/benchmarks.md "Lanes in the
+          // free-flight loop").
+          {gpu::SPEC_EARLY_EVENT_EXIT,
+           flag(settings.early_event_exit && lights.strategy == LightStrategy::Bsdf && scene.shapes.empty() &&
+                ctx_.features().subgroup_ballot)}};
 }
 
 // The bindings that change with the media's grids.
@@ -184,7 +193,8 @@ void RenderSession::write_grid_descriptors() {
 
 bool RenderSession::load_frame(const Scene& scene, const RenderSettings& settings) {
   if (settings.width != settings_.width || settings.height != settings_.height ||
-      settings.debug_mode != settings_.debug_mode || scene.media.size() != volumes_.size())
+      settings.debug_mode != settings_.debug_mode ||
+      settings.early_event_exit != settings_.early_event_exit || scene.media.size() != volumes_.size())
     return false;
   // Load into locals first: a bad frame (or a different variant) leaves the
   // session as it was.
