@@ -19,6 +19,7 @@ layout(local_size_x = WORKGROUP_SIZE_X, local_size_y = WORKGROUP_SIZE_Y) in;
 
 // Specialisation: a scene without grids/scattering/emission compiles none of that code.
 layout(constant_id = SPEC_HAS_GRIDS) const bool HAS_GRIDS = true;
+layout(constant_id = SPEC_HAS_ANALYTIC_MEDIA) const bool HAS_ANALYTIC_MEDIA = true;
 layout(constant_id = SPEC_HAS_SCATTERING) const bool HAS_SCATTERING = true;
 layout(constant_id = SPEC_HAS_EMISSION) const bool HAS_EMISSION = true;
 layout(constant_id = SPEC_COLLISION_ESTIMATOR) const bool COLLISION_ESTIMATOR = false;
@@ -41,8 +42,7 @@ const bool NEE = LIGHT_STRATEGY != LIGHT_STRATEGY_BSDF;  // next-event estimatio
 layout(constant_id = SPEC_GUIDED_CONTINUATION) const bool GUIDED_CONTINUATION = false;
 // The free-flight loop in path_step leaves once half of the SIMD group's lanes
 // have found their event, instead of waiting for the last one (the device
-// supports subgroup ballots; the host sets it where it pays: media without
-// surfaces, BSDF/phase sampling; docs/benchmarks.md).
+// supports subgroup ballots; the host sets it where it pays, docs/benchmarks.md).
 layout(constant_id = SPEC_EARLY_EVENT_EXIT) const bool EARLY_EVENT_EXIT = false;
 
 layout(std140, set = 0, binding = BINDING_FRAME) uniform FrameBlock { FrameConstants frame; };
@@ -92,6 +92,11 @@ const float INF = 1.0 / 0.0;
 float avg3(vec3 v) { return (v.x + v.y + v.z) * (1.0 / 3.0); }
 float max3(vec3 v) { return max(v.x, max(v.y, v.z)); }
 float min3(vec3 v) { return min(v.x, min(v.y, v.z)); }
+
+// Whether medium m is a grid (else a sphere or a box). Without analytic media
+// the test and the analytic code compile out: llvmpipe runs both sides of
+// every branch, and that code cost ~5 % of a grid scene's time.
+bool is_grid(GpuMedium m) { return HAS_GRIDS && (!HAS_ANALYTIC_MEDIA || uint(m.sigma_a.w) == SHAPE_GRID); }
 
 struct PathStats {
   float events;   // real collisions: absorptions + scatterings
@@ -176,9 +181,9 @@ void media_spans(vec3 o, vec3 d, out vec2 span[MEDIA_N], out bool any_hit) {
     uint shape = uint(m.sigma_a.w);
     vec2 t;
     bool hit;
-    if (shape == SHAPE_SPHERE) {
+    if (!is_grid(m) && shape == SHAPE_SPHERE) {
       hit = intersect_sphere(o, d, m.bounds0.xyz, m.bounds0.w, t);
-    } else if (shape == SHAPE_BOX) {
+    } else if (!is_grid(m)) {
       hit = intersect_box(o, d, m.bounds0.xyz, m.bounds1.xyz, t);
     } else {
       // The texel box [0, dims] in texel space; t is the same there (affine map).
@@ -252,7 +257,7 @@ void coefficients_at(vec3 x, float t, vec2 span[MEDIA_N], out vec3 sigma_a, out 
     if (!(span[i].x <= t && t < span[i].y)) continue;
     GpuMedium m = media[i];
     float r = 1.0;
-    if (HAS_GRIDS && uint(m.sigma_a.w) == SHAPE_GRID) {
+    if (is_grid(m)) {
       uint slot = uint(m.bounds0.x);
       vec4 dims = grids[slot].density_dims;
       r = dims.w * density_at(slot, density_texel(slot, x) / dims.xyz);
@@ -288,7 +293,7 @@ vec3 emission_at(vec3 x, float t, vec2 span[MEDIA_N], float rho[MEDIA_N]) {
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     if (!(span[i].x <= t && t < span[i].y)) continue;
     GpuMedium m = media[i];
-    if (HAS_GRIDS && uint(m.sigma_a.w) == SHAPE_GRID) {
+    if (is_grid(m)) {
       if (rho[i] > 0.0) E += rho[i] * m.sigma_a.rgb * grid_le(m, uint(m.bounds0.x), x);
     } else {
       E += m.emission.rgb;
@@ -312,7 +317,7 @@ float majorant_at(vec3 o, vec3 d, float t, vec2 span[MEDIA_N], out float t_next,
     }
     t_next = min(t_next, s.y);
     GpuMedium m = media[i];
-    if (HAS_GRIDS && uint(m.sigma_a.w) == SHAPE_GRID) sigma_bar += grid_majorant(m, o, d, t, s.y, t_next);
+    if (is_grid(m)) sigma_bar += grid_majorant(m, o, d, t, s.y, t_next);
     else sigma_bar += max3(m.sigma_a.rgb + m.sigma_s.rgb);
   }
   return sigma_bar;
@@ -370,7 +375,7 @@ void light_norms(vec3 o, out vec4 norm) {
   norm = vec4(0.0);
   if (HAS_GRIDS && HAS_EMISSION)
     for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-      if (uint(media[i].sigma_a.w) != SHAPE_GRID) continue;
+      if (!is_grid(media[i])) continue;
       const uint slot = uint(media[i].bounds0.x);
       if (emission_lights[slot].measure.w > 0.0) norm[slot] = emission_receiver_norm(emission_lights[slot], o);
     }
@@ -385,7 +390,7 @@ float light_direction_pdf(vec3 o, vec4 norm, vec3 d) {
   if (HAS_ENVIRONMENT && frame.lights.x > 0.0) p += frame.lights.x * env_pdf(environment, d);
   if (HAS_GRIDS && HAS_EMISSION)
     for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-      if (uint(media[i].sigma_a.w) != SHAPE_GRID) continue;
+      if (!is_grid(media[i])) continue;
       GpuEmissionCdf e = emission_lights[uint(media[i].bounds0.x)];
       if (e.measure.w > 0.0) p += e.measure.w * emission_direction_pdf(e, o, norm[uint(media[i].bounds0.x)], d);
     }
@@ -412,7 +417,7 @@ bool sample_light_direction(vec3 o, vec4 norm, inout uint rng, out vec3 dir) {
   uint pick = MEDIUM_COUNT;
   bool found = false;
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-    if (uint(media[i].sigma_a.w) != SHAPE_GRID) continue;
+    if (!is_grid(media[i])) continue;
     float p = emission_lights[uint(media[i].bounds0.x)].measure.w;
     if (!(p > 0.0) || found) continue;
     pick = i;

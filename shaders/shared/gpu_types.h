@@ -64,6 +64,7 @@ PYRO_CONST uint SPEC_SURFACE_HAS_TRIANGLES = 9;
 PYRO_CONST uint SPEC_HAS_ENVIRONMENT = 10;
 PYRO_CONST uint SPEC_LIGHT_STRATEGY = 11;  // LIGHT_STRATEGY_*: next-event estimation and MIS (docs/mis.md)
 PYRO_CONST uint SPEC_GUIDED_CONTINUATION = 12;  // some continuations are drawn from the lights (LightSelection::p_continue_own < 1)
+PYRO_CONST uint SPEC_HAS_ANALYTIC_MEDIA = 14;  // a sphere or box medium (else every medium is a grid)
 PYRO_CONST uint SPEC_EARLY_EVENT_EXIT = 13;  // free flights leave once half the SIMD group has its event (render.comp path_step)
 PYRO_CONST uint LIGHT_STRATEGY_BSDF = 0;        // BSDF/phase sampling only: no light sampling code
 PYRO_CONST uint LIGHT_STRATEGY_MIS = 1;         // both, power heuristic

@@ -37,6 +37,7 @@ GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<Sto
     if (m.type == Medium::Type::Homogeneous) {
       bool sphere = m.bounds.kind == Bounds::Kind::Sphere;
       g.sigma_a = v4(m.sigma_a, sphere ? gpu::SHAPE_SPHERE : gpu::SHAPE_BOX);
+      out.has_analytic = true;
       // A medium emits sigma_a·Le per unit length (DESIGN.md).
       g.emission = v4(m.sigma_a * homogeneous_le(m.emission), 0.0);
       if (sphere) {

@@ -24,6 +24,7 @@ struct GpuScene {
   std::vector<GpuGridSource> grid_sources;  // per slot, same order as grids
   std::vector<float> majorants;             // every grid's cells, at GpuGrid::majorant_res.w
   bool has_grids = false, has_scattering = false, has_emission = false;
+  bool has_analytic = false;  // a sphere or box medium
 };
 
 // volumes[i] holds medium i's grids when it is a vdb medium. Empty grids are

@@ -148,6 +148,7 @@ std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const S
                                                                         const LightSelection& lights) const {
   auto flag = [](bool b) { return uint32_t(b ? 1 : 0); };
   return {{gpu::SPEC_HAS_GRIDS, flag(g.has_grids)},
+          {gpu::SPEC_HAS_ANALYTIC_MEDIA, flag(g.has_analytic)},
           {gpu::SPEC_HAS_SCATTERING, flag(g.has_scattering && scene.integrator.max_depth > 0)},
           {gpu::SPEC_HAS_EMISSION, flag(g.has_emission)},
           {gpu::SPEC_COLLISION_ESTIMATOR, flag(lights.estimator == EmissionEstimator::Collision)},
