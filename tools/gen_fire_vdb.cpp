@@ -220,9 +220,21 @@ int main(int argc, char** argv) {
     else if (a == "--sparse") prm.sparse = true;
     else if (a == "--float") prm.half = false;
     else if (!a.empty() && a[0] != '-' && out.empty()) out = a;
-    else return usage();
+    else {
+      const bool takes_value = a == "--resolution" || a == "--seed" || a == "--time";
+      std::cerr << "gen_fire_vdb: " << a << (takes_value ? " needs a value" : ": unknown argument") << "\n";
+      return usage();
+    }
   }
-  if (out.empty() || prm.resolution < 4 || prm.resolution > 1024 || !(prm.time >= 0 && prm.time <= 1)) return usage();
+  if (out.empty()) {
+    std::cerr << "gen_fire_vdb: no output file given\n";
+    return usage();
+  }
+  if (prm.resolution < 4 || prm.resolution > 1024 || !(prm.time >= 0 && prm.time <= 1)) {
+    std::cerr << "gen_fire_vdb: --resolution " << prm.resolution << " --time " << prm.time
+              << ": the resolution must be 4..1024 and the time in [0, 1]\n";
+    return usage();
+  }
 
   openvdb::initialize();
   const Fire fire(prm);

@@ -82,7 +82,10 @@ int usage(bool asked = false) {
 int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") return usage(true);
-  if (argc < 2 || argv[1][0] == '-') return usage();  // the first argument is the output, never an option
+  if (argc < 2 || argv[1][0] == '-') {  // the first argument is the output, never an option
+    std::fprintf(stderr, "gen_sky: %s\n", argc < 2 ? "no output file given" : ("expected OUT.exr first, not " + std::string(argv[1])).c_str());
+    return usage();
+  }
   std::string out = argv[1];
   int W = 512, H = 256;
   bool as_float = false;
@@ -108,10 +111,13 @@ int main(int argc, char** argv) {
     else if (a == "--sun-azimuth") sky.sun_azimuth = next() * kPi / 180.0;
     else if (a == "--sun-radiance") sky.sun_radiance = next();
     else if (a == "--float") as_float = true;
-    else return usage();
+    else {
+      std::fprintf(stderr, "gen_sky: unknown argument %s\n", a.c_str());
+      return usage();
+    }
   }
   if (W < 4 || H < 2 || W > 16384 || H > 8192 || sky.sun_radiance < 0) {
-    std::fprintf(stderr, "gen_sky: bad size or sun radiance\n");
+    std::fprintf(stderr, "gen_sky: --width %d --height %d --sun-radiance %g: the size must be 4..16384 x 2..8192 and the radiance >= 0\n", W, H, sky.sun_radiance);
     return 2;
   }
 

@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
       else if (a == "--texture")
         params.texture_size = std::stoi(value());
       else {
-        std::fprintf(stderr, "usage: gen_terrain [--out DIR] [--seed S] [--grid N] [--texture N]\n");
+        std::fprintf(stderr, "gen_terrain: unknown argument %s\nusage: gen_terrain [--out DIR] [--seed S] [--grid N] [--texture N]\n", a.c_str());
         return 2;
       }
     } catch (const std::exception&) {

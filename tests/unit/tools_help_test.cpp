@@ -39,3 +39,37 @@ TEST(ToolsHelp, EveryToolAnswersHelpWritesNothingAndExitsZero) {
     fs::remove_all(dir);
   }
 }
+
+// A bad argument: exit status 2, nothing written, and a line on stderr that
+// names it (docs: bad input gets a one-line error naming the key).
+TEST(ToolsHelp, EveryCppToolNamesABadArgumentAndExitsTwo) {
+  const fs::path bin = fs::path(PYROLUME_BIN).parent_path();
+  struct Case {
+    std::vector<std::string> args;  // tool, then its arguments
+    std::string named;              // what stderr must name
+  };
+  const std::vector<Case> cases = {{{"gen_sky", "out.exr", "--bogus-flag"}, "--bogus-flag"},
+                                   {{"gen_sky", "out.exr", "--width", "x7"}, "--width"},
+                                   {{"gen_fire_vdb", "out.vdb", "--bogus-flag"}, "--bogus-flag"},
+                                   {{"gen_fire_vdb", "out.vdb", "--resolution"}, "--resolution"},
+                                   {{"gen_terrain", "--bogus-flag"}, "--bogus-flag"},
+                                   {{"gen_terrain", "--grid", "seven"}, "--grid"},
+                                   {{"bench_mis", "--bogus-flag"}, "--bogus-flag"},
+                                   {{"bench_lookup", "--bogus-flag"}, "--bogus-flag"},
+                                   {{"bench_lookup", "--steps", "0"}, "--steps"}};
+  for (const Case& c : cases) {
+    if (!fs::exists(bin / c.args[0])) continue;  // the sanitizer build has no C++ tools
+    const fs::path dir = temp_dir("badarg");
+    std::string cmd = "cd '" + dir.string() + "' && '" + (bin / c.args[0]).string() + "'";
+    for (size_t i = 1; i < c.args.size(); ++i) cmd += " '" + c.args[i] + "'";
+    cmd += " >'" + (dir / "out").string() + "' 2>'" + (dir / "err").string() + "'";
+    const int raw = std::system(cmd.c_str());
+    const std::string err = read_file(dir / "err"), &bad = c.named;
+    EXPECT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 2) << cmd << "\n" << err;
+    EXPECT_NE(err.find(bad), std::string::npos) << cmd << ": stderr does not name " << bad << ":\n" << err;
+    int files = 0;
+    for (const auto& e : fs::directory_iterator(dir)) files += e.path().filename() != "out" && e.path().filename() != "err";
+    EXPECT_EQ(files, 0) << cmd << " wrote a file";
+    fs::remove_all(dir);
+  }
+}
