@@ -614,33 +614,6 @@ bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 f, float pdf_own, vec3
   return false;
 }
 
-// A Lambertian bounce at the surface ahead: weight × albedo (cosine sampling's
-// pdf cancels the cosine and 1/π), new direction on the side the ray came
-// from (surfaces are two-sided). Returns true when the path ends.
-bool surface_bounce(inout PathState p, inout uint rng, inout PathStats stats) {
-  SurfaceInteraction si = surface_interaction(p.o, p.d, p.hit);
-  stats.events += 1.0;
-  if (p.depth >= frame.image.w) return true;  // max_depth reached
-  ++p.depth;
-  GpuMaterial m = surface_materials[si.material];
-  vec3 albedo = m.albedo.rgb;
-  if (m.info.x != NO_TEXTURE) albedo *= albedo_texture_at(m.info.x, vec2(si.uv.x, 1.0 - si.uv.y));  // OBJ v=0 at the bottom
-  vec3 n = dot(si.normal, p.d) < 0.0 ? si.normal : -si.normal;
-  vec3 o = offset_ray_origin(si.position, n);
-  // Next-event estimation: f·cos = albedo·cos/π, BSDF pdf cos/π; its light
-  // rays are all drawn by next_surface_light_ray (one copy of the sampling code).
-  if (NEE) light_norms(o, p.vertex_norm);
-  vec3 d;
-  bool none;
-  if (!continue_toward_light(o, p.vertex_norm, rng, d, none))
-    d = sample_cosine_hemisphere(n, vec2(rng_next(rng), rng_next(rng)));
-  const float pdf_own = none ? 0.0 : max(dot(n, d), 0.0) * (1.0 / PI);
-  p.vertex_n = n;
-  p.vertex_wa = p.w * albedo;
-  const uint n_light = NEE && max3(p.w * albedo) > 0.0 ? uint(frame.lights.z) : 0u;
-  return leave_vertex(p, o, d, albedo * pdf_own, pdf_own, vec3(0.0), vec3(0.0), 0.0, max(n_light, 1u), n_light);
-}
-
 // The phase function of a scattering mixture from d_in toward w: its value
 // f = Σ_i share_i·HG_i (per channel) and the pdf with which the vertex samples
 // w, Σ_i q_i·HG_i (lobe i picked with probability q_i).
@@ -652,6 +625,105 @@ void phase_mixture(vec3 d_in, vec3 w, vec3 share[MEDIA_N], float q[MEDIA_N], out
     f += share[i] * hg;
     pdf += q[i] * hg;
   }
+}
+
+// A scattering vertex: a Lambertian bounce at the surface ahead (surface;
+// weight × albedo, as cosine sampling's pdf cancels the cosine and 1/π, the
+// new direction on the side the ray came from: surfaces are two-sided) or a
+// real scattering collision at x in the media. Returns true when the path
+// ends. Both kinds share one copy of the light code (the receiver
+// normalisers, the light direction, leave_vertex's light pdfs): llvmpipe runs
+// every copy for the whole SIMD group, and one more copy of light_norms,
+// sample_light_direction or light_direction_pdf cost fire_ground 22, 10 and
+// 16 % (docs/benchmarks.md "One copy of the vertex's light code").
+bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float sigma_bar, float p_s,
+                    float rho[MEDIA_N], inout uint rng, inout PathStats stats) {
+  vec3 o = x, n = vec3(0.0), albedo = vec3(0.0);
+  vec3 share[MEDIA_N];
+  float q[MEDIA_N];
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+    share[i] = vec3(0.0);
+    q[i] = 0.0;
+  }
+  if (surface) {
+    SurfaceInteraction si = surface_interaction(p.o, p.d, p.hit);
+    stats.events += 1.0;
+    if (p.depth >= frame.image.w) return true;  // max_depth reached
+    ++p.depth;
+    GpuMaterial m = surface_materials[si.material];
+    albedo = m.albedo.rgb;
+    if (m.info.x != NO_TEXTURE) albedo *= albedo_texture_at(m.info.x, vec2(si.uv.x, 1.0 - si.uv.y));  // OBJ v=0 at the bottom
+    n = dot(si.normal, p.d) < 0.0 ? si.normal : -si.normal;
+    o = offset_ray_origin(si.position, n);
+  } else {
+    if (p.depth >= frame.image.w) return true;  // max_depth reached
+    ++p.depth;
+    const float w_before = max3(p.w);
+    p.w *= sigma_s / (sigma_bar * p_s);
+    if (NEE && COLLISION_ESTIMATOR) {
+      // Russian roulette for what absorption no longer ends: once the factors
+      // that kept this path alive have lowered its weight below
+      // SCATTER_ROULETTE_BELOW of what it was, survive with probability
+      // survival / SCATTER_ROULETTE_BELOW, reweighted.
+      p.survival *= max3(p.w) / w_before;
+      const float q_survive = p.survival / SCATTER_ROULETTE_BELOW;
+      if (q_survive < 1.0) {
+        if (rng_next(rng) >= q_survive) return true;
+        p.w /= q_survive;
+        p.survival = SCATTER_ROULETTE_BELOW;
+      }
+    }
+    // Phase function of the mixture f = Σ_i share_i·HG_i, share_i = σs_i/σs (per
+    // channel): sample lobe i with q_i ∝ avg(share_i ⊙ w); the direction's pdf
+    // is the mixture's, Σ_i q_i·HG_i, and the weight f/pdf.
+    vec3 inv_sigma_s = 1.0 / max(sigma_s, vec3(1e-30));
+    float total = 0.0;
+    for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+      share[i] = rho[i] * media[i].sigma_s.rgb * inv_sigma_s;
+      q[i] = avg3(share[i] * p.w);
+      total += q[i];
+    }
+    for (uint i = 0u; i < MEDIUM_COUNT; ++i) q[i] /= total;
+  }
+  if (NEE) light_norms(o, p.vertex_norm);
+  // A medium vertex draws its light ray here; a surface vertex's light rays
+  // are all drawn by next_surface_light_ray.
+  vec3 light_dir = vec3(0.0), f_light = vec3(0.0);
+  float pdf_light = 0.0;
+  if (NEE && !surface && sample_light_direction(o, p.vertex_norm, rng, light_dir))
+    phase_mixture(p.d, light_dir, share, q, f_light, pdf_light);
+  vec3 d;
+  bool none;
+  if (!continue_toward_light(o, p.vertex_norm, rng, d, none)) {
+    if (surface) {
+      d = sample_cosine_hemisphere(n, vec2(rng_next(rng), rng_next(rng)));
+    } else {
+      float pick = rng_next(rng), acc = 0.0, g = 0.0;
+      for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+        if (q[i] <= 0.0) continue;
+        acc += q[i];
+        g = media[i].sigma_s.w;
+        if (pick < acc) break;
+      }
+      d = sample_hg(p.d, g, vec2(rng_next(rng), rng_next(rng)));
+    }
+  }
+  vec3 f;
+  float pdf_own;
+  uint n_light = 1u, lights_after = 0u;
+  if (surface) {
+    // f·cos = albedo·cos/π, BSDF pdf cos/π.
+    pdf_own = none ? 0.0 : max(dot(n, d), 0.0) * (1.0 / PI);
+    f = albedo * pdf_own;
+    p.vertex_n = n;
+    p.vertex_wa = p.w * albedo;
+    lights_after = NEE && max3(p.w * albedo) > 0.0 ? uint(frame.lights.z) : 0u;
+    n_light = max(lights_after, 1u);
+  } else {
+    phase_mixture(p.d, d, share, q, f, pdf_own);
+    if (none) f = vec3(0.0);
+  }
+  return leave_vertex(p, o, d, f, pdf_own, light_dir, f_light, pdf_light, n_light, lights_after);
 }
 
 // One step of delta tracking along one path; returns true when the path has
@@ -804,67 +876,17 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     escape(p);
     return ray_ends(p);
   }
-  if (event == EVENT_SURFACE) return NEE && p.light_ray ? ray_ends(p) : surface_bounce(p, rng, stats);
-  if (event == EVENT_END) return ray_ends(p);
-  stats.events += 1.0;
-  if (event == EVENT_ABSORB) {
-    // Absorbed: the absorption estimator collects sigma_a·Le / (sigma_bar·P_a).
-    if (HAS_EMISSION && !COLLISION_ESTIMATOR) p.L += p.w * emission_at(x, p.t, span, rho) / (sigma_bar * p_a);
-    return ray_ends(p);
-  }
-  // Scattered.
-  if (p.depth >= frame.image.w) return true;  // max_depth reached
-  ++p.depth;
-  const float w_before = max3(p.w);
-  p.w *= sigma_s / (sigma_bar * p_s);
-  if (NEE && COLLISION_ESTIMATOR) {
-    // Russian roulette for what absorption no longer ends: once the factors
-    // that kept this path alive have lowered its weight below
-    // SCATTER_ROULETTE_BELOW of what it was, survive with probability
-    // survival / SCATTER_ROULETTE_BELOW, reweighted.
-    p.survival *= max3(p.w) / w_before;
-    const float q = p.survival / SCATTER_ROULETTE_BELOW;
-    if (q < 1.0) {
-      if (rng_next(rng) >= q) return true;
-      p.w /= q;
-      p.survival = SCATTER_ROULETTE_BELOW;
+  if (event == EVENT_END || (event == EVENT_SURFACE && NEE && p.light_ray)) return ray_ends(p);
+  const bool surface = HAS_SURFACES && event == EVENT_SURFACE;
+  if (!surface) {
+    stats.events += 1.0;
+    if (event == EVENT_ABSORB) {
+      // Absorbed: the absorption estimator collects sigma_a·Le / (sigma_bar·P_a).
+      if (HAS_EMISSION && !COLLISION_ESTIMATOR) p.L += p.w * emission_at(x, p.t, span, rho) / (sigma_bar * p_a);
+      return ray_ends(p);
     }
   }
-  // Phase function of the mixture f = Σ_i share_i·HG_i, share_i = σs_i/σs (per
-  // channel): sample lobe i with q_i ∝ avg(share_i ⊙ w); the direction's pdf
-  // is the mixture's, Σ_i q_i·HG_i, and the weight f/pdf.
-  vec3 inv_sigma_s = 1.0 / max(sigma_s, vec3(1e-30));
-  vec3 share[MEDIA_N];
-  float q[MEDIA_N];
-  float total = 0.0;
-  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-    share[i] = rho[i] * media[i].sigma_s.rgb * inv_sigma_s;
-    q[i] = avg3(share[i] * p.w);
-    total += q[i];
-  }
-  for (uint i = 0u; i < MEDIUM_COUNT; ++i) q[i] /= total;
-  vec3 light_dir = vec3(0.0), f_light = vec3(0.0);
-  float pdf_light = 0.0;
-  if (NEE) light_norms(x, p.vertex_norm);
-  if (NEE && sample_light_direction(x, p.vertex_norm, rng, light_dir))
-    phase_mixture(p.d, light_dir, share, q, f_light, pdf_light);
-  vec3 d;
-  bool none;
-  if (!continue_toward_light(x, p.vertex_norm, rng, d, none)) {
-    float pick = rng_next(rng), acc = 0.0, g = 0.0;
-    for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-      if (q[i] <= 0.0) continue;
-      acc += q[i];
-      g = media[i].sigma_s.w;
-      if (pick < acc) break;
-    }
-    d = sample_hg(p.d, g, vec2(rng_next(rng), rng_next(rng)));
-  }
-  vec3 f;
-  float pdf_phase;
-  phase_mixture(p.d, d, share, q, f, pdf_phase);
-  if (none) f = vec3(0.0);
-  return leave_vertex(p, x, d, f, pdf_phase, light_dir, f_light, pdf_light, 1u, 0u);
+  return scatter_vertex(p, surface, x, sigma_s, sigma_bar, p_s, rho, rng, stats);
 }
 
 // A camera ray through pixel `pixel` for sample `k`, with that sample's random stream.
