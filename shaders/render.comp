@@ -477,6 +477,13 @@ struct PathState {
   bool light_pending;  // a light ray ended and lights_left > 0: draw the next one
   vec3 vertex_wa, vertex_n;
   vec4 vertex_norm;  // light_norms at the current vertex, by grid slot (MAX_GRIDS = 4)
+  // A medium vertex's light ray is drawn like a surface vertex's, by
+  // next_light_ray: its phase mixture (the incident direction, each lobe's
+  // share and probability); vertex_wa is then the path weight at the vertex.
+  bool vertex_medium;
+  vec3 vertex_d_in;
+  vec3 vertex_share[MEDIA_N];
+  float vertex_q[MEDIA_N];
 };
 
 // Radiance of a ray that leaves the scene: the environment map (+Z up,
@@ -506,22 +513,44 @@ float continuation_pdf(float pdf_own, float p_light) {
   return c * pdf_own + (1.0 - c) * p_light;
 }
 
-// The next of a surface vertex's light rays (docs/mis.md "Several light
-// samples"), drawn at the top of path_step: a light direction from the vertex,
-// its weight w·f·MIS weight / (n·p_light) for the n = frame.lights.z samples;
-// weight 0 when no light direction was found (the ray then ends at once).
+// The phase function of a scattering mixture from d_in toward w: its value
+// f = Σ_i share_i·HG_i (per channel) and the pdf with which the vertex samples
+// w, Σ_i q_i·HG_i (lobe i picked with probability q_i).
+void phase_mixture(vec3 d_in, vec3 w, vec3 share[MEDIA_N], float q[MEDIA_N], out vec3 f, out float pdf) {
+  f = vec3(0.0);
+  pdf = 0.0;
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+    float hg = hg_pdf(dot(d_in, w), media[i].sigma_s.w);
+    f += share[i] * hg;
+    pdf += q[i] * hg;
+  }
+}
+
+// The next of a vertex's light rays (docs/mis.md "Several light samples"),
+// drawn at the top of path_step: a light direction from the vertex, its
+// weight w·f·MIS weight / (n·p_light) for the vertex's n light samples (a
+// surface's frame.lights.z, a medium vertex's 1); weight 0 when no light
+// direction was found (the ray then ends at once). The only copy of the
+// light-sampling code: llvmpipe runs every copy for the whole SIMD group.
 // One draw per call and no loop: Mesa 22.3's llvmpipe returned false from a
 // `return true` inside this function's former retry loop for some lanes of a
 // SIMD group (measured: 46 % of the found light rays lost, the furnace 2 % dark).
-void next_surface_light_ray(inout PathState p, inout uint rng) {
-  const float n = frame.lights.z;
+void next_light_ray(inout PathState p, inout uint rng) {
+  const float n = p.vertex_medium ? 1.0 : frame.lights.z;
   --p.lights_left;
   vec3 dir;
   vec3 w = vec3(0.0);
   if (sample_light_direction(p.next_o, p.vertex_norm, rng, dir)) {
-    const float pdf_own = max(dot(p.vertex_n, dir), 0.0) * (1.0 / PI);
-    const float p_l = pdf_own > 0.0 ? light_direction_pdf(p.next_o, p.vertex_norm, dir) : 0.0;
-    if (p_l > 0.0) w = p.vertex_wa * pdf_own * (light_weight(n * p_l, continuation_pdf(pdf_own, p_l)) / (n * p_l));
+    vec3 f;
+    float pdf_own;
+    if (p.vertex_medium) {
+      phase_mixture(p.vertex_d_in, dir, p.vertex_share, p.vertex_q, f, pdf_own);
+    } else {
+      pdf_own = max(dot(p.vertex_n, dir), 0.0) * (1.0 / PI);  // Lambertian: f·cos = albedo·cos/π
+      f = vec3(pdf_own);
+    }
+    const float p_l = pdf_own > 0.0 && max3(p.vertex_wa * f) > 0.0 ? light_direction_pdf(p.next_o, p.vertex_norm, dir) : 0.0;
+    if (p_l > 0.0) w = p.vertex_wa * f * (light_weight(n * p_l, continuation_pdf(pdf_own, p_l)) / (n * p_l));
   }
   p.w = w;
   new_ray(p, p.next_o, dir, 0.0, 0.0);
@@ -577,13 +606,11 @@ bool continue_toward_light(vec3 o, vec4 norm, inout uint rng, out vec3 dir, out 
 
 // Leave vertex o along d, which the vertex's lobe weights by f with pdf
 // pdf_own (the continuation's pdf is the mixture with the lights'). With
-// next-event estimation, first the vertex's light rays, and the continuation
-// waits: a medium vertex's one along light_dir, which the lobe weights by
-// f_light with pdf pdf_light (0: none); a surface vertex's lights_after, all
-// drawn by next_surface_light_ray. n_light: the vertex's number of light
-// samples, for the MIS weights (eq. 6). Returns true when the path has ended.
-bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 f, float pdf_own, vec3 light_dir,
-                  vec3 f_light, float pdf_light, uint n_light, uint lights_after) {
+// next-event estimation the continuation waits for the vertex's lights_after
+// light rays, all drawn by next_light_ray (n_light: the vertex's number of
+// light samples, for the MIS weights, eq. 6). Returns true when the path has
+// ended.
+bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 f, float pdf_own, uint n_light, uint lights_after) {
   // "<= 0", not "!(> 0)": a NaN weight goes on and is counted (nonfinite_samples).
   if (!NEE) {
     p.w *= f / pdf_own;
@@ -594,11 +621,6 @@ bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 f, float pdf_own, vec3
   const float p_light_d = max3(f) > 0.0 ? light_direction_pdf(o, p.vertex_norm, d) : 0.0;
   const float p_mix = continuation_pdf(pdf_own, p_light_d);
   const vec3 w = p_mix > 0.0 ? p.w * f / p_mix : vec3(0.0);
-  vec3 w_light = vec3(0.0);
-  if (pdf_light > 0.0 && max3(p.w * f_light) > 0.0) {
-    const float p_l = light_direction_pdf(o, p.vertex_norm, light_dir);
-    if (p_l > 0.0) w_light = p.w * f_light * (light_weight(n * p_l, continuation_pdf(pdf_light, p_l)) / (n * p_l));
-  }
   p.next_ends = max3(w) <= 0.0;
   p.next_o = o;
   p.next_d = d;
@@ -606,25 +628,10 @@ bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 f, float pdf_own, vec3
   p.next_pdf_dir = p_mix;
   p.next_p_light = n * p_light_d;
   p.lights_left = lights_after;
-  p.continuation_ray = frame.lights.w > 0.0 && lights_after > 0u ? 1u : 0u;  // surface vertices
+  // The ratio-tracked continuation: surface vertices only.
+  p.continuation_ray = frame.lights.w > 0.0 && lights_after > 0u && !p.vertex_medium ? 1u : 0u;
   p.light_ray = true;
-  if (max3(w_light) <= 0.0) return ray_ends(p);  // the next light ray, or the continuation
-  p.w = w_light;
-  new_ray(p, o, light_dir, 0.0, 0.0);
-  return false;
-}
-
-// The phase function of a scattering mixture from d_in toward w: its value
-// f = Σ_i share_i·HG_i (per channel) and the pdf with which the vertex samples
-// w, Σ_i q_i·HG_i (lobe i picked with probability q_i).
-void phase_mixture(vec3 d_in, vec3 w, vec3 share[MEDIA_N], float q[MEDIA_N], out vec3 f, out float pdf) {
-  f = vec3(0.0);
-  pdf = 0.0;
-  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-    float hg = hg_pdf(dot(d_in, w), media[i].sigma_s.w);
-    f += share[i] * hg;
-    pdf += q[i] * hg;
-  }
+  return ray_ends(p);  // the first light ray, or the continuation
 }
 
 // A scattering vertex: a Lambertian bounce at the surface ahead (surface;
@@ -686,12 +693,6 @@ bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float
     for (uint i = 0u; i < MEDIUM_COUNT; ++i) q[i] /= total;
   }
   if (NEE) light_norms(o, p.vertex_norm);
-  // A medium vertex draws its light ray here; a surface vertex's light rays
-  // are all drawn by next_surface_light_ray.
-  vec3 light_dir = vec3(0.0), f_light = vec3(0.0);
-  float pdf_light = 0.0;
-  if (NEE && !surface && sample_light_direction(o, p.vertex_norm, rng, light_dir))
-    phase_mixture(p.d, light_dir, share, q, f_light, pdf_light);
   vec3 d;
   bool none;
   if (!continue_toward_light(o, p.vertex_norm, rng, d, none)) {
@@ -715,6 +716,7 @@ bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float
     // f·cos = albedo·cos/π, BSDF pdf cos/π.
     pdf_own = none ? 0.0 : max(dot(n, d), 0.0) * (1.0 / PI);
     f = albedo * pdf_own;
+    p.vertex_medium = false;
     p.vertex_n = n;
     p.vertex_wa = p.w * albedo;
     lights_after = NEE && max3(p.w * albedo) > 0.0 ? uint(frame.lights.z) : 0u;
@@ -722,8 +724,17 @@ bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float
   } else {
     phase_mixture(p.d, d, share, q, f, pdf_own);
     if (none) f = vec3(0.0);
+    // Its one light ray, drawn by next_light_ray with this phase mixture.
+    p.vertex_medium = true;
+    p.vertex_wa = p.w;
+    p.vertex_d_in = p.d;
+    for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+      p.vertex_share[i] = share[i];
+      p.vertex_q[i] = q[i];
+    }
+    lights_after = NEE ? 1u : 0u;
   }
-  return leave_vertex(p, o, d, f, pdf_own, light_dir, f_light, pdf_light, n_light, lights_after);
+  return leave_vertex(p, o, d, f, pdf_own, n_light, lights_after);
 }
 
 // One step of delta tracking along one path; returns true when the path has
@@ -740,7 +751,7 @@ bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float
 bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inout PathStats stats) {
   if (NEE && p.light_pending) {
     p.light_pending = false;
-    next_surface_light_ray(p, rng);
+    next_light_ray(p, rng);
     if (max3(p.w) <= 0.0) return ray_ends(p);  // no light this time: the next one, or the continuation
   }
   if (p.fresh) {
@@ -889,8 +900,10 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   return scatter_vertex(p, surface, x, sigma_s, sigma_bar, p_s, rho, rng, stats);
 }
 
-// A camera ray through pixel `pixel` for sample `k`, with that sample's random stream.
-PathState camera_path(uvec2 pixel, uint k, out uint rng) {
+// Start p as a camera ray through pixel `pixel` for sample `k`, with that
+// sample's random stream (p is filled in place: PathState holds arrays sized
+// by a specialisation constant, which GLSL cannot copy).
+void camera_path(uvec2 pixel, uint k, out uint rng, inout PathState p) {
   uint width = frame.image.x, height = frame.image.y;
   rng = rng_init(frame.sampling.x, frame.sampling.y, pixel.y * width + pixel.x, k);
   // Box filter: jitter uniformly inside the pixel; pixel (0,0) is top-left.
@@ -900,7 +913,6 @@ PathState camera_path(uvec2 pixel, uint k, out uint rng) {
   float tan_half = frame.camera_position.w, aspect = frame.camera_forward.w;
   vec3 d = normalize(frame.camera_forward.xyz + ndc.x * tan_half * aspect * frame.camera_right.xyz +
                      ndc.y * tan_half * frame.camera_up.xyz);
-  PathState p;
   p.o = frame.camera_position.xyz;
   p.d = d;
   p.w = vec3(1.0);
@@ -923,7 +935,12 @@ PathState camera_path(uvec2 pixel, uint k, out uint rng) {
   p.vertex_wa = p.vertex_n = vec3(0.0);
   p.light_pending = false;
   p.vertex_norm = vec4(0.0);
-  return p;
+  p.vertex_medium = false;
+  p.vertex_d_in = vec3(0.0);
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+    p.vertex_share[i] = vec3(0.0);
+    p.vertex_q[i] = 0.0;
+  }
 }
 
 // One Kahan (1965) summation step: s − c carries the sum of the x's to about
@@ -952,7 +969,8 @@ void main() {
   if (DEBUG_MODE != DEBUG_NONE) {
     for (; k < last; ++k) {
       uint rng;
-      PathState p = camera_path(pixel, k, rng);
+      PathState p;
+      camera_path(pixel, k, rng, p);
       vec3 T = transmittance(p.o, p.d, DEBUG_MODE == DEBUG_RATIO_TRACKING, rng, stats);
       pass_sum += T;
       pass_sq += T * T;
@@ -970,7 +988,8 @@ void main() {
     // smaller ones. (The nested loops are from when the limit was thought to
     // be per loop; they cost nothing.)
     uint rng;
-    PathState p = camera_path(pixel, k, rng);
+    PathState p;
+    camera_path(pixel, k, rng, p);
     vec2 span[MEDIA_N];
     while (k < last) {
       for (uint n = 0u; n < 16384u && k < last; ++n) {
@@ -983,7 +1002,7 @@ void main() {
         }
         kahan_add(pass_sum, pass_sum_c, L);
         kahan_add(pass_sq, pass_sq_c, L * L);
-        if (++k < last) p = camera_path(pixel, k, rng);
+        if (++k < last) camera_path(pixel, k, rng, p);
       }
     }
   }

@@ -66,7 +66,7 @@ TEST_F(VulkanMis, StrategiesAgreeOnGpu) {
 TEST_F(VulkanMis, FurnaceSphereIsOneWithSkyAsLight) {
   const auto dir = test::temp_dir("vk_mis_furnace");
   // Light only as well: a light ray lost on its way (as on llvmpipe once, see
-  // next_surface_light_ray) darkens it about 5x more than it darkens MIS.
+  // next_light_ray) darkens it about 5x more than it darkens MIS.
   // n next-event samples per surface vertex; the last with the ratio-tracked continuation.
   for (auto [n, ratio] : {std::pair{1, false}, std::pair{3, false}, std::pair{3, true}}) {
     for (Strategy st : {Strategy::Mis, Strategy::LightOnly}) {
