@@ -34,6 +34,7 @@ layout(constant_id = SPEC_GRID_COUNT) const uint GRID_COUNT = 1;
 layout(constant_id = SPEC_HAS_SURFACES) const bool HAS_SURFACES = false;
 layout(constant_id = SPEC_SURFACE_SHAPE_COUNT) const uint SURFACE_SHAPE_COUNT = 0;
 layout(constant_id = SPEC_SURFACE_HAS_TRIANGLES) const bool SURFACE_HAS_TRIANGLES = false;
+layout(constant_id = SPEC_ALBEDO_TEXTURE_COUNT) const uint ALBEDO_TEXTURE_COUNT = MAX_TEXTURES;
 layout(constant_id = SPEC_HAS_ENVIRONMENT) const bool HAS_ENVIRONMENT = false;
 layout(constant_id = SPEC_LIGHT_STRATEGY) const uint LIGHT_STRATEGY = LIGHT_STRATEGY_BSDF;
 const bool NEE = LIGHT_STRATEGY != LIGHT_STRATEGY_BSDF;  // next-event estimation (with the collision estimator)
@@ -135,7 +136,11 @@ vec3 blackbody_at(uint slot, float s) {
 
 // Grid fields are read straight from the uniform block (no GpuGrid copies:
 // copying the 192-byte struct per call is measurably slower on lavapipe).
+// With at most one texture the slot is 0 and the switch's other cases
+// compile out: each is a texture lookup, which llvmpipe runs for the whole
+// SIMD group whether or not a lane takes it.
 vec3 albedo_texture_at(uint slot, vec2 uv) {
+  if (ALBEDO_TEXTURE_COUNT <= 1u) return textureLod(albedo_tex[0], uv, 0.0).rgb;
   switch (slot) {
     case 0u: return textureLod(albedo_tex[0], uv, 0.0).rgb;
     case 1u: return textureLod(albedo_tex[1], uv, 0.0).rgb;
@@ -659,7 +664,7 @@ bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float
     ++p.depth;
     GpuMaterial m = surface_materials[si.material];
     albedo = m.albedo.rgb;
-    if (m.info.x != NO_TEXTURE) albedo *= albedo_texture_at(m.info.x, vec2(si.uv.x, 1.0 - si.uv.y));  // OBJ v=0 at the bottom
+    if (ALBEDO_TEXTURE_COUNT > 0u && m.info.x != NO_TEXTURE) albedo *= albedo_texture_at(m.info.x, vec2(si.uv.x, 1.0 - si.uv.y));  // OBJ v=0 at the bottom
     n = dot(si.normal, p.d) < 0.0 ? si.normal : -si.normal;
     o = offset_ray_origin(si.position, n);
   } else {

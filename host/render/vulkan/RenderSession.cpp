@@ -149,6 +149,8 @@ std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const S
   auto flag = [](bool b) { return uint32_t(b ? 1 : 0); };
   return {{gpu::SPEC_HAS_GRIDS, flag(g.has_grids)},
           {gpu::SPEC_HAS_ANALYTIC_MEDIA, flag(g.has_analytic)},
+          {gpu::SPEC_ALBEDO_TEXTURE_COUNT,
+           uint32_t(std::min<size_t>(textures_2d_.empty() ? 0 : textures_2d_.size() - 1, gpu::MAX_TEXTURES))},
           {gpu::SPEC_HAS_SCATTERING, flag(g.has_scattering && scene.integrator.max_depth > 0)},
           {gpu::SPEC_HAS_EMISSION, flag(g.has_emission)},
           {gpu::SPEC_COLLISION_ESTIMATOR, flag(lights.estimator == EmissionEstimator::Collision)},
