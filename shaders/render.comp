@@ -186,11 +186,7 @@ void media_spans(vec3 o, vec3 d, out vec2 span[MEDIA_N], out bool any_hit) {
     uint shape = uint(m.sigma_a.w);
     vec2 t;
     bool hit;
-    if (!is_grid(m) && shape == SHAPE_SPHERE) {
-      hit = intersect_sphere(o, d, m.bounds0.xyz, m.bounds0.w, t);
-    } else if (!is_grid(m)) {
-      hit = intersect_box(o, d, m.bounds0.xyz, m.bounds1.xyz, t);
-    } else {
+    if (is_grid(m)) {
       // The texel box [0, dims] in texel space; t is the same there (affine map).
       uint slot = uint(m.bounds0.x);
       // Clip to the trilinear support, between the zero padding texels' centres
@@ -198,6 +194,10 @@ void media_spans(vec3 o, vec3 d, out vec2 span[MEDIA_N], out bool any_hit) {
       // majorant there would only buy null collisions.
       hit = intersect_box(density_texel(slot, o), density_texel_dir(slot, d), vec3(0.5),
                           grids[slot].density_dims.xyz - 0.5, t);
+    } else if (shape == SHAPE_SPHERE) {
+      hit = intersect_sphere(o, d, m.bounds0.xyz, m.bounds0.w, t);
+    } else {
+      hit = intersect_box(o, d, m.bounds0.xyz, m.bounds1.xyz, t);
     }
     span[i] = hit ? t : vec2(-1.0);
     any_hit = any_hit || hit;
@@ -644,8 +644,9 @@ bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 f, float pdf_own, uint
 // new direction on the side the ray came from: surfaces are two-sided) or a
 // real scattering collision at x in the media. Returns true when the path
 // ends. Both kinds share one copy of the light code (the receiver
-// normalisers, the light direction, leave_vertex's light pdfs): llvmpipe runs
-// every copy for the whole SIMD group, and one more copy of light_norms,
+// normalisers, leave_vertex's light pdf; their light rays are drawn by
+// next_light_ray): llvmpipe runs every copy for the whole SIMD group, and one
+// more copy of light_norms,
 // sample_light_direction or light_direction_pdf cost fire_ground 22, 10 and
 // 16 % (docs/benchmarks.md "One copy of the vertex's light code").
 bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float sigma_bar, float p_s,
@@ -664,7 +665,8 @@ bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float
     ++p.depth;
     GpuMaterial m = surface_materials[si.material];
     albedo = m.albedo.rgb;
-    if (ALBEDO_TEXTURE_COUNT > 0u && m.info.x != NO_TEXTURE) albedo *= albedo_texture_at(m.info.x, vec2(si.uv.x, 1.0 - si.uv.y));  // OBJ v=0 at the bottom
+    if (ALBEDO_TEXTURE_COUNT > 0u && m.info.x != NO_TEXTURE)
+      albedo *= albedo_texture_at(m.info.x, vec2(si.uv.x, 1.0 - si.uv.y));  // OBJ v=0 at the bottom
     n = dot(si.normal, p.d) < 0.0 ? si.normal : -si.normal;
     o = offset_ray_origin(si.position, n);
   } else {
@@ -729,15 +731,16 @@ bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float
   } else {
     phase_mixture(p.d, d, share, q, f, pdf_own);
     if (none) f = vec3(0.0);
-    // Its one light ray, drawn by next_light_ray with this phase mixture.
-    p.vertex_medium = true;
-    p.vertex_wa = p.w;
-    p.vertex_d_in = p.d;
-    for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-      p.vertex_share[i] = share[i];
-      p.vertex_q[i] = q[i];
+    if (NEE) {  // its one light ray, drawn by next_light_ray with this phase mixture
+      p.vertex_medium = true;
+      p.vertex_wa = p.w;
+      p.vertex_d_in = p.d;
+      for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+        p.vertex_share[i] = share[i];
+        p.vertex_q[i] = q[i];
+      }
+      lights_after = 1u;
     }
-    lights_after = NEE ? 1u : 0u;
   }
   return leave_vertex(p, o, d, f, pdf_own, n_light, lights_after);
 }
