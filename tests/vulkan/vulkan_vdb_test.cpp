@@ -60,6 +60,15 @@ class VulkanVdb : public test::VulkanFixture, public test::ConstantBoxSetup {
 
   VulkanVdb() : test::ConstantBoxSetup("vulkan_vdb") {}
 
+  // The shipped fire (assets/scenes/fire.json) at a test's film size.
+  static Scene shipped_fire(int width, int height, int spp) {
+    Scene s = load_scene(std::filesystem::path(PYROLUME_SOURCE_DIR) / "assets/scenes/fire.json");
+    s.film.width = width;
+    s.film.height = height;
+    s.film.spp = spp;
+    return s;
+  }
+
   // Both estimators against the exact image; returns the last render.
   RenderResult expect_closed_form(Scene s, const std::function<glm::dvec3(int, int)>& exact, const char* what,
                                   double tolerance = 0.005) {
@@ -231,10 +240,7 @@ TEST_F(VulkanVdb, MajorantGridMatchesGlobalWithFewerLookups) {
 // on another lattice) at low resolution. The CPU is the expensive side: few
 // pixels and spp there, many on the GPU so its error is small.
 TEST_F(VulkanVdb, AgreesWithCpuOnProceduralFire) {
-  Scene s = load_scene(std::filesystem::path(PYROLUME_SOURCE_DIR) / "assets/scenes/fire.json");
-  s.film.width = 24;
-  s.film.height = 16;
-  s.film.spp = 4096;
+  Scene s = shipped_fire(24, 16, 4096);
   s.film.seed = 3;
   const RenderResult gpu = render(s);
   Scene cs = s;
@@ -265,10 +271,7 @@ TEST_F(VulkanVdb, AgreesWithCpuOnProceduralFire) {
 // of the shipped fire (dense, scattering, long flights) and with the
 // absorption estimator's emission at absorptions.
 TEST_F(VulkanVdb, EarlyEventExitRendersTheSameImageBitForBit) {
-  Scene s = load_scene(std::filesystem::path(PYROLUME_SOURCE_DIR) / "assets/scenes/fire.json");
-  s.film.width = 24;
-  s.film.height = 32;
-  s.film.spp = 16;
+  Scene s = shipped_fire(24, 32, 16);
   s.integrator.max_depth = 16;
   s.integrator.emission_estimator = "absorption";
   s.media[0].density_scale = 8.0;
