@@ -745,22 +745,26 @@ bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float
   return leave_vertex(p, o, d, f, pdf_own, n_light, lights_after);
 }
 
-// One step of delta tracking along one path; returns true when the path has
-// ended (p.L is then final).
-//
-// Delta tracking against a piecewise-constant majorant: the ray is split at
-// media boundaries and majorant-cell faces, and free flights restart at each
-// (memoryless). RGB sigma is handled by spectral tracking (Kutz et al. 2017,
-// "Spectral and Decomposition Tracking", history-aware averaged probabilities):
-// distances are sampled with the grey majorant sigma_bar, and event x (absorb /
-// scatter / null) is chosen with P_x = avg(sigma_x ⊙ w) / (sigma_bar·avg(w)); the
-// path weight w then picks up sigma_x / (sigma_bar·P_x) per channel. For grey
-// media every factor is 1 and this is plain delta tracking.
-bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inout PathStats stats) {
+// The events path_track ends a ray segment with (EVENT_NONE: EARLY_EVENT_EXIT
+// left the free-flight loop before this lane found its event).
+const uint EVENT_NONE = 0u, EVENT_ESCAPE = 1u, EVENT_SURFACE = 2u, EVENT_ABSORB = 3u, EVENT_SCATTER = 4u,
+           EVENT_END = 5u;
+// What path_event needs of the real collision path_track found.
+struct Collision {
+  vec3 x, sigma_s;
+  float sigma_bar, p_a, p_s;
+};
+// path_begin's answers: the ray is ready for free flights, or it ended before
+// any (the path goes on with its next ray, or has ended).
+const int RAY_READY = -1, RAY_ENDED = 0, PATH_ENDED = 1;
+
+// The start of a path_step: the vertex's next light ray when one is pending,
+// and a fresh ray's media spans and surface hit.
+int path_begin(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng) {
   if (NEE && p.light_pending) {
     p.light_pending = false;
     next_light_ray(p, rng);
-    if (max3(p.w) <= 0.0) return ray_ends(p);  // no light this time: the next one, or the continuation
+    if (max3(p.w) <= 0.0) return ray_ends(p) ? PATH_ENDED : RAY_ENDED;  // no light this time: the next one, or the continuation
   }
   if (p.fresh) {
     bool any_hit;
@@ -770,7 +774,7 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     p.t = 0.0;
     if (!any_hit && !p.has_hit) {
       escape(p);
-      return ray_ends(p);
+      return ray_ends(p) ? PATH_ENDED : RAY_ENDED;
     }
     // Move the origin to the first thing the ray reaches, so every later
     // position o + t·d is computed with a small t: from a camera 1e4 units
@@ -786,6 +790,21 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
       if (p.has_hit) p.hit.t -= t0;
     }
   }
+  return RAY_READY;
+}
+
+// Free flights along the current ray until its event (path_step's loop).
+//
+// Delta tracking against a piecewise-constant majorant: the ray is split at
+// media boundaries and majorant-cell faces, and free flights restart at each
+// (memoryless). RGB sigma is handled by spectral tracking (Kutz et al. 2017,
+// "Spectral and Decomposition Tracking", history-aware averaged probabilities):
+// distances are sampled with the grey majorant sigma_bar, and event x (absorb /
+// scatter / null) is chosen with P_x = avg(sigma_x ⊙ w) / (sigma_bar·avg(w)); the
+// path weight w then picks up sigma_x / (sigma_bar·P_x) per channel. For grey
+// media every factor is 1 and this is plain delta tracking.
+uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout PathStats stats, out Collision c_out,
+                out float rho[MEDIA_N]) {
   // Free flights, until the ray meets what needs more than a density lookup:
   // a surface, a real event, the end of the media, a light ray's lost
   // roulette. The cheap steps loop here and the event code below runs once per
@@ -802,12 +821,9 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   // others keep their ray and position and go on at the next call (free
   // flights are memoryless). Each path sees the same random numbers either
   // way, so the image is bit-identical.
-  const uint EVENT_NONE = 0u, EVENT_ESCAPE = 1u, EVENT_SURFACE = 2u, EVENT_ABSORB = 3u, EVENT_SCATTER = 4u,
-             EVENT_END = 5u;
   uint event = EVENT_NONE;
   float sigma_bar = 0.0, p_a = 0.0, p_s = 0.0;
   vec3 x = vec3(0.0), sigma_a = vec3(0.0), sigma_s = vec3(0.0);
-  float rho[MEDIA_N];
   for (;;) {
     if (event == EVENT_NONE) do {
       float t_next;
@@ -890,7 +906,15 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
       if (2u * tracking <= lanes) break;
     }
   }
-  if (event == EVENT_NONE) return false;  // EARLY_EVENT_EXIT: still in free flight
+  c_out = Collision(x, sigma_s, sigma_bar, p_a, p_s);
+  return event;
+}
+
+// What a ray segment's event does (path_step's end); true when the path has ended.
+bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, float rho[MEDIA_N], inout uint rng,
+                inout PathStats stats) {
+  const vec3 x = c.x, sigma_s = c.sigma_s;
+  const float sigma_bar = c.sigma_bar, p_a = c.p_a, p_s = c.p_s;
   if (event == EVENT_ESCAPE) {
     escape(p);
     return ray_ends(p);
@@ -906,6 +930,18 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
     }
   }
   return scatter_vertex(p, surface, x, sigma_s, sigma_bar, p_s, rho, rng, stats);
+}
+
+// One step of delta tracking along one path: its next ray if needed, free
+// flights, the event. Returns true when the path has ended (p.L is then final).
+bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inout PathStats stats) {
+  const int begun = path_begin(p, span, rng);
+  if (begun != RAY_READY) return begun == PATH_ENDED;
+  Collision c;
+  float rho[MEDIA_N];
+  const uint event = path_track(p, span, rng, stats, c, rho);
+  if (event == EVENT_NONE) return false;  // EARLY_EVENT_EXIT: still in free flight
+  return path_event(p, span, event, c, rho, rng, stats);
 }
 
 // Start p as a camera ray through pixel `pixel` for sample `k`, with that
@@ -962,7 +998,42 @@ void kahan_add(inout vec3 s, inout vec3 c, vec3 x) {
   s = t;
 }
 
+// One sample's radiance into the pass's sums (NaN and Inf fail the
+// comparison too: counted, and recorded as 0).
+void add_sample(vec3 L, inout vec3 pass_sum, inout vec3 pass_sum_c, inout vec3 pass_sq, inout vec3 pass_sq_c,
+                inout float nonfinite) {
+  if (!all(lessThanEqual(abs(L), vec3(MAX_SAMPLE_RADIANCE)))) {
+    nonfinite += 1.0;
+    L = vec3(0.0);
+  }
+  kahan_add(pass_sum, pass_sum_c, L);
+  kahan_add(pass_sq, pass_sq_c, L * L);
+}
+
+// A pass's sums into the pixel's accumulation, Kahan-compensated across passes.
+void add_pass(uint pixel_index, vec3 pass_sum, vec3 pass_sum_c, vec3 pass_sq, vec3 pass_sq_c, PathStats stats,
+              float nonfinite) {
+  AccumTexel a = accum[pixel_index];
+  precise vec4 y = vec4(pass_sum - pass_sum_c, stats.events) - a.sum_c;
+  precise vec4 s = a.sum + y;
+  a.sum_c = (s - a.sum) - y;
+  a.sum = s;
+  precise vec3 y2 = (pass_sq - pass_sq_c) - a.sum_sq_c.xyz;
+  precise vec3 s2 = a.sum_sq.xyz + y2;
+  a.sum_sq_c.xyz = (s2 - a.sum_sq.xyz) - y2;
+  a.sum_sq.xyz = s2;
+  a.sum_sq.w += stats.lookups;
+  a.sum_sq_c.w += nonfinite;
+  accum[pixel_index] = a;
+}
+
+#include "wavefront.glsl"
+
 void main() {
+  if (WAVEFRONT_STAGE != WAVEFRONT_NONE) {
+    wavefront_main();
+    return;
+  }
   uvec2 pixel = gl_GlobalInvocationID.xy + uvec2(0u, pass_constants.row_begin);
   uint width = frame.image.x, height = frame.image.y;
   if (pixel.x >= width || pixel.y >= min(height, pass_constants.row_end)) return;
@@ -1002,14 +1073,7 @@ void main() {
     while (k < last) {
       for (uint n = 0u; n < 16384u && k < last; ++n) {
         if (!path_step(p, span, rng, stats)) continue;
-        vec3 L = p.L;
-        // NaN and Inf fail the comparison too.
-        if (!all(lessThanEqual(abs(L), vec3(MAX_SAMPLE_RADIANCE)))) {
-          nonfinite += 1.0;
-          L = vec3(0.0);
-        }
-        kahan_add(pass_sum, pass_sum_c, L);
-        kahan_add(pass_sq, pass_sq_c, L * L);
+        add_sample(p.L, pass_sum, pass_sum_c, pass_sq, pass_sq_c, nonfinite);
         if (++k < last) camera_path(pixel, k, rng, p);
       }
     }
@@ -1020,17 +1084,5 @@ void main() {
     return;
   }
 
-  // Kahan-compensated accumulation across passes.
-  AccumTexel a = accum[pixel_index];
-  precise vec4 y = vec4(pass_sum - pass_sum_c, stats.events) - a.sum_c;
-  precise vec4 s = a.sum + y;
-  a.sum_c = (s - a.sum) - y;
-  a.sum = s;
-  precise vec3 y2 = (pass_sq - pass_sq_c) - a.sum_sq_c.xyz;
-  precise vec3 s2 = a.sum_sq.xyz + y2;
-  a.sum_sq_c.xyz = (s2 - a.sum_sq.xyz) - y2;
-  a.sum_sq.xyz = s2;
-  a.sum_sq.w += stats.lookups;
-  a.sum_sq_c.w += nonfinite;
-  accum[pixel_index] = a;
+  add_pass(pixel_index, pass_sum, pass_sum_c, pass_sq, pass_sq_c, stats, nonfinite);
 }

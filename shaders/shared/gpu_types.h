@@ -49,6 +49,8 @@ PYRO_CONST uint BINDING_EMISSION_PMF = 19;     // readonly buffer float[]: per-c
 PYRO_CONST uint BINDING_EMISSION_HEADERS = 20; // uniform GpuEmissionCdf[MAX_GRIDS], by grid slot
 PYRO_CONST uint BINDING_EMISSION_CLUSTERS = 22; // readonly buffer GpuEmissionCluster[]: their clusters
 PYRO_CONST uint BINDING_PASS_STATUS = 21;      // buffer PassStatus: what the pass could not finish
+PYRO_CONST uint BINDING_PATHS = 23;    // uimageBuffer (rgba32ui): the wavefront's path states (shaders/wavefront.glsl path_io)
+PYRO_CONST uint BINDING_QUEUES = 24;   // buffer WavefrontQueues, then its queues of path slots
 
 // Specialisation constants of render.comp: a scene pays only for what it uses.
 PYRO_CONST uint SPEC_HAS_GRIDS = 0;
@@ -67,6 +69,20 @@ PYRO_CONST uint SPEC_GUIDED_CONTINUATION = 12;  // some continuations are drawn 
 PYRO_CONST uint SPEC_HAS_ANALYTIC_MEDIA = 14;
 PYRO_CONST uint SPEC_ALBEDO_TEXTURE_COUNT = 15;  // albedo textures the surfaces use (0..MAX_TEXTURES)  // a sphere or box medium (else every medium is a grid)
 PYRO_CONST uint SPEC_EARLY_EVENT_EXIT = 13;  // free flights leave once half the SIMD group has its event (render.comp path_step)
+PYRO_CONST uint SPEC_WAVEFRONT_STAGE = 16;  // WAVEFRONT_*: the megakernel, or one stage of the wavefront integrator
+PYRO_CONST uint WAVEFRONT_NONE = 0;        // the megakernel: each lane runs its paths to the end
+PYRO_CONST uint WAVEFRONT_START = 1;       // one lane per pixel: its first camera ray
+PYRO_CONST uint WAVEFRONT_TRACK = 2;       // the track queue: free flights up to each path's event
+PYRO_CONST uint WAVEFRONT_EVENT = 3;       // the event queue: the event, and the path's next ray
+PYRO_CONST uint WAVEFRONT_SIZE_TRACK = 4;  // one lane: the track dispatch's size from its queue
+PYRO_CONST uint WAVEFRONT_SIZE_EVENT = 5;  // one lane: the event dispatch's size from its queue
+PYRO_CONST uint WAVEFRONT_BEGIN = 6;       // the begin queue: the path's next ray (split event stage)
+PYRO_CONST uint WAVEFRONT_SIZE_BEGIN = 7;  // one lane: the begin dispatch's size from its queue
+PYRO_CONST uint SPEC_WAVEFRONT_SPLIT = 17;  // the event stage leaves the next ray to the begin stage
+PYRO_CONST uint WAVEFRONT_GROUP = 64;      // lanes per workgroup of the queue stages
+// 16-byte words of one path's state: a fixed part and a part per medium.
+PYRO_CONST uint WAVEFRONT_PATH_WORDS = 22;
+PYRO_CONST uint WAVEFRONT_PATH_WORDS_PER_MEDIUM = 2;
 PYRO_CONST uint LIGHT_STRATEGY_BSDF = 0;        // BSDF/phase sampling only: no light sampling code
 PYRO_CONST uint LIGHT_STRATEGY_MIS = 1;         // both, power heuristic
 PYRO_CONST uint LIGHT_STRATEGY_LIGHT_ONLY = 2;  // debug: next-event estimation only
@@ -146,6 +162,17 @@ struct PassStatus {
   uvec4 counts;  // x: samples not finished (summed over pixels); yzw: 0
 };
 
+// The wavefront's queues (buffer BINDING_QUEUES): this header, then four
+// queues of `capacity` path slots: two track queues (the one being read, the
+// one being filled), the event queue and the begin queue. Zeroed before every band.
+struct WavefrontQueues {
+  uvec4 track_dispatch;  // xyz: vkCmdDispatchIndirect's workgroups for the track stage
+  uvec4 event_dispatch;  // xyz: the same for the event stage
+  uvec4 begin_dispatch;  // xyz: the same for the begin stage
+  uvec4 counts;          // x, y: paths in track queue 0, 1; z: in the event queue; w: the track queue being read
+  uvec4 sizes;           // x: capacity (paths per queue); y: paths in the begin queue; zw: unused
+};
+
 // Per-pixel accumulation, Kahan-compensated so float32 sums stay accurate over
 // thousands of passes (Kahan 1965; `precise` stops the compiler reassociating).
 struct AccumTexel {
@@ -163,6 +190,7 @@ static_assert(offsetof(FrameConstants, image) == 80);
 static_assert(sizeof(PassConstants) == 16);
 static_assert(sizeof(AccumTexel) == 64);
 static_assert(sizeof(PassStatus) == 16);
+static_assert(sizeof(WavefrontQueues) == 80);
 }  // namespace pyrolume::gpu
 #endif
 #endif

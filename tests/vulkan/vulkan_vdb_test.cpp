@@ -291,6 +291,47 @@ TEST_F(VulkanVdb, EarlyEventExitRendersTheSameImageBitForBit) {
   EXPECT_GT(early.events, 0.0);
 }
 
+// The wavefront prototype (PYROLUME_WAVEFRONT=1: track and event stages; 2:
+// the event stage split in two) runs each path's code on the same random
+// numbers in the same order as the megakernel: the same image bit for bit,
+// on the fire over a ground with MIS (light rays, surfaces) and on the
+// lookup-bound fire (BSDF sampling, no surfaces).
+TEST_F(VulkanVdb, WavefrontRendersTheSameImageBitForBit) {
+  Scene ground = load_scene(std::filesystem::path(PYROLUME_SOURCE_DIR) / "assets/scenes/fire_ground.json");
+  ground.film.width = 24;
+  ground.film.height = 16;
+  ground.film.spp = 8;
+  Scene lookup = shipped_fire(16, 24, 8);
+  lookup.integrator.max_depth = 16;
+  lookup.integrator.emission_estimator = "absorption";
+  lookup.media[0].density_scale = 8.0;
+  lookup.media[0].sigma_a = glm::dvec3(0.5);
+  lookup.media[0].sigma_s = glm::dvec3(4.0);
+  struct Restore {
+    ~Restore() { unsetenv("PYROLUME_WAVEFRONT"); }
+  } restore;
+  // Each mode once (each session compiles its stages: seconds on lavapipe).
+  for (const auto& [s, mode] : {std::pair<const Scene*, const char*>{&ground, "1"}, {&lookup, "2"}}) {
+    unsetenv("PYROLUME_WAVEFRONT");
+    const RenderResult mega = render(*s);
+    EXPECT_EQ(mega.light_strategy, s == &ground ? "mis" : "bsdf");
+    EXPECT_GT(mega.events, 0.0);
+    {
+      setenv("PYROLUME_WAVEFRONT", mode, 1);
+      const RenderResult wave = render(*s);
+      ASSERT_EQ(wave.light_strategy, mega.light_strategy);
+      ASSERT_EQ(wave.sum.size(), mega.sum.size());
+      size_t differing = 0;
+      for (size_t i = 0; i < wave.sum.size(); ++i)
+        differing += wave.sum[i] != mega.sum[i] || wave.sum_sq[i] != mega.sum_sq[i];
+      EXPECT_EQ(differing, 0u) << "of " << wave.sum.size() << " channel sums, " << s->file << ", mode " << mode;
+      EXPECT_EQ(wave.density_lookups, mega.density_lookups) << mode;
+      EXPECT_EQ(wave.events, mega.events) << mode;
+      EXPECT_EQ(wave.spp, mega.spp) << mode;
+    }
+  }
+}
+
 // An all-zero grid and a grid with no active voxels render the background
 // exactly, read no texel and have no events.
 TEST_F(VulkanVdb, ZeroAndEmptyGridsRenderTheBackground) {

@@ -73,6 +73,7 @@ using UniqueBuffer = Unique<VkBuffer, DeviceDeleter<VkBuffer, vkDestroyBuffer>>;
 using UniqueDeviceMemory = Unique<VkDeviceMemory, DeviceDeleter<VkDeviceMemory, vkFreeMemory>>;
 using UniqueImage = Unique<VkImage, DeviceDeleter<VkImage, vkDestroyImage>>;
 using UniqueImageView = Unique<VkImageView, DeviceDeleter<VkImageView, vkDestroyImageView>>;
+using UniqueBufferView = Unique<VkBufferView, DeviceDeleter<VkBufferView, vkDestroyBufferView>>;
 using UniqueSampler = Unique<VkSampler, DeviceDeleter<VkSampler, vkDestroySampler>>;
 using UniqueDescriptorSetLayout =
     Unique<VkDescriptorSetLayout, DeviceDeleter<VkDescriptorSetLayout, vkDestroyDescriptorSetLayout>>;

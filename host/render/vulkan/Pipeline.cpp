@@ -121,6 +121,16 @@ void DescriptorSet::write_buffer(uint32_t binding, const Buffer& buffer, VkDevic
   vkUpdateDescriptorSets(device_, 1, &w, 0, nullptr);
 }
 
+void DescriptorSet::write_texel_buffer(uint32_t binding, VkBufferView view) {
+  VkWriteDescriptorSet w{.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  w.dstSet = set_;
+  w.dstBinding = binding;
+  w.descriptorCount = 1;
+  w.descriptorType = type_of(binding);
+  w.pTexelBufferView = &view;
+  vkUpdateDescriptorSets(device_, 1, &w, 0, nullptr);
+}
+
 void DescriptorSet::write_image(uint32_t binding, VkImageView view, VkSampler sampler, VkImageLayout layout,
                                 uint32_t array_element) {
   VkDescriptorImageInfo info{sampler, view, layout};

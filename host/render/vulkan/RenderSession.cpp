@@ -83,7 +83,8 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   upload_emission_lights(build_emission_lights(scene, volumes_, gpu_scene_));
 
   spec_ = spec_constants(scene, gpu_scene_, settings, light_selection_);
-  pipeline_.emplace(ctx, vk::load_spirv("render.comp"),
+  pipeline_code_ = vk::load_spirv("render.comp");
+  pipeline_.emplace(ctx, pipeline_code_,
                     std::vector<vk::ComputePipeline::Binding>{
                         {gpu::BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
                         {gpu::BINDING_MEDIA, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
@@ -107,9 +108,12 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                         {gpu::BINDING_EMISSION_PMF, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_EMISSION_CLUSTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_EMISSION_HEADERS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
-                        {gpu::BINDING_PASS_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
+                        {gpu::BINDING_PASS_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_PATHS, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER},
+                        {gpu::BINDING_QUEUES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
                     uint32_t(sizeof(gpu::PassConstants)), spec_, "render");
   set_.emplace(ctx, *pipeline_, "render set");
+  create_wavefront();
   set_->write_buffer(gpu::BINDING_FRAME, frame_buffer_);
   set_->write_buffer(gpu::BINDING_MEDIA, media_buffer_);
   set_->write_buffer(gpu::BINDING_ACCUM, accum_);
@@ -135,6 +139,12 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
     pipeline_->bind(cmd, set_->set());
     pipeline_->push(cmd, nothing);
     vkCmdDispatch(cmd, 1, 1, 1);
+    // The wavefront's stages, on empty queues (the queues are zero).
+    for (const vk::ComputePipeline& stage : wavefront_stages_) {
+      stage.bind(cmd, set_->set());
+      stage.push(cmd, nothing);
+      vkCmdDispatch(cmd, 1, 1, 1);
+    }
   });
 }
 
@@ -443,7 +453,7 @@ void RenderSession::record_pass(VkCommandBuffer cmd, int spp) {
   spp_done_ += spp;
 }
 
-void RenderSession::record_band(VkCommandBuffer cmd, int spp, int row_begin, int row_end) {
+void RenderSession::record_band(VkCommandBuffer cmd, int spp, int row_begin, int row_end, bool wavefront) {
   vkCmdFillBuffer(cmd, pass_status_.buffer(), 0, VK_WHOLE_SIZE, 0u);
   vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
@@ -454,6 +464,10 @@ void RenderSession::record_band(VkCommandBuffer cmd, int spp, int row_begin, int
     needs_clear_ = false;
   }
   gpu::PassConstants pass{uint32_t(spp_done_), uint32_t(spp), uint32_t(row_begin), uint32_t(row_end)};
+  if (wavefront) {
+    record_wavefront_start(cmd, pass);
+    return;
+  }
   pipeline_->bind(cmd, set_->set());
   pipeline_->push(cmd, pass);
   const uint32_t groups_x = (uint32_t(settings_.width) + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X;
@@ -463,6 +477,121 @@ void RenderSession::record_band(VkCommandBuffer cmd, int spp, int row_begin, int
   vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT);
+}
+
+// The wavefront integrator (shaders/wavefront.glsl), a benchmark and test
+// hook (no scene key or flag): PYROLUME_WAVEFRONT=1 renders with its track
+// and event stages, =2 with the event stage split in two (event, begin).
+// It loses to the megakernel on lavapipe (docs/benchmarks.md "A wavefront
+// prototype"), so nothing turns it on by default. One path slot per pixel:
+// the whole image is one band, and the state must fit one texel buffer.
+void RenderSession::create_wavefront() {
+  const char* env = std::getenv("PYROLUME_WAVEFRONT");
+  const std::string mode = env ? env : "";
+  const bool on = (mode == "1" || mode == "2") && settings_.debug_mode == 0;
+  wavefront_split_ = on && mode == "2";
+  const size_t slots = on ? size_t(settings_.width) * size_t(settings_.height) : 1;
+  const size_t words = gpu::WAVEFRONT_PATH_WORDS + gpu::WAVEFRONT_PATH_WORDS_PER_MEDIUM *
+                                                       std::max<size_t>(1, gpu_scene_.media.size());
+  const double bytes = double(slots * words) * 16.0;
+  if (slots * words > ctx_.properties().limits.maxTexelBufferElements || bytes > double(ctx_.max_allocation_size()))
+    throw vk::VulkanError("PYROLUME_WAVEFRONT: " + std::to_string(settings_.width) + "x" +
+                          std::to_string(settings_.height) + " pixels need " + mib(bytes) +
+                          " of path state, more than this device's texel buffer holds; render a smaller image");
+  wavefront_paths_ = vk::Buffer(ctx_, slots * words * 4 * sizeof(uint32_t),
+                                VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT, vk::MemoryKind::DeviceLocal,
+                                "wavefront paths");
+  const VkBufferViewCreateInfo vi{.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO,
+                                  .pNext = nullptr,
+                                  .flags = 0,
+                                  .buffer = wavefront_paths_.buffer(),
+                                  .format = VK_FORMAT_R32G32B32A32_UINT,
+                                  .offset = 0,
+                                  .range = VK_WHOLE_SIZE};
+  VkBufferView view = VK_NULL_HANDLE;
+  VK_CHECK(vkCreateBufferView(ctx_.device(), &vi, nullptr, &view));
+  wavefront_paths_view_ = vk::UniqueBufferView(view, {ctx_.device()});
+  wavefront_queues_ = vk::Buffer(ctx_, sizeof(gpu::WavefrontQueues) + 4 * slots * sizeof(uint32_t),
+                                 kStorage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, vk::MemoryKind::HostVisible,
+                                 "wavefront queues");
+  std::memset(wavefront_queues_.map(), 0, sizeof(gpu::WavefrontQueues));
+  wavefront_queues_.flush();
+  set_->write_texel_buffer(gpu::BINDING_PATHS, wavefront_paths_view_.get());
+  set_->write_buffer(gpu::BINDING_QUEUES, wavefront_queues_);
+  wavefront_capacity_ = uint32_t(slots);
+  if (!on) return;
+  for (uint32_t stage = gpu::WAVEFRONT_START; stage <= gpu::WAVEFRONT_SIZE_BEGIN; ++stage) {
+    std::vector<std::pair<uint32_t, uint32_t>> spec = spec_;
+    spec.push_back({gpu::SPEC_WAVEFRONT_STAGE, stage});
+    spec.push_back({gpu::SPEC_WAVEFRONT_SPLIT, wavefront_split_ ? 1u : 0u});
+    for (auto& [id, value] : spec)
+      if (id == gpu::SPEC_EARLY_EVENT_EXIT)
+        value = stage == gpu::WAVEFRONT_TRACK && ctx_.features().subgroup_ballot ? 1u : 0u;
+    wavefront_stages_.emplace_back(ctx_, pipeline_code_, pipeline_->bindings(), uint32_t(sizeof(gpu::PassConstants)),
+                                   spec, "render wavefront stage");
+  }
+}
+
+void RenderSession::record_wavefront_start(VkCommandBuffer cmd, const gpu::PassConstants& pass) {
+  gpu::WavefrontQueues start{};
+  start.sizes.x = wavefront_capacity_;
+  vkCmdUpdateBuffer(cmd, wavefront_queues_.buffer(), 0, sizeof start, &start);
+  vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                     VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  wavefront_pass_ = pass;
+  const vk::ComputePipeline& start_stage = wavefront_stages_[gpu::WAVEFRONT_START - 1];
+  start_stage.bind(cmd, set_->set());
+  start_stage.push(cmd, pass);
+  const uint32_t groups_x = (uint32_t(settings_.width) + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X;
+  const uint32_t groups_y = (pass.row_end - pass.row_begin + gpu::WORKGROUP_SIZE_Y - 1) / gpu::WORKGROUP_SIZE_Y;
+  vkCmdDispatch(cmd, groups_x, groups_y, 1);
+  record_wavefront_iterations(cmd, kWavefrontIterations);
+}
+
+void RenderSession::record_wavefront_iterations(VkCommandBuffer cmd, int iterations) {
+  auto barrier = [&] {
+    vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
+  };
+  auto stage = [&](uint32_t s) -> const vk::ComputePipeline& { return wavefront_stages_[s - 1]; };
+  // The stages' layouts are identically defined, so the set and the push
+  // constants stay bound across their pipelines: bound once.
+  stage(gpu::WAVEFRONT_TRACK).bind(cmd, set_->set());
+  stage(gpu::WAVEFRONT_TRACK).push(cmd, wavefront_pass_);
+  auto run = [&](uint32_t s) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, stage(s).pipeline()); };
+  for (int i = 0; i < iterations; ++i) {
+    barrier();
+    run(gpu::WAVEFRONT_SIZE_TRACK);
+    vkCmdDispatch(cmd, 1, 1, 1);
+    barrier();
+    run(gpu::WAVEFRONT_TRACK);
+    vkCmdDispatchIndirect(cmd, wavefront_queues_.buffer(), offsetof(gpu::WavefrontQueues, track_dispatch));
+    barrier();
+    run(gpu::WAVEFRONT_SIZE_EVENT);
+    vkCmdDispatch(cmd, 1, 1, 1);
+    barrier();
+    run(gpu::WAVEFRONT_EVENT);
+    vkCmdDispatchIndirect(cmd, wavefront_queues_.buffer(), offsetof(gpu::WavefrontQueues, event_dispatch));
+    if (!wavefront_split_) continue;
+    barrier();
+    run(gpu::WAVEFRONT_SIZE_BEGIN);
+    vkCmdDispatch(cmd, 1, 1, 1);
+    barrier();
+    run(gpu::WAVEFRONT_BEGIN);
+    vkCmdDispatchIndirect(cmd, wavefront_queues_.buffer(), offsetof(gpu::WavefrontQueues, begin_dispatch));
+  }
+  vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                     VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
+                     VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
+                         VK_ACCESS_HOST_READ_BIT);
+}
+
+// Paths still queued for the track stage after the last recorded iteration.
+uint32_t RenderSession::wavefront_paths_left() const {
+  wavefront_queues_.invalidate();
+  const gpu::WavefrontQueues* q = wavefront_queues_.data<gpu::WavefrontQueues>();
+  return (q->counts.w ^ 1u) == 0u ? q->counts.x : q->counts.y;
 }
 
 int RenderSession::first_band_rows(int spp) const {
@@ -526,6 +655,7 @@ bool RenderSession::run_pass(int spp, const std::atomic<bool>* cancel) {
     // works is kept for the passes after it. Each sample keeps its index, so
     // the result is the same as with passes that fit, and as with one dispatch
     // for the whole image: the bands below only split the pixels.
+    const bool wavefront = !wavefront_stages_.empty();
     for (int remaining = spp; remaining > 0;) {
       const int n = std::min(remaining, max_pass_spp_);
       const bool clears = needs_clear_;
@@ -533,7 +663,8 @@ bool RenderSession::run_pass(int spp, const std::atomic<bool>* cancel) {
       uint32_t unfinished = 0;
       bool interrupted = false;
       for (int row = 0; row < settings_.height;) {
-        const int rows = std::min(band_rows_, settings_.height - row);
+        // The wavefront keeps every pixel's path in flight at once: one band.
+        const int rows = wavefront ? settings_.height - row : std::min(band_rows_, settings_.height - row);
         const bool first_band = row == 0;
         const auto t0 = std::chrono::steady_clock::now();
         ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
@@ -542,8 +673,11 @@ bool RenderSession::run_pass(int spp, const std::atomic<bool>* cancel) {
             vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT,
                                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
           }
-          record_band(cmd, n, row, row + rows);
+          record_band(cmd, n, row, row + rows, wavefront);
         });
+        // The wavefront: more rounds until no path is left in its queues.
+        while (wavefront && wavefront_paths_left() > 0)
+          ctx_.submit_and_wait([&](VkCommandBuffer cmd) { record_wavefront_iterations(cmd, kWavefrontIterations); });
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         pass_status_.invalidate();
         unfinished += pass_status_.data<gpu::PassStatus>()->counts.x;

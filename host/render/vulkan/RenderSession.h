@@ -138,8 +138,24 @@ class RenderSession {
   // Rows for one dispatch of `spp` samples per pixel before anything is measured.
   int first_band_rows(int spp) const;
   // One dispatch of rows [row_begin, row_end) into cmd (the first after a
-  // reset clears the accumulation); spp_done_ unchanged.
-  void record_band(VkCommandBuffer cmd, int spp, int row_begin, int row_end);
+  // reset clears the accumulation); spp_done_ unchanged. wavefront: the
+  // wavefront's first stage and rounds instead; the caller submits more
+  // rounds until its queues are empty (run_pass).
+  void record_band(VkCommandBuffer cmd, int spp, int row_begin, int row_end, bool wavefront = false);
+  // The wavefront integrator (shaders/wavefront.glsl): its stages' pipelines
+  // (index: WAVEFRONT_* − 1; empty: the megakernel renders), path states and queues.
+  void create_wavefront();
+  void record_wavefront_start(VkCommandBuffer cmd, const gpu::PassConstants& pass);
+  void record_wavefront_iterations(VkCommandBuffer cmd, int iterations);
+  uint32_t wavefront_paths_left() const;
+  static constexpr int kWavefrontIterations = 32;  // track + event rounds per submission
+  std::vector<uint32_t> pipeline_code_;
+  std::vector<vk::ComputePipeline> wavefront_stages_;
+  vk::Buffer wavefront_paths_, wavefront_queues_;
+  vk::UniqueBufferView wavefront_paths_view_;
+  uint32_t wavefront_capacity_ = 0;
+  bool wavefront_split_ = false;
+  gpu::PassConstants wavefront_pass_{};
   uint64_t dropped_samples_ = 0;
   int spp_done_ = 0;
   bool needs_clear_ = true;
