@@ -69,6 +69,18 @@ class VulkanVdb : public test::VulkanFixture, public test::ConstantBoxSetup {
     return s;
   }
 
+  // The lookup-bound fire (docs/benchmarks.md): dense and scattering, BSDF
+  // sampling with the absorption estimator, long paths.
+  static Scene lookup_bound_fire(int width, int height, int spp) {
+    Scene s = shipped_fire(width, height, spp);
+    s.integrator.max_depth = 16;
+    s.integrator.emission_estimator = "absorption";
+    s.media[0].density_scale = 8.0;
+    s.media[0].sigma_a = glm::dvec3(0.5);
+    s.media[0].sigma_s = glm::dvec3(4.0);
+    return s;
+  }
+
   // Both estimators against the exact image; returns the last render.
   RenderResult expect_closed_form(Scene s, const std::function<glm::dvec3(int, int)>& exact, const char* what,
                                   double tolerance = 0.005) {
@@ -271,12 +283,7 @@ TEST_F(VulkanVdb, AgreesWithCpuOnProceduralFire) {
 // of the shipped fire (dense, scattering, long flights) and with the
 // absorption estimator's emission at absorptions.
 TEST_F(VulkanVdb, EarlyEventExitRendersTheSameImageBitForBit) {
-  Scene s = shipped_fire(24, 32, 16);
-  s.integrator.max_depth = 16;
-  s.integrator.emission_estimator = "absorption";
-  s.media[0].density_scale = 8.0;
-  s.media[0].sigma_a = glm::dvec3(0.5);
-  s.media[0].sigma_s = glm::dvec3(4.0);
+  Scene s = lookup_bound_fire(24, 32, 16);
   RenderSettings waiting = settings_for(s);
   waiting.early_event_exit = false;
   const RenderResult early = render(s), late = backend_->render(s, waiting, {});
@@ -301,12 +308,7 @@ TEST_F(VulkanVdb, WavefrontRendersTheSameImageBitForBit) {
   ground.film.width = 24;
   ground.film.height = 16;
   ground.film.spp = 8;
-  Scene lookup = shipped_fire(16, 24, 8);
-  lookup.integrator.max_depth = 16;
-  lookup.integrator.emission_estimator = "absorption";
-  lookup.media[0].density_scale = 8.0;
-  lookup.media[0].sigma_a = glm::dvec3(0.5);
-  lookup.media[0].sigma_s = glm::dvec3(4.0);
+  const Scene lookup = lookup_bound_fire(16, 24, 8);
   struct Restore {
     ~Restore() { unsetenv("PYROLUME_WAVEFRONT"); }
   } restore;

@@ -110,38 +110,35 @@ VkDescriptorType DescriptorSet::type_of(uint32_t binding) const {
   throw VulkanError("DescriptorSet: the pipeline has no binding " + std::to_string(binding));
 }
 
-void DescriptorSet::write_buffer(uint32_t binding, const Buffer& buffer, VkDeviceSize offset, VkDeviceSize range) {
-  VkDescriptorBufferInfo info{buffer.buffer(), offset, range};
-  VkWriteDescriptorSet w{.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-  w.dstSet = set_;
-  w.dstBinding = binding;
-  w.descriptorCount = 1;
-  w.descriptorType = type_of(binding);
-  w.pBufferInfo = &info;
-  vkUpdateDescriptorSets(device_, 1, &w, 0, nullptr);
-}
-
-void DescriptorSet::write_texel_buffer(uint32_t binding, VkBufferView view) {
-  VkWriteDescriptorSet w{.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-  w.dstSet = set_;
-  w.dstBinding = binding;
-  w.descriptorCount = 1;
-  w.descriptorType = type_of(binding);
-  w.pTexelBufferView = &view;
-  vkUpdateDescriptorSets(device_, 1, &w, 0, nullptr);
-}
-
-void DescriptorSet::write_image(uint32_t binding, VkImageView view, VkSampler sampler, VkImageLayout layout,
-                                uint32_t array_element) {
-  VkDescriptorImageInfo info{sampler, view, layout};
+// One descriptor of `binding`, array element `array_element`; exactly one of
+// the three pointers is set, by the binding's type.
+void DescriptorSet::write(uint32_t binding, uint32_t array_element, const VkDescriptorBufferInfo* buffer,
+                          const VkDescriptorImageInfo* image, const VkBufferView* texel_buffer) {
   VkWriteDescriptorSet w{.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
   w.dstSet = set_;
   w.dstBinding = binding;
   w.dstArrayElement = array_element;
   w.descriptorCount = 1;
   w.descriptorType = type_of(binding);
-  w.pImageInfo = &info;
+  w.pBufferInfo = buffer;
+  w.pImageInfo = image;
+  w.pTexelBufferView = texel_buffer;
   vkUpdateDescriptorSets(device_, 1, &w, 0, nullptr);
+}
+
+void DescriptorSet::write_buffer(uint32_t binding, const Buffer& buffer, VkDeviceSize offset, VkDeviceSize range) {
+  const VkDescriptorBufferInfo info{buffer.buffer(), offset, range};
+  write(binding, 0, &info, nullptr, nullptr);
+}
+
+void DescriptorSet::write_texel_buffer(uint32_t binding, VkBufferView view) {
+  write(binding, 0, nullptr, nullptr, &view);
+}
+
+void DescriptorSet::write_image(uint32_t binding, VkImageView view, VkSampler sampler, VkImageLayout layout,
+                                uint32_t array_element) {
+  const VkDescriptorImageInfo info{sampler, view, layout};
+  write(binding, array_element, nullptr, &info, nullptr);
 }
 
 }  // namespace pyrolume::vk

@@ -72,6 +72,8 @@ class DescriptorSet {
 
  private:
   VkDescriptorType type_of(uint32_t binding) const;
+  void write(uint32_t binding, uint32_t array_element, const VkDescriptorBufferInfo* buffer,
+             const VkDescriptorImageInfo* image, const VkBufferView* texel_buffer);
 
   VkDevice device_ = VK_NULL_HANDLE;
   std::vector<ComputePipeline::Binding> bindings_;

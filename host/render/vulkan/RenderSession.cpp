@@ -559,27 +559,20 @@ void RenderSession::record_wavefront_iterations(VkCommandBuffer cmd, int iterati
   // constants stay bound across their pipelines: bound once.
   stage(gpu::WAVEFRONT_TRACK).bind(cmd, set_->set());
   stage(gpu::WAVEFRONT_TRACK).push(cmd, wavefront_pass_);
-  auto run = [&](uint32_t s) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, stage(s).pipeline()); };
+  // A queue stage: its one-lane sizing stage, then the stage itself, as large as its queue.
+  auto run = [&](uint32_t sizing, uint32_t queued, VkDeviceSize dispatch_offset) {
+    barrier();
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, stage(sizing).pipeline());
+    vkCmdDispatch(cmd, 1, 1, 1);
+    barrier();
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, stage(queued).pipeline());
+    vkCmdDispatchIndirect(cmd, wavefront_queues_.buffer(), dispatch_offset);
+  };
   for (int i = 0; i < iterations; ++i) {
-    barrier();
-    run(gpu::WAVEFRONT_SIZE_TRACK);
-    vkCmdDispatch(cmd, 1, 1, 1);
-    barrier();
-    run(gpu::WAVEFRONT_TRACK);
-    vkCmdDispatchIndirect(cmd, wavefront_queues_.buffer(), offsetof(gpu::WavefrontQueues, track_dispatch));
-    barrier();
-    run(gpu::WAVEFRONT_SIZE_EVENT);
-    vkCmdDispatch(cmd, 1, 1, 1);
-    barrier();
-    run(gpu::WAVEFRONT_EVENT);
-    vkCmdDispatchIndirect(cmd, wavefront_queues_.buffer(), offsetof(gpu::WavefrontQueues, event_dispatch));
-    if (!wavefront_split_) continue;
-    barrier();
-    run(gpu::WAVEFRONT_SIZE_BEGIN);
-    vkCmdDispatch(cmd, 1, 1, 1);
-    barrier();
-    run(gpu::WAVEFRONT_BEGIN);
-    vkCmdDispatchIndirect(cmd, wavefront_queues_.buffer(), offsetof(gpu::WavefrontQueues, begin_dispatch));
+    run(gpu::WAVEFRONT_SIZE_TRACK, gpu::WAVEFRONT_TRACK, offsetof(gpu::WavefrontQueues, track_dispatch));
+    run(gpu::WAVEFRONT_SIZE_EVENT, gpu::WAVEFRONT_EVENT, offsetof(gpu::WavefrontQueues, event_dispatch));
+    if (wavefront_split_)
+      run(gpu::WAVEFRONT_SIZE_BEGIN, gpu::WAVEFRONT_BEGIN, offsetof(gpu::WavefrontQueues, begin_dispatch));
   }
   vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
