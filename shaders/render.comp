@@ -41,7 +41,7 @@ const bool NEE = LIGHT_STRATEGY != LIGHT_STRATEGY_BSDF;  // next-event estimatio
 // Continuations drawn from the lights with probability 1 − frame.lights.y; off
 // (frame.lights.y = 1) compiles that code out: llvmpipe runs every branch.
 layout(constant_id = SPEC_GUIDED_CONTINUATION) const bool GUIDED_CONTINUATION = false;
-// The free-flight loop in path_step leaves once half of the SIMD group's lanes
+// The free-flight loop in path_track leaves once half of the SIMD group's lanes
 // have found their event, instead of waiting for the last one (the device
 // supports subgroup ballots; the host sets it where it pays, docs/benchmarks.md).
 layout(constant_id = SPEC_EARLY_EVENT_EXIT) const bool EARLY_EVENT_EXIT = false;
@@ -217,7 +217,7 @@ float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, float t_span_end, inou
   vec3 inv_du = 1.0 / du;
   float nudge = 1e-4 * min3(cs) / max(max3(abs(du)), 1e-30);
   // At least a few float ulps of t, so t always moves on (a far camera loses
-  // precision in u; see also the origin shift in path_step).
+  // precision in u; see also the origin shift in path_begin).
   float min_step = max(nudge, abs(t) * 1e-6);
   ivec3 res = ivec3(res4.xyz);
   ivec3 cell = clamp(ivec3(floor((u + du * nudge) / cs)), ivec3(0), res - 1);
@@ -464,7 +464,7 @@ struct PathState {
   // the scene, hits a surface or loses the roulette (weight w = path weight ·
   // f · MIS weight / p_light), then the path goes on with the continuation
   // sampled at the vertex (next_*), one ray segment (free flights up to its
-  // event) per path_step like any other ray (LAVAPIPE.md: divergence).
+  // event) per path_step like any other ray (docs/rendering.md: divergence).
   bool light_ray;
   float light_T;  // a light ray's ratio-tracking transmittance (max channel) since its last roulette
   // Ratio-tracked continuation (docs/mis.md): 1 while the surface vertex's
@@ -532,7 +532,7 @@ void phase_mixture(vec3 d_in, vec3 w, vec3 share[MEDIA_N], float q[MEDIA_N], out
 }
 
 // The next of a vertex's light rays (docs/mis.md "Several light samples"),
-// drawn at the top of path_step: a light direction from the vertex, its
+// drawn by path_begin: a light direction from the vertex, its
 // weight w·f·MIS weight / (n·p_light) for the vertex's n light samples (a
 // surface's frame.lights.z, a medium vertex's 1); weight 0 when no light
 // direction was found (the ray then ends at once). The only copy of the
@@ -586,7 +586,7 @@ bool hand_over(inout PathState p) {
 
 // The current ray ends. A light ray hands over to the vertex's next light ray
 // or to the continuation it sampled; returns true when the path has ended. The
-// next light ray is drawn at the top of path_step (light_pending), in one
+// next light ray is drawn by path_begin (light_pending), in one
 // place: inlined at each of ray_ends' call sites, the light sampling code made
 // the shader 2× slower on llvmpipe.
 bool ray_ends(inout PathState p) {
@@ -1057,7 +1057,7 @@ void main() {
   } else {
     // Paths are regenerated within the lane: one loop iteration is one tracking
     // step, and a lane whose path ends starts its next sample at once instead of
-    // idling until the longest path of its SIMD group ends (LAVAPIPE.md:
+    // idling until the longest path of its SIMD group ends (docs/rendering.md:
     // divergence halves throughput). Each sample keeps its own random stream, so
     // the result does not depend on the schedule.
     //

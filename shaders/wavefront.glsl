@@ -75,7 +75,7 @@ void io_v3b(bool store, uint at, inout vec3 a, inout bool b) {
 uint b2u(bool b) { return b ? 1u : 0u; }
 
 // Path slot `slot`'s state. TRACK moves only what free flights read and
-// write (everything = false): the words before FIXED_TRACK_WORDS.
+// write (everything = false): words 0–8 and each medium's first word.
 void path_io(bool store, bool everything, uint slot, inout PathState p, inout SlotState s, inout vec2 span[MEDIA_N],
              inout float rho[MEDIA_N]) {
   const uint base = slot * PATH_STRIDE;
@@ -142,7 +142,7 @@ void path_io(bool store, bool everything, uint slot, inout PathState p, inout Sl
   io_v3f(store, base + 21u, s.sq_c, unused);
 }
 
-// Append slot to queue q (0, 1: track queues; EVENT_QUEUE).
+// Append slot to queue q (0, 1: track queues; EVENT_QUEUE; BEGIN_QUEUE).
 void enqueue(uint q, uint slot) {
   uint j;
   if (q == 0u) j = atomicAdd(queues.counts.x, 1u);
@@ -206,7 +206,6 @@ void wavefront_main() {
   }
   if (WAVEFRONT_STAGE == WAVEFRONT_SIZE_EVENT) {
     queues.event_dispatch = uvec4((queues.counts.z + WAVEFRONT_GROUP - 1u) / WAVEFRONT_GROUP, 1u, 1u, 0u);
-    queues.begin_dispatch = uvec4(0u);  // sized after the event stage
     return;
   }
   if (WAVEFRONT_STAGE == WAVEFRONT_SIZE_BEGIN) {

@@ -83,8 +83,8 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   upload_emission_lights(build_emission_lights(scene, volumes_, gpu_scene_));
 
   spec_ = spec_constants(scene, gpu_scene_, settings, light_selection_);
-  pipeline_code_ = vk::load_spirv("render.comp");
-  pipeline_.emplace(ctx, pipeline_code_,
+  const std::vector<uint32_t> code = vk::load_spirv("render.comp");
+  pipeline_.emplace(ctx, code,
                     std::vector<vk::ComputePipeline::Binding>{
                         {gpu::BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
                         {gpu::BINDING_MEDIA, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
@@ -113,7 +113,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                         {gpu::BINDING_QUEUES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
                     uint32_t(sizeof(gpu::PassConstants)), spec_, "render");
   set_.emplace(ctx, *pipeline_, "render set");
-  create_wavefront();
+  create_wavefront(code);
   set_->write_buffer(gpu::BINDING_FRAME, frame_buffer_);
   set_->write_buffer(gpu::BINDING_MEDIA, media_buffer_);
   set_->write_buffer(gpu::BINDING_ACCUM, accum_);
@@ -132,7 +132,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
     set_->write_image(gpu::BINDING_TEXTURES, textures_2d_[slot + 1 < textures_2d_.size() ? slot + 1 : 0], slot);
   upload_constants(scene);
   // lavapipe compiles a pipeline inside its first dispatch (~0.1–0.5 s,
-  // LAVAPIPE.md): dispatch one empty workgroup now so that cost counts as
+  // docs/rendering.md): dispatch one empty workgroup now so that cost counts as
   // loading, not rendering (DESIGN.md: `seconds` starts at the first real pass).
   ctx.submit_and_wait([&](VkCommandBuffer cmd) {
     gpu::PassConstants nothing{0u, 0u, 0u, 0u};
@@ -485,7 +485,7 @@ void RenderSession::record_band(VkCommandBuffer cmd, int spp, int row_begin, int
 // It loses to the megakernel on lavapipe (docs/benchmarks.md "A wavefront
 // prototype"), so nothing turns it on by default. One path slot per pixel:
 // the whole image is one band, and the state must fit one texel buffer.
-void RenderSession::create_wavefront() {
+void RenderSession::create_wavefront(const std::vector<uint32_t>& code) {
   const char* env = std::getenv("PYROLUME_WAVEFRONT");
   const std::string mode = env ? env : "";
   const bool on = (mode == "1" || mode == "2") && settings_.debug_mode == 0;
@@ -527,7 +527,7 @@ void RenderSession::create_wavefront() {
     for (auto& [id, value] : spec)
       if (id == gpu::SPEC_EARLY_EVENT_EXIT)
         value = stage == gpu::WAVEFRONT_TRACK && ctx_.features().subgroup_ballot ? 1u : 0u;
-    wavefront_stages_.emplace_back(ctx_, pipeline_code_, pipeline_->bindings(), uint32_t(sizeof(gpu::PassConstants)),
+    wavefront_stages_.emplace_back(ctx_, code, pipeline_->bindings(), uint32_t(sizeof(gpu::PassConstants)),
                                    spec, "render wavefront stage");
   }
 }

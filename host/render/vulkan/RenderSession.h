@@ -143,13 +143,13 @@ class RenderSession {
   // rounds until its queues are empty (run_pass).
   void record_band(VkCommandBuffer cmd, int spp, int row_begin, int row_end, bool wavefront = false);
   // The wavefront integrator (shaders/wavefront.glsl): its stages' pipelines
-  // (index: WAVEFRONT_* − 1; empty: the megakernel renders), path states and queues.
-  void create_wavefront();
+  // (index: WAVEFRONT_* − 1; empty: the megakernel renders), path states and
+  // queues. code: render.comp's SPIR-V, which every stage specialises.
+  void create_wavefront(const std::vector<uint32_t>& code);
   void record_wavefront_start(VkCommandBuffer cmd, const gpu::PassConstants& pass);
   void record_wavefront_iterations(VkCommandBuffer cmd, int iterations);
   uint32_t wavefront_paths_left() const;
   static constexpr int kWavefrontIterations = 32;  // track + event rounds per submission
-  std::vector<uint32_t> pipeline_code_;
   std::vector<vk::ComputePipeline> wavefront_stages_;
   vk::Buffer wavefront_paths_, wavefront_queues_;
   vk::UniqueBufferView wavefront_paths_view_;
