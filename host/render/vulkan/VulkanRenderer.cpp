@@ -38,7 +38,7 @@ void VulkanRenderer::set_frame_reuse(bool on) {
 int VulkanRenderer::spp_per_pass(int width, int height, int spp, int rays_per_vertex) {
   // About 2^19 paths per dispatch: tens of milliseconds on lavapipe for simple
   // scenes, far below any GPU watchdog, and large enough that per-dispatch
-  // overhead (~1.3 ms on lavapipe, LAVAPIPE.md) stays small. With next-event
+  // overhead (~1.3 ms on lavapipe, docs/rendering.md) stays small. With next-event
   // estimation each vertex also sends light rays (up to rays_per_vertex − 1):
   // proportionally fewer paths, which also keeps passes within llvmpipe's loop budget (PassStatus; a pass that
   // overruns it is redone in halves, wasting it: terrain_explosion at 160×90
