@@ -25,7 +25,7 @@ layout(constant_id = SPEC_HAS_EMISSION) const bool HAS_EMISSION = true;
 layout(constant_id = SPEC_COLLISION_ESTIMATOR) const bool COLLISION_ESTIMATOR = false;
 layout(constant_id = SPEC_DEBUG_MODE) const uint DEBUG_MODE = DEBUG_NONE;
 // A constant trip count lets the compiler unroll the per-medium loops and keep
-// span[] and rho[] in registers instead of per-lane scratch memory (lavapipe).
+// span[], rho[] and temperature_value[] in registers instead of per-lane scratch memory (lavapipe).
 layout(constant_id = SPEC_MEDIUM_COUNT) const uint MEDIUM_COUNT = 1;
 const uint MEDIA_N = MEDIUM_COUNT > 0u ? MEDIUM_COUNT : 1u;  // array size (never 0)
 // With a single grid medium the texture switches below fold to slot 0 (15 %
@@ -45,6 +45,10 @@ layout(constant_id = SPEC_GUIDED_CONTINUATION) const bool GUIDED_CONTINUATION = 
 // have found their event, instead of waiting for the last one (the device
 // supports subgroup ballots; the host sets it where it pays, docs/benchmarks.md).
 layout(constant_id = SPEC_EARLY_EVENT_EXIT) const bool EARLY_EVENT_EXIT = false;
+// The temperature is the density texture's second channel: the density lookup
+// at a collision reads it too, and the emission there needs no lookup of its own
+// (docs/rendering.md "One texture for density and temperature").
+layout(constant_id = SPEC_TEMPERATURE_IN_DENSITY) const bool TEMPERATURE_IN_DENSITY = false;
 
 layout(std140, set = 0, binding = BINDING_FRAME) uniform FrameBlock { FrameConstants frame; };
 // Media and grids are uniform blocks: every lane reads the same entries, which
@@ -106,14 +110,17 @@ struct PathStats {
 
 // Texture arrays are indexed with constants only (no dependence on
 // dynamically-uniform indexing, which lavapipe and older GPUs handle poorly).
-float density_at(uint slot, vec3 tc) {
+// With TEMPERATURE_IN_DENSITY, .y is the temperature grid's value (else 0).
+vec2 density_at(uint slot, vec3 tc) {
   if (GRID_COUNT <= 1u) slot = 0u;
+  vec2 v;
   switch (slot) {
-    case 0u: return textureLod(density_tex[0], tc, 0.0).r;
-    case 1u: return textureLod(density_tex[1], tc, 0.0).r;
-    case 2u: return textureLod(density_tex[2], tc, 0.0).r;
-    default: return textureLod(density_tex[3], tc, 0.0).r;
+    case 0u: v = textureLod(density_tex[0], tc, 0.0).rg; break;
+    case 1u: v = textureLod(density_tex[1], tc, 0.0).rg; break;
+    case 2u: v = textureLod(density_tex[2], tc, 0.0).rg; break;
+    default: v = textureLod(density_tex[3], tc, 0.0).rg; break;
   }
+  return TEMPERATURE_IN_DENSITY ? v : vec2(v.x, 0.0);
 }
 float temperature_at(uint slot, vec3 tc) {
   if (GRID_COUNT <= 1u) slot = 0u;
@@ -163,15 +170,19 @@ vec3 density_texel_dir(uint slot, vec3 d) {
 }
 
 // Emitted radiance Le of grid medium m at world point x (DESIGN.md: T = (v − offset)·scale,
-// no emission at or below cutoff_k; the LUT is uniform in ln T).
-vec3 grid_le(GpuMedium m, uint slot, vec3 x) {
+// no emission at or below cutoff_k; the LUT is uniform in ln T). With
+// TEMPERATURE_IN_DENSITY the grid's value v was read with the density at x.
+vec3 grid_le(GpuMedium m, uint slot, vec3 x, float value_read) {
   uint mode = uint(m.emission.w);
   if (mode == EMIT_CONSTANT) return m.emission.rgb;
   if (mode != EMIT_TEMPERATURE) return vec3(0.0);
-  vec4 p1 = vec4(x, 1.0);
-  vec3 u = vec3(dot(grids[slot].temperature_row0, p1), dot(grids[slot].temperature_row1, p1),
-                dot(grids[slot].temperature_row2, p1));
-  float value = temperature_at(slot, u / grids[slot].temperature_dims.xyz);
+  float value = value_read;
+  if (!TEMPERATURE_IN_DENSITY) {
+    vec4 p1 = vec4(x, 1.0);
+    vec3 u = vec3(dot(grids[slot].temperature_row0, p1), dot(grids[slot].temperature_row1, p1),
+                  dot(grids[slot].temperature_row2, p1));
+    value = temperature_at(slot, u / grids[slot].temperature_dims.xyz);
+  }
   vec4 map = grids[slot].temperature_map, lut = grids[slot].blackbody_lut;
   float T = (value - map.x) * map.y;
   if (!(T > map.z) || !(T >= lut.z)) return vec3(0.0);
@@ -252,20 +263,25 @@ float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, float t_span_end, inou
 }
 
 // Media coefficients at a tentative collision; rho[i] keeps each grid's
-// density_scale · density for the scattering-lobe choice.
+// density_scale · density for the scattering-lobe choice, and
+// temperature_value[i] its temperature grid's value where the density lookup
+// reads it (TEMPERATURE_IN_DENSITY; else 0).
 void coefficients_at(vec3 x, float t, vec2 span[MEDIA_N], out vec3 sigma_a, out vec3 sigma_s, out float rho[MEDIA_N],
-                     inout PathStats stats) {
+                     out float temperature_value[MEDIA_N], inout PathStats stats) {
   sigma_a = vec3(0.0);
   sigma_s = vec3(0.0);
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     rho[i] = 0.0;
+    temperature_value[i] = 0.0;
     if (!(span[i].x <= t && t < span[i].y)) continue;
     GpuMedium m = media[i];
     float r = 1.0;
     if (is_grid(m)) {
       uint slot = uint(m.bounds0.x);
       vec4 dims = grids[slot].density_dims;
-      r = dims.w * density_at(slot, density_texel(slot, x) / dims.xyz);
+      const vec2 v = density_at(slot, density_texel(slot, x) / dims.xyz);
+      r = dims.w * v.x;
+      temperature_value[i] = v.y;
       stats.lookups += 1.0;
     }
     rho[i] = r;
@@ -293,13 +309,13 @@ float light_weight(float p_light, float pdf_dir) {
 }
 
 // Emitted power per unit length, Σ sigma_a_i(x)·Le_i(x), over the media at t.
-vec3 emission_at(vec3 x, float t, vec2 span[MEDIA_N], float rho[MEDIA_N]) {
+vec3 emission_at(vec3 x, float t, vec2 span[MEDIA_N], float rho[MEDIA_N], float temperature_value[MEDIA_N]) {
   vec3 E = vec3(0.0);
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     if (!(span[i].x <= t && t < span[i].y)) continue;
     GpuMedium m = media[i];
     if (is_grid(m)) {
-      if (rho[i] > 0.0) E += rho[i] * m.sigma_a.rgb * grid_le(m, uint(m.bounds0.x), x);
+      if (rho[i] > 0.0) E += rho[i] * m.sigma_a.rgb * grid_le(m, uint(m.bounds0.x), x, temperature_value[i]);
     } else {
       E += m.emission.rgb;
     }
@@ -355,8 +371,8 @@ vec3 transmittance(vec3 o, vec3 d, bool ratio, inout uint rng, inout PathStats s
     if (t + dt >= t_next) { t = t_next; continue; }
     t += dt;
     vec3 sigma_a, sigma_s;
-    float rho[MEDIA_N];
-    coefficients_at(o + t * d, t, span, sigma_a, sigma_s, rho, stats);
+    float rho[MEDIA_N], temperature_value[MEDIA_N];
+    coefficients_at(o + t * d, t, span, sigma_a, sigma_s, rho, temperature_value, stats);
     vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
     if (ratio) {
       T *= sigma_n / sigma_bar;
@@ -804,7 +820,7 @@ int path_begin(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng) {
 // path weight w then picks up sigma_x / (sigma_bar·P_x) per channel. For grey
 // media every factor is 1 and this is plain delta tracking.
 uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout PathStats stats, out Collision c_out,
-                out float rho[MEDIA_N]) {
+                out float rho[MEDIA_N], out float temperature_value[MEDIA_N]) {
   // Free flights, until the ray meets what needs more than a density lookup:
   // a surface, a real event, the end of the media, a light ray's lost
   // roulette. The cheap steps loop here and the event code below runs once per
@@ -848,12 +864,12 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
       }
       p.t += dt;
       x = p.o + p.t * p.d;
-      coefficients_at(x, p.t, span, sigma_a, sigma_s, rho, stats);
+      coefficients_at(x, p.t, span, sigma_a, sigma_s, rho, temperature_value, stats);
       if (HAS_EMISSION && COLLISION_ESTIMATOR && !p.skip_segment) {
         // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.
         // With next-event estimation the ray's own MIS weight (light rays: 1). A skipped
         // segment (ratio-tracked continuation) was already collected: no lookup.
-        vec3 e = emission_at(x, p.t, span, rho);
+        vec3 e = emission_at(x, p.t, span, rho, temperature_value);
         if (max3(e) > 0.0) p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_bar) * p.w * e;
       }
       vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
@@ -911,8 +927,8 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
 }
 
 // What a ray segment's event does (path_step's end); true when the path has ended.
-bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, float rho[MEDIA_N], inout uint rng,
-                inout PathStats stats) {
+bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, float rho[MEDIA_N],
+                float temperature_value[MEDIA_N], inout uint rng, inout PathStats stats) {
   const vec3 x = c.x, sigma_s = c.sigma_s;
   const float sigma_bar = c.sigma_bar, p_a = c.p_a, p_s = c.p_s;
   if (event == EVENT_ESCAPE) {
@@ -925,7 +941,8 @@ bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, 
     stats.events += 1.0;
     if (event == EVENT_ABSORB) {
       // Absorbed: the absorption estimator collects sigma_a·Le / (sigma_bar·P_a).
-      if (HAS_EMISSION && !COLLISION_ESTIMATOR) p.L += p.w * emission_at(x, p.t, span, rho) / (sigma_bar * p_a);
+      if (HAS_EMISSION && !COLLISION_ESTIMATOR)
+        p.L += p.w * emission_at(x, p.t, span, rho, temperature_value) / (sigma_bar * p_a);
       return ray_ends(p);
     }
   }
@@ -938,10 +955,10 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   const int begun = path_begin(p, span, rng);
   if (begun != RAY_READY) return begun == PATH_ENDED;
   Collision c;
-  float rho[MEDIA_N];
-  const uint event = path_track(p, span, rng, stats, c, rho);
+  float rho[MEDIA_N], temperature_value[MEDIA_N];
+  const uint event = path_track(p, span, rng, stats, c, rho, temperature_value);
   if (event == EVENT_NONE) return false;  // EARLY_EVENT_EXIT: still in free flight
-  return path_event(p, span, event, c, rho, rng, stats);
+  return path_event(p, span, event, c, rho, temperature_value, rng, stats);
 }
 
 // Start p as a camera ray through pixel `pixel` for sample `k`, with that

@@ -77,7 +77,7 @@ uint b2u(bool b) { return b ? 1u : 0u; }
 // Path slot `slot`'s state. TRACK moves only what free flights read and
 // write (everything = false): words 0–8 and each medium's first word.
 void path_io(bool store, bool everything, uint slot, inout PathState p, inout SlotState s, inout vec2 span[MEDIA_N],
-             inout float rho[MEDIA_N]) {
+             inout float rho[MEDIA_N], inout float temperature_value[MEDIA_N]) {
   const uint base = slot * PATH_STRIDE;
   io_v3f(store, base + 0u, p.o, p.t);
   io_v3f(store, base + 1u, p.d, p.pdf_dir);
@@ -102,17 +102,14 @@ void path_io(bool store, bool everything, uint slot, inout PathState p, inout Sl
   s.c.p_s = uintBitsToFloat(u.y);
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     const uint m = base + WAVEFRONT_PATH_WORDS + i * WAVEFRONT_PATH_WORDS_PER_MEDIUM;
-    vec4 f = vec4(span[i], rho[i], p.vertex_q[i]);
+    vec4 f = vec4(span[i], rho[i], temperature_value[i]);
     u = floatBitsToUint(f);
     io(store, m, u);
     f = uintBitsToFloat(u);
     span[i] = f.xy;
     rho[i] = f.z;
-    p.vertex_q[i] = f.w;
-    if (everything) {
-      float unused = 0.0;
-      io_v3f(store, m + 1u, p.vertex_share[i], unused);
-    }
+    temperature_value[i] = f.w;
+    if (everything) io_v3f(store, m + 1u, p.vertex_share[i], p.vertex_q[i]);
   }
   if (!everything) return;
   u = uvec4(p.depth, b2u(p.fresh), floatBitsToUint(p.survival), p.hit.kind);
@@ -215,7 +212,7 @@ void wavefront_main() {
   PathState p;
   SlotState s;
   vec2 span[MEDIA_N];
-  float rho[MEDIA_N];
+  float rho[MEDIA_N], temperature_value[MEDIA_N];
   const uint read = queues.counts.w, fill = read ^ 1u;
   if (WAVEFRONT_STAGE == WAVEFRONT_START) {
     const uvec2 pixel = gl_GlobalInvocationID.xy + uvec2(0u, pass_constants.row_begin);
@@ -227,13 +224,13 @@ void wavefront_main() {
     s.stats = PathStats(0.0, 0.0);
     s.event = EVENT_NONE;
     s.c = Collision(vec3(0.0), vec3(0.0), 0.0, 0.0, 0.0);
-    for (uint i = 0u; i < MEDIUM_COUNT; ++i) rho[i] = 0.0;
+    for (uint i = 0u; i < MEDIUM_COUNT; ++i) rho[i] = temperature_value[i] = 0.0;
     camera_path(pixel, s.k, s.rng, p);
     if (!settle(pixel, p, s, span, false)) {
       finish_slot(slot, s);
       return;
     }
-    path_io(true, true, slot, p, s, span, rho);
+    path_io(true, true, slot, p, s, span, rho, temperature_value);
     enqueue(fill, slot);
     return;
   }
@@ -241,9 +238,9 @@ void wavefront_main() {
   if (WAVEFRONT_STAGE == WAVEFRONT_TRACK) {
     if (j >= (read == 0u ? queues.counts.x : queues.counts.y)) return;
     const uint slot = queue_slots[read * queues.sizes.x + j];
-    path_io(false, false, slot, p, s, span, rho);
-    if (s.pending == 0u) s.event = path_track(p, span, s.rng, s.stats, s.c, rho);
-    path_io(true, false, slot, p, s, span, rho);
+    path_io(false, false, slot, p, s, span, rho, temperature_value);
+    if (s.pending == 0u) s.event = path_track(p, span, s.rng, s.stats, s.c, rho, temperature_value);
+    path_io(true, false, slot, p, s, span, rho, temperature_value);
     enqueue(s.pending != 0u ? (WAVEFRONT_SPLIT ? BEGIN_QUEUE : EVENT_QUEUE) : s.event != EVENT_NONE ? EVENT_QUEUE : fill,
             slot);
     return;
@@ -251,11 +248,12 @@ void wavefront_main() {
   if (WAVEFRONT_STAGE == WAVEFRONT_EVENT) {
     if (j >= queues.counts.z) return;
     const uint slot = queue_slots[EVENT_QUEUE * queues.sizes.x + j];
-    path_io(false, true, slot, p, s, span, rho);
-    const bool ended = s.pending != 0u ? s.pending == 2u : path_event(p, span, s.event, s.c, rho, s.rng, s.stats);
+    path_io(false, true, slot, p, s, span, rho, temperature_value);
+    const bool ended = s.pending != 0u ? s.pending == 2u
+                                       : path_event(p, span, s.event, s.c, rho, temperature_value, s.rng, s.stats);
     if (WAVEFRONT_SPLIT) {
       s.pending = ended ? 2u : 1u;
-      path_io(true, true, slot, p, s, span, rho);
+      path_io(true, true, slot, p, s, span, rho, temperature_value);
       enqueue(BEGIN_QUEUE, slot);
       return;
     }
@@ -263,18 +261,18 @@ void wavefront_main() {
       finish_slot(slot, s);
       return;
     }
-    path_io(true, true, slot, p, s, span, rho);
+    path_io(true, true, slot, p, s, span, rho, temperature_value);
     enqueue(fill, slot);
   }
   if (WAVEFRONT_STAGE == WAVEFRONT_BEGIN) {
     if (j >= queues.sizes.y) return;
     const uint slot = queue_slots[BEGIN_QUEUE * queues.sizes.x + j];
-    path_io(false, true, slot, p, s, span, rho);
+    path_io(false, true, slot, p, s, span, rho, temperature_value);
     if (!settle(slot_pixel(slot), p, s, span, s.pending == 2u)) {
       finish_slot(slot, s);
       return;
     }
-    path_io(true, true, slot, p, s, span, rho);
+    path_io(true, true, slot, p, s, span, rho, temperature_value);
     enqueue(fill, slot);
   }
 }

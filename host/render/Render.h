@@ -48,6 +48,10 @@ struct RenderSettings {
   // free-flight loop until the group's last event, as before the early exit
   // (Vulkan; the image is the same bit for bit either way).
   bool early_event_exit = true;
+  // Test hook (no scene key): false keeps the temperature in a texture of its
+  // own even where it could be the density texture's second channel (Vulkan;
+  // GpuScene::temperature_in_density).
+  bool temperature_in_density = true;
 };
 
 // Called after each progressive pass: samples per pixel done so far, target.

@@ -79,6 +79,9 @@ PYRO_CONST uint WAVEFRONT_SIZE_EVENT = 5;  // one lane: the event dispatch's siz
 PYRO_CONST uint WAVEFRONT_BEGIN = 6;       // the begin queue: the path's next ray (split event stage)
 PYRO_CONST uint WAVEFRONT_SIZE_BEGIN = 7;  // one lane: the begin dispatch's size from its queue
 PYRO_CONST uint SPEC_WAVEFRONT_SPLIT = 17;  // the event stage leaves the next ray to the begin stage
+// Every emitting grid's temperature is the second channel of its density
+// texture (GpuScene::temperature_in_density): one lookup reads both.
+PYRO_CONST uint SPEC_TEMPERATURE_IN_DENSITY = 18;
 PYRO_CONST uint WAVEFRONT_GROUP = 64;      // lanes per workgroup of the queue stages
 // 16-byte words of one path's state: a fixed part and a part per medium.
 PYRO_CONST uint WAVEFRONT_PATH_WORDS = 22;

@@ -27,6 +27,8 @@
 
 #include <glm/glm.hpp>
 
+#include "color/Blackbody.h"
+#include "render/cpu/Intersect.h"
 #include "scene/Scene.h"
 #include "support/AnalyticScenes.h"
 #include "support/TestSupport.h"
@@ -439,6 +441,50 @@ struct ConstantBoxSetup {
     return s;
   }
   ConstantBoxField field() const { return {lat, box, double(c)}; }
+
+  // The box with a temperature grid `tb` (1 on its voxels) that emits only
+  // where it is hot: T = (v − (1 − 1e-4)) · 6e7 K puts the stored 1.0 at
+  // 6000 K and everything below v = 0.99990 at or under cutoff_k (100 K), so
+  // the emitting region is tb's centre box (its trilinear ramp emits only
+  // within 1e-4 of a voxel of it: a 1e-5 relative effect). max_depth 0: σs
+  // only extinguishes (and keeps the two estimators from coinciding sample by
+  // sample: with σs = 0 every tentative collision in the hot region is real).
+  Scene hot_box_scene(const std::string& file, const TemperatureBox& tb) const {
+    Scene s = vdb_base_scene(24, 24, 2048);
+    s.camera.position = {1.5, 1.0, -4.0};
+    s.camera.look_at = {0.0, 0.0, 0.0};
+    s.camera.fov_deg = 22.0;
+    s.background = {0.02, 0.02, 0.05};
+    s.integrator.max_depth = 0;
+    s.media.push_back(vdb_medium("box", write_constant_box_vdb(dir / file, lat, box, c, tb), {0.8, 1.2, 1.6},
+                                 {0.4, 0.3, 0.2}, 0.0, std::nullopt, 2.0, true));
+    s.media[0].temperature.offset = 1.0 - 1e-4;
+    s.media[0].temperature.scale = 6000.0 / 1e-4;
+    s.media[0].temperature.cutoff_k = 100.0;
+    return s;
+  }
+  // hot_box_scene's exact image, with the emission inside `hot` only. σa/σt is
+  // the same everywhere, so over the hot chord [ta, tb]
+  //   ∫ σa(t) Le e^{−σt τ(t)} dt = (σa/σt)·Le·(e^{−σt τ(ta)} − e^{−σt τ(tb)}).
+  std::function<glm::dvec3(int, int)> hot_box_exact(const Scene& s, const Bounds& hot) const {
+    const glm::dvec3 Le = 2.0 * color::blackbody_rgb(6000.0, BlackbodyMode::Seed);
+    const ConstantBoxField f = field();
+    const glm::dvec3 sigma_a = s.media[0].sigma_a, sigma_t = s.media[0].sigma_a + s.media[0].sigma_s;
+    const glm::dvec3 bg = s.background;
+    return exact_image(s, [&](const glm::dvec3& o, const glm::dvec3& d, int* sig) {
+      const double tau = f.optical_depth(o, d);
+      const cpu::RayInterval h = cpu::intersect_box(o, d, hot.min, hot.max);
+      double ta = 0, tb = 0;
+      if (h.hit && h.t1 > 0.0) ta = std::max(0.0, h.t0), tb = h.t1;
+      const double tau_a = f.optical_depth(o, d, 0.0, ta), tau_b = f.optical_depth(o, d, 0.0, tb);
+      if (sig) *sig = f.signature(o, d) + 7 * chord(hot, o, d).signature;
+      glm::dvec3 L;
+      for (int k = 0; k < 3; ++k)
+        L[k] = sigma_a[k] / sigma_t[k] * Le[k] * (std::exp(-sigma_t[k] * tau_a) - std::exp(-sigma_t[k] * tau_b)) +
+               bg[k] * std::exp(-sigma_t[k] * tau);
+      return L;
+    });
+  }
 };
 
 }  // namespace pyrolume::test

@@ -282,46 +282,12 @@ TEST_F(CpuVdb, LongRays) {
 }
 
 // A temperature grid on ANOTHER lattice (voxel 0.13, shifted) that covers only
-// part of the density: emission must come from the temperature THERE. The
-// mapping T = (v − (1 − 1e-4)) · 6e7 K puts the stored 1.0 at 6000 K and
-// everything below v = 0.99990 at or under cutoff_k (100 K), so the emitting
-// region is the temperature grid's centre box (its trilinear ramp emits only
-// within 1e-4 of a voxel of it: a 1e-5 relative effect). With max_depth 0
-// (scattering only extinguishes) and σa/σt the same everywhere,
-//   ∫ σa(t) Le e^{−σt τ(t)} dt over [ta, tb] = (σa/σt)·Le·(e^{−σt τ(ta)} − e^{−σt τ(tb)}).
-// (σs > 0 also keeps the two estimators from coinciding sample by sample: with
-// σs = 0 every tentative collision in the hot constant region is real.)
+// part of the density: emission must come from the temperature THERE, which
+// emits only on its centre box (test::ConstantBoxSetup::hot_box_scene).
 TEST_F(CpuVdb, TemperatureGridOnAnotherLatticeEmitsWhereItIsHot) {
   const test::TemperatureBox tb{{0.13, {0.065, -0.03, 0.02}}, {{-3, -2, -3}, {2, 3, 3}}, 1.0f};
-  Scene s = test::vdb_base_scene(24, 24, 2048);
-  s.camera.position = {1.5, 1.0, -4.0};
-  s.camera.look_at = {0.0, 0.0, 0.0};
-  s.camera.fov_deg = 22.0;
-  s.background = {0.02, 0.02, 0.05};
-  s.integrator.max_depth = 0;
-  s.media.push_back(test::vdb_medium("box", test::write_constant_box_vdb(dir / "tbox.vdb", lat, box, c, tb),
-                                     {0.8, 1.2, 1.6}, {0.4, 0.3, 0.2}, 0.0, std::nullopt, 2.0, true));
-  s.media[0].temperature.offset = 1.0 - 1e-4;
-  s.media[0].temperature.scale = 6000.0 / 1e-4;
-  s.media[0].temperature.cutoff_k = 100.0;
-  const glm::dvec3 Le = 2.0 * color::blackbody_rgb(6000.0, BlackbodyMode::Seed);
-  const test::ConstantBoxField f = field();
-  const Bounds hot = test::centre_box(tb.lattice, tb.box);
-  const glm::dvec3 sigma_a = s.media[0].sigma_a, sigma_t = s.media[0].sigma_a + s.media[0].sigma_s;
-  const glm::dvec3 bg = s.background;
-  auto exact = test::exact_image(s, [&](const glm::dvec3& o, const glm::dvec3& d, int* sig) {
-    const double tau = f.optical_depth(o, d);
-    cpu::RayInterval h = cpu::intersect_box(o, d, hot.min, hot.max);
-    double ta = 0, tb_ = 0;
-    if (h.hit && h.t1 > 0.0) ta = std::max(0.0, h.t0), tb_ = h.t1;
-    const double tau_a = f.optical_depth(o, d, 0.0, ta), tau_b = f.optical_depth(o, d, 0.0, tb_);
-    if (sig) *sig = f.signature(o, d) + 7 * test::chord(hot, o, d).signature;
-    glm::dvec3 L;
-    for (int k = 0; k < 3; ++k)
-      L[k] = sigma_a[k] / sigma_t[k] * Le[k] * (std::exp(-sigma_t[k] * tau_a) - std::exp(-sigma_t[k] * tau_b)) +
-             bg[k] * std::exp(-sigma_t[k] * tau);
-    return L;
-  });
+  Scene s = hot_box_scene("tbox.vdb", tb);
+  const auto exact = hot_box_exact(s, test::centre_box(tb.lattice, tb.box));
   for (const char* est : kEstimators) {
     s.integrator.emission_estimator = est;
     RenderResult r = render(s);

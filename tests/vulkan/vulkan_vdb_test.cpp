@@ -21,6 +21,8 @@
 #include "support/Stats.h"
 #include "support/TestSupport.h"
 #include "support/VdbScenes.h"
+#include "render/vulkan/GpuScene.h"
+#include "volume/StoredVolume.h"
 #include "volume/VdbLoader.h"
 
 namespace pyrolume {
@@ -458,37 +460,9 @@ TEST_F(VulkanVdb, LongRays) {
 //   L = Σ_k (σa/σt)·Le·(e^{−σt τ(ta)} − e^{−σt τ(tb)}) + bg·e^{−σt τ}.
 TEST_F(VulkanVdb, TemperatureGridOnAnotherLatticeEmitsWhereItIsHot) {
   const test::TemperatureBox tb{{0.13, {0.065, -0.03, 0.02}}, {{-3, -2, -3}, {2, 3, 3}}, 1.0f};
-  Scene s = test::vdb_base_scene(24, 24, 2048);
-  s.camera.position = {1.5, 1.0, -4.0};
-  s.camera.look_at = {0.0, 0.0, 0.0};
-  s.camera.fov_deg = 22.0;
-  s.background = {0.02, 0.02, 0.05};
-  s.integrator.max_depth = 0;
-  s.media.push_back(test::vdb_medium("box", test::write_constant_box_vdb(dir / "tbox.vdb", lat, box, c, tb),
-                                     {0.8, 1.2, 1.6}, {0.4, 0.3, 0.2}, 0.0, std::nullopt, 2.0, true));
-  s.media[0].temperature.offset = 1.0 - 1e-4;
-  s.media[0].temperature.scale = 6000.0 / 1e-4;
-  s.media[0].temperature.cutoff_k = 100.0;
-  const glm::dvec3 Le = 2.0 * color::blackbody_rgb(6000.0, BlackbodyMode::Seed);
-  const test::ConstantBoxField f = field();
+  const Scene s = hot_box_scene("tbox.vdb", tb);
   const Bounds hot = test::centre_box(tb.lattice, tb.box);
-  const glm::dvec3 sigma_a = s.media[0].sigma_a, sigma_t = s.media[0].sigma_a + s.media[0].sigma_s;
-  const glm::dvec3 bg = s.background;
-  auto exact_for = [&](const Bounds& hot_box) {
-    return test::exact_image(s, [&, hot_box](const glm::dvec3& o, const glm::dvec3& d, int* sig) {
-      const double tau = f.optical_depth(o, d);
-      cpu::RayInterval h = cpu::intersect_box(o, d, hot_box.min, hot_box.max);
-      double ta = 0, tb_ = 0;
-      if (h.hit && h.t1 > 0.0) ta = std::max(0.0, h.t0), tb_ = h.t1;
-      const double tau_a = f.optical_depth(o, d, 0.0, ta), tau_b = f.optical_depth(o, d, 0.0, tb_);
-      if (sig) *sig = f.signature(o, d) + 7 * test::chord(hot_box, o, d).signature;
-      glm::dvec3 L;
-      for (int k = 0; k < 3; ++k)
-        L[k] = sigma_a[k] / sigma_t[k] * Le[k] * (std::exp(-sigma_t[k] * tau_a) - std::exp(-sigma_t[k] * tau_b)) +
-               bg[k] * std::exp(-sigma_t[k] * tau);
-      return L;
-    });
-  };
+  auto exact_for = [&](const Bounds& hot_box) { return hot_box_exact(s, hot_box); };
   RenderResult r = expect_closed_form(s, exact_for(hot), "temperature lattice");
   // The check can fail: the hot box on the DENSITY's lattice (the classic
   // mistake: temperature indices read with the density transform) is rejected.
@@ -496,6 +470,52 @@ TEST_F(VulkanVdb, TemperatureGridOnAnotherLatticeEmitsWhereItIsHot) {
   ZTestReport wrong = test::ztest_against_exact(r, exact_for(wrong_hot), pooled());
   EXPECT_FALSE(wrong.ok) << "temperature on the density's lattice was accepted: " << wrong.summary();
   std::printf("deliberately wrong (density lattice): %s\n", wrong.summary().c_str());
+}
+
+// A temperature grid on the density's own lattice (how Blender and EmberGen
+// write them) is the density texture's second channel: one lookup reads both
+// (docs/rendering.md). Over a box other than the density's (sticking out on
+// some sides, short on others) the image is the closed form's, and a hot box
+// one voxel off is rejected. Over the same box it is bit-identical to the
+// image with the temperature in a texture of its own: the same texel
+// coordinates, the same values.
+TEST_F(VulkanVdb, TemperatureOnTheDensityLatticeSharesItsTexture) {
+  const test::TemperatureBox tb{lat, {{-7, -8, -6}, {7, 5, 9}}, 1.0f};
+  const Scene s = hot_box_scene("shared.vdb", tb);
+  {  // the layout this test is about
+    const StoredVolume v = load_stored_volume(s.media[0]);
+    ASSERT_TRUE(v.temperature);
+    ASSERT_TRUE(temperature_fits_density_texture(v.density, *v.temperature, ~uint64_t(0)));
+  }
+  auto exact_for = [&](const Bounds& hot_box) { return hot_box_exact(s, hot_box); };
+  const RenderResult r =
+      expect_closed_form(s, exact_for(test::centre_box(lat, tb.box)), "temperature in the density texture");
+  test::VoxelBox off = tb.box;
+  off.lo.x += 1;
+  off.hi.x += 1;
+  ZTestReport wrong = test::ztest_against_exact(r, exact_for(test::centre_box(lat, off)), pooled());
+  EXPECT_FALSE(wrong.ok) << "the hot box one voxel off was accepted: " << wrong.summary();
+  std::printf("deliberately wrong (one voxel off): %s\n", wrong.summary().c_str());
+
+  // The same box: bit for bit against a texture of its own, with scattering
+  // and the collision estimator (every tentative collision reads the temperature).
+  Scene same = hot_box_scene("same.vdb", test::TemperatureBox{lat, box, 1.0f});
+  same.film.spp = 64;
+  same.integrator.max_depth = 4;
+  same.integrator.emission_estimator = "collision";
+  RenderSettings apart = settings_for(same);
+  apart.temperature_in_density = false;
+  const RenderResult shared = render(same), own = backend_->render(same, apart, {});
+  ASSERT_EQ(shared.sum.size(), own.sum.size());
+  size_t differing = 0;
+  double total = 0.0;
+  for (size_t i = 0; i < shared.sum.size(); ++i) {
+    differing += shared.sum[i] != own.sum[i] || shared.sum_sq[i] != own.sum_sq[i];
+    total += shared.sum[i];
+  }
+  EXPECT_EQ(differing, 0u) << "of " << shared.sum.size() << " channel sums";
+  EXPECT_EQ(shared.density_lookups, own.density_lookups);
+  EXPECT_GT(total, 0.0);
 }
 
 // NaN voxels are 0: a grid with NaN voxels renders bit-identically to the same

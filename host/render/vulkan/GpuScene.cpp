@@ -28,7 +28,47 @@ void texel_rows(const DenseGrid& g, gpu::vec4& r0, gpu::vec4& r1, gpu::vec4& r2)
 }
 }  // namespace
 
-GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes, bool with_luts) {
+bool temperature_fits_density_texture(const StoredGrid& density, const StoredGrid& temperature, uint64_t max_bytes) {
+  if (density.grid.world_to_index != temperature.grid.world_to_index) return false;
+  const bool half = density.format == TextureFormat::R16F && temperature.format == TextureFormat::R16F;
+  const double apart = double(dense_bytes(density.grid, density.format == TextureFormat::R16F)) +
+                       double(dense_bytes(temperature.grid, temperature.format == TextureFormat::R16F));
+  const double together = double(density.grid.texel_count()) * 2.0 * (half ? 2.0 : 4.0);
+  return together <= 1.25 * apart && together <= double(max_bytes);
+}
+
+DensityTemperatureTexels density_temperature_texels(const StoredGrid& density, const StoredGrid& temperature) {
+  DensityTemperatureTexels out;
+  out.half = density.format == TextureFormat::R16F && temperature.format == TextureFormat::R16F;
+  const DenseGrid& d = density.grid;
+  const DenseGrid& t = temperature.grid;
+  const size_t n = d.texel_count();
+  if (out.half) out.half_bits.assign(2 * n, 0);
+  else out.values.assign(2 * n, 0.f);
+  // Both grids share one index space: density texel (i,j,k) is index
+  // d.origin + (i,j,k), temperature texel index − t.origin (0 outside its box).
+  const glm::ivec3 shift = d.origin - t.origin;
+  size_t at = 0;
+  for (int k = 0; k < d.dims.z; ++k)
+    for (int j = 0; j < d.dims.y; ++j)
+      for (int i = 0; i < d.dims.x; ++i, ++at) {
+        const glm::ivec3 ti = glm::ivec3(i, j, k) + shift;
+        const bool inside = glm::all(glm::greaterThanEqual(ti, glm::ivec3(0))) && glm::all(glm::lessThan(ti, t.dims));
+        const size_t t_at =
+            inside ? (size_t(ti.z) * size_t(t.dims.y) + size_t(ti.y)) * size_t(t.dims.x) + size_t(ti.x) : 0;
+        if (out.half) {
+          out.half_bits[2 * at] = density.half_bits[at];
+          out.half_bits[2 * at + 1] = inside ? temperature.half_bits[t_at] : uint16_t(0);
+        } else {
+          out.values[2 * at] = d.values[at];
+          out.values[2 * at + 1] = inside ? t.values[t_at] : 0.f;
+        }
+      }
+  return out;
+}
+
+GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes, bool with_luts,
+                         uint64_t max_texture_bytes) {
   GpuScene out;
   for (size_t i = 0; i < scene.media.size(); ++i) {
     const Medium& m = scene.media[i];
@@ -96,6 +136,15 @@ GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<Sto
     out.has_scattering = out.has_scattering || max3(m.sigma_s) > 0.0;
     out.media.push_back(g);
   }
+  // One texture per grid for density and temperature where every emitting
+  // grid allows it: the shader variant reads the temperature one way for all.
+  bool any_temperature = false, all_fit = true;
+  for (const GpuGridSource& src : out.grid_sources)
+    if (src.temperature) {
+      any_temperature = true;
+      all_fit = all_fit && temperature_fits_density_texture(*src.density, *src.temperature, max_texture_bytes);
+    }
+  out.temperature_in_density = any_temperature && all_fit;
   if (out.media.size() > gpu::MAX_MEDIA)
     throw input_error(scene.file.string(), "media", "at most " + std::to_string(gpu::MAX_MEDIA) + " media are supported");
   return out;

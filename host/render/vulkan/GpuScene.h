@@ -1,5 +1,7 @@
 #pragma once
 // Scene (+ its loaded grids) -> the structs in shaders/shared/gpu_types.h.
+#include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -25,13 +27,35 @@ struct GpuScene {
   std::vector<float> majorants;             // every grid's cells, at GpuGrid::majorant_res.w
   bool has_grids = false, has_scattering = false, has_emission = false;
   bool has_analytic = false;  // a sphere or box medium
+  // Every emitting grid's temperature goes into its density texture's second
+  // channel (temperature_fits_density_texture), so one lookup reads both.
+  bool temperature_in_density = false;
 };
+
+// Whether a grid's temperature can be the second channel of its density
+// texture: both grids share one index space, so the temperature at a density
+// texel is a texel of its own, and the two-channel texture over the density's
+// box costs at most a quarter more memory than the two textures apart and fits
+// in max_bytes. Emission is σa·ρ·Le, zero wherever the density texture is, so
+// the temperature outside the density's box is never needed.
+bool temperature_fits_density_texture(const StoredGrid& density, const StoredGrid& temperature, uint64_t max_bytes);
+
+// The two-channel texels (density, temperature) over the density's box, as
+// RG16F bits when both grids are R16F (the uint16_t pairs) or RG32F floats.
+struct DensityTemperatureTexels {
+  bool half = true;
+  std::vector<uint16_t> half_bits;
+  std::vector<float> values;
+};
+DensityTemperatureTexels density_temperature_texels(const StoredGrid& density, const StoredGrid& temperature);
 
 // volumes[i] holds medium i's grids when it is a vdb medium. Empty grids are
 // left out (they render as no medium). `with_luts` = false skips the blackbody
-// LUT bake (for updates that keep the existing textures).
+// LUT bake (for updates that keep the existing textures); max_texture_bytes
+// bounds one texture (the device's largest allocation).
 GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes,
-                         bool with_luts = true);
+                         bool with_luts = true,
+                         uint64_t max_texture_bytes = std::numeric_limits<uint64_t>::max());
 gpu::FrameConstants build_frame_constants(const Scene& scene, const RenderSettings& settings, uint32_t medium_count);
 
 }  // namespace pyrolume

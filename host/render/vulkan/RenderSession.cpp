@@ -60,7 +60,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
     for (const auto& w : volumes_[i]->warnings) warnings_.push_back(w);
   }
   check_loaded_media(scene, volumes_);
-  gpu_scene_ = build_gpu_scene(scene, volumes_);
+  gpu_scene_ = build_gpu_scene(scene, volumes_, /*with_luts=*/true, shared_texture_bytes(settings));
 
   frame_buffer_ = vk::Buffer(ctx, sizeof(gpu::FrameConstants), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                              vk::MemoryKind::HostVisible, "frame constants");
@@ -148,6 +148,12 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   });
 }
 
+// The largest density texture that may take its temperature as a second
+// channel: one allocation; 0 (never) when the test hook turns it off.
+uint64_t RenderSession::shared_texture_bytes(const RenderSettings& settings) const {
+  return settings.temperature_in_density ? uint64_t(ctx_.max_allocation_size()) : 0;
+}
+
 DenseLimits RenderSession::dense_limits() const {
   return DenseLimits{ctx_.properties().limits.maxImageDimension3D, uint64_t(ctx_.max_allocation_size())};
 }
@@ -163,6 +169,7 @@ std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const S
            uint32_t(std::min<size_t>(textures_2d_.empty() ? 0 : textures_2d_.size() - 1, gpu::MAX_TEXTURES))},
           {gpu::SPEC_HAS_SCATTERING, flag(g.has_scattering && scene.integrator.max_depth > 0)},
           {gpu::SPEC_HAS_EMISSION, flag(g.has_emission)},
+          {gpu::SPEC_TEMPERATURE_IN_DENSITY, flag(g.temperature_in_density)},
           {gpu::SPEC_COLLISION_ESTIMATOR, flag(lights.estimator == EmissionEstimator::Collision)},
           {gpu::SPEC_DEBUG_MODE, settings.debug_mode},
           {gpu::SPEC_MEDIUM_COUNT, uint32_t(g.media.size())},
@@ -207,7 +214,8 @@ void RenderSession::write_grid_descriptors() {
 bool RenderSession::load_frame(const Scene& scene, const RenderSettings& settings) {
   if (settings.width != settings_.width || settings.height != settings_.height ||
       settings.debug_mode != settings_.debug_mode ||
-      settings.early_event_exit != settings_.early_event_exit || scene.media.size() != volumes_.size())
+      settings.early_event_exit != settings_.early_event_exit ||
+      settings.temperature_in_density != settings_.temperature_in_density || scene.media.size() != volumes_.size())
     return false;
   // Load into locals first: a bad frame (or a different variant) leaves the
   // session as it was.
@@ -218,7 +226,7 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
   check_loaded_media(scene, volumes);
   // The blackbody LUTs depend only on the emission's mode, observer and
   // adaptation: bake them once per sequence and reuse them frame after frame.
-  GpuScene gpu_scene = build_gpu_scene(scene, volumes, /*with_luts=*/false);
+  GpuScene gpu_scene = build_gpu_scene(scene, volumes, /*with_luts=*/false, shared_texture_bytes(settings));
   for (size_t slot = 0; slot < gpu_scene.grid_sources.size(); ++slot) {
     GpuGridSource& src = gpu_scene.grid_sources[slot];
     if (!src.temperature) continue;
@@ -259,11 +267,14 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
 
 // One 3D texture per grid, each over its own active bounding box with its own
 // transform (no resampling), plus one blackbody LUT per emitting grid medium.
+// With GpuScene::temperature_in_density the temperature is the density
+// texture's second channel instead (RG16F, or RG32F where either grid is R32F).
 void RenderSession::create_textures(const Scene& scene) {
   const VkPhysicalDeviceLimits& limits = ctx_.properties().limits;
   const uint16_t zero_half = 0;
   const float zero_rgba[4] = {0, 0, 0, 0};
-  auto make_3d = [&](const StoredGrid* g, const std::string& what) {
+  // temperature: a grid to put in the second channel (temperature_in_density).
+  auto make_3d = [&](const StoredGrid* g, const std::string& what, const StoredGrid* temperature = nullptr) {
     if (!g) {
       vk::Image3D img(ctx_, 1, 1, 1, VK_FORMAT_R16_SFLOAT, "unused grid slot");
       img.upload(ctx_, &zero_half, sizeof zero_half);
@@ -279,11 +290,21 @@ void RenderSession::create_textures(const Scene& scene) {
                             " texels exceed this device's 3D texture limit of " + std::to_string(max_dim) +
                             " per axis; add \"downsample\": " + std::to_string((largest + max_dim - 1) / max_dim) +
                             " to the medium");
-    double bytes = double(dense_bytes(g->grid, half));
+    const bool both_half = half && (!temperature || temperature->format == TextureFormat::R16F);
+    const double bytes =
+        temperature ? double(g->grid.texel_count()) * (both_half ? 4.0 : 8.0) : double(dense_bytes(g->grid, half));
     if (bytes > double(ctx_.max_allocation_size()))
       throw input_error(scene.file.string(), what,
                         "the dense texture needs " + mib(bytes) + ", more than the device allows in one allocation (" +
                             mib(double(ctx_.max_allocation_size())) + "); add \"downsample\": 2 to the medium");
+    if (temperature) {
+      const DensityTemperatureTexels texels = density_temperature_texels(*g, *temperature);
+      vk::Image3D img(ctx_, uint32_t(d.x), uint32_t(d.y), uint32_t(d.z),
+                      texels.half ? VK_FORMAT_R16G16_SFLOAT : VK_FORMAT_R32G32_SFLOAT, what.c_str());
+      if (texels.half) img.upload(ctx_, texels.half_bits.data(), texels.half_bits.size() * sizeof(uint16_t));
+      else img.upload(ctx_, texels.values.data(), texels.values.size() * sizeof(float));
+      return img;
+    }
     vk::Image3D img(ctx_, uint32_t(d.x), uint32_t(d.y), uint32_t(d.z), half ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT,
                     what.c_str());
     if (half) img.upload(ctx_, g->half_bits.data(), g->half_bits.size() * sizeof(uint16_t));
@@ -309,8 +330,11 @@ void RenderSession::create_textures(const Scene& scene) {
   textures_3d_.push_back(make_3d(nullptr, ""));
   textures_1d_.push_back(make_lut(nullptr));
   for (const GpuGridSource& s : gpu_scene_.grid_sources) {
-    textures_3d_.push_back(make_3d(s.density, "grid \"" + s.density->grid.name + "\""));
-    textures_3d_.push_back(make_3d(s.temperature, s.temperature ? "grid \"" + s.temperature->grid.name + "\"" : ""));
+    const bool together = gpu_scene_.temperature_in_density && s.temperature;
+    textures_3d_.push_back(
+        make_3d(s.density, "grid \"" + s.density->grid.name + "\"", together ? s.temperature : nullptr));
+    textures_3d_.push_back(make_3d(together ? nullptr : s.temperature,
+                                   s.temperature ? "grid \"" + s.temperature->grid.name + "\"" : ""));
     textures_1d_.push_back(make_lut(s.blackbody ? &*s.blackbody : nullptr));
   }
 }

@@ -90,6 +90,7 @@ class RenderSession {
 
  private:
   DenseLimits dense_limits() const;  // this device's 3D texture limits, for the grid loader
+  uint64_t shared_texture_bytes(const RenderSettings& settings) const;
   void upload_constants(const Scene& scene);
   void create_textures(const Scene& scene);
   void create_surfaces(const Scene& scene);
