@@ -1,4 +1,4 @@
-// pyrolume command line (contract: ../shared/DESIGN.md "Command line").
+// pyrolume command line (README.md "Using it"; the scene format: docs/scene-format.md).
 // Exit status: 0 ok, 1 internal error, 2 bad input, 3 compare beyond limits,
 // 130/143 interrupted (the image so far is saved first).
 #include <atomic>

@@ -1,4 +1,4 @@
-// Each real export in ../shared/data/vdb (SOURCES.md there) rendered at low
+// Each real export in the shared data folder rendered at low
 // resolution on the Vulkan backend and on the CPU reference, compared
 // statistically (issue 4 "Real data", issue 5 "GPU vs CPU ... on each real VDB"):
 // per-pixel z-test on 3×3-pooled variances (>= 99.75 % within 4σ) and the

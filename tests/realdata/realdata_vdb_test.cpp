@@ -1,4 +1,4 @@
-// The real exports in ../shared/data/vdb (SOURCES.md there lists what each
+// The real exports in the shared data folder (their publishers list what each
 // holds): `info` must print those facts, and load_volume must read each file
 // with the default grid names. Read in place, never copied into the project.
 #include <gtest/gtest.h>
