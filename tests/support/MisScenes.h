@@ -27,6 +27,14 @@ inline void set_strategy(Scene& s, Strategy k) {
   s.integrator.light_only = k == Strategy::LightOnly;
 }
 
+// A scene that writes its strategy out must render with it: light selection
+// may turn light sampling off where nothing is there to light (docs/mis.md),
+// and a MIS test would then go on passing while testing BSDF sampling.
+inline void expect_strategy_as_written(const Scene& s, const RenderResult& r) {
+  if (s.integrator.light_only) EXPECT_EQ(r.light_strategy, "light_only") << s.file;
+  else if (s.integrator.mis) EXPECT_EQ(r.light_strategy, *s.integrator.mis ? "mis" : "bsdf") << s.file;
+}
+
 // A uniform lat-long sky of radiance `value` (written once per folder).
 inline std::filesystem::path write_uniform_sky(const std::filesystem::path& dir, glm::vec3 value) {
   const auto exr = dir / "uniform_sky.exr";

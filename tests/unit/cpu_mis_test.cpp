@@ -29,6 +29,7 @@ RenderResult render(const Scene& s) {
   RenderResult res = r.render(s, test::settings_for(s), {});
   EXPECT_EQ(r.majorant_violations(), 0u);
   EXPECT_EQ(res.nonfinite_samples, 0u);
+  test::expect_strategy_as_written(s, res);
   return res;
 }
 

@@ -26,6 +26,7 @@ class VulkanMis : public test::VulkanFixture {
   RenderResult gpu(const Scene& s) {
     RenderResult r = backend_->render(s, test::settings_for(s), {});
     EXPECT_EQ(r.nonfinite_samples, 0u);
+    test::expect_strategy_as_written(s, r);
     return r;
   }
   RenderResult cpu(const Scene& s, int spp) {
@@ -34,6 +35,7 @@ class VulkanMis : public test::VulkanFixture {
     CpuRenderer renderer(0);
     RenderResult r = renderer.render(c, test::settings_for(c), {});
     EXPECT_EQ(renderer.majorant_violations(), 0u);
+    test::expect_strategy_as_written(c, r);
     return r;
   }
 };
