@@ -472,9 +472,9 @@ TEST_F(VulkanVdb, TemperatureGridOnAnotherLatticeEmitsWhereItIsHot) {
   std::printf("deliberately wrong (density lattice): %s\n", wrong.summary().c_str());
 }
 
-// A temperature grid on the density's own lattice (how Blender and EmberGen
-// write them) is the density texture's second channel: one lookup reads both
-// (docs/rendering.md). Over a box other than the density's (sticking out on
+// A temperature grid on the density's own lattice (as the Blender 2.79 and
+// Mantaflow exports have them) is the density texture's second channel: one
+// lookup reads both (docs/rendering.md). Over a box other than the density's (sticking out on
 // some sides, short on others) the image is the closed form's, and a hot box
 // one voxel off is rejected. Over the same box it is bit-identical to the
 // image with the temperature in a texture of its own: the same texel
