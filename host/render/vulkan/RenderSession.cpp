@@ -692,9 +692,16 @@ bool RenderSession::run_pass(int spp, const std::atomic<bool>* cancel) {
           }
           record_band(cmd, n, row, row + rows, wavefront);
         });
-        // The wavefront: more rounds until no path is left in its queues.
-        while (wavefront && wavefront_paths_left() > 0)
+        // The wavefront: more rounds until no path is left in its queues (a
+        // signal drops the pass; the next one starts on fresh queues).
+        while (wavefront && wavefront_paths_left() > 0) {
+          if (cancel && cancel->load()) {
+            interrupted = true;
+            break;
+          }
           ctx_.submit_and_wait([&](VkCommandBuffer cmd) { record_wavefront_iterations(cmd, kWavefrontIterations); });
+        }
+        if (interrupted) break;
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         pass_status_.invalidate();
         unfinished += pass_status_.data<gpu::PassStatus>()->counts.x;
