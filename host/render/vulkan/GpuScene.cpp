@@ -28,18 +28,27 @@ void texel_rows(const DenseGrid& g, gpu::vec4& r0, gpu::vec4& r1, gpu::vec4& r2)
 }
 }  // namespace
 
+namespace {
+bool both_half(const StoredGrid& density, const StoredGrid& temperature) {
+  return density.format == TextureFormat::R16F && temperature.format == TextureFormat::R16F;
+}
+}  // namespace
+
+uint64_t density_temperature_bytes(const StoredGrid& density, const StoredGrid& temperature) {
+  return uint64_t(dense_bytes(density.grid, both_half(density, temperature))) * 2;
+}
+
 bool temperature_fits_density_texture(const StoredGrid& density, const StoredGrid& temperature, uint64_t max_bytes) {
   if (density.grid.world_to_index != temperature.grid.world_to_index) return false;
-  const bool half = density.format == TextureFormat::R16F && temperature.format == TextureFormat::R16F;
   const double apart = double(dense_bytes(density.grid, density.format == TextureFormat::R16F)) +
                        double(dense_bytes(temperature.grid, temperature.format == TextureFormat::R16F));
-  const double together = double(density.grid.texel_count()) * 2.0 * (half ? 2.0 : 4.0);
+  const double together = double(density_temperature_bytes(density, temperature));
   return together <= 1.25 * apart && together <= double(max_bytes);
 }
 
 DensityTemperatureTexels density_temperature_texels(const StoredGrid& density, const StoredGrid& temperature) {
   DensityTemperatureTexels out;
-  out.half = density.format == TextureFormat::R16F && temperature.format == TextureFormat::R16F;
+  out.half = both_half(density, temperature);
   const DenseGrid& d = density.grid;
   const DenseGrid& t = temperature.grid;
   const size_t n = d.texel_count();

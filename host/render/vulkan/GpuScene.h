@@ -39,6 +39,8 @@ struct GpuScene {
 // in max_bytes. Emission is σa·ρ·Le, zero wherever the density texture is, so
 // the temperature outside the density's box is never needed.
 bool temperature_fits_density_texture(const StoredGrid& density, const StoredGrid& temperature, uint64_t max_bytes);
+// Bytes of that two-channel texture: RG16F when both grids are R16F, else RG32F.
+uint64_t density_temperature_bytes(const StoredGrid& density, const StoredGrid& temperature);
 
 // The two-channel texels (density, temperature) over the density's box, as
 // RG16F bits when both grids are R16F (the uint16_t pairs) or RG32F floats.

@@ -290,25 +290,23 @@ void RenderSession::create_textures(const Scene& scene) {
                             " texels exceed this device's 3D texture limit of " + std::to_string(max_dim) +
                             " per axis; add \"downsample\": " + std::to_string((largest + max_dim - 1) / max_dim) +
                             " to the medium");
-    const bool both_half = half && (!temperature || temperature->format == TextureFormat::R16F);
-    const double bytes =
-        temperature ? double(g->grid.texel_count()) * (both_half ? 4.0 : 8.0) : double(dense_bytes(g->grid, half));
+    const double bytes = temperature ? double(density_temperature_bytes(*g, *temperature))
+                                     : double(dense_bytes(g->grid, half));
     if (bytes > double(ctx_.max_allocation_size()))
       throw input_error(scene.file.string(), what,
                         "the dense texture needs " + mib(bytes) + ", more than the device allows in one allocation (" +
                             mib(double(ctx_.max_allocation_size())) + "); add \"downsample\": 2 to the medium");
-    if (temperature) {
-      const DensityTemperatureTexels texels = density_temperature_texels(*g, *temperature);
-      vk::Image3D img(ctx_, uint32_t(d.x), uint32_t(d.y), uint32_t(d.z),
-                      texels.half ? VK_FORMAT_R16G16_SFLOAT : VK_FORMAT_R32G32_SFLOAT, what.c_str());
-      if (texels.half) img.upload(ctx_, texels.half_bits.data(), texels.half_bits.size() * sizeof(uint16_t));
-      else img.upload(ctx_, texels.values.data(), texels.values.size() * sizeof(float));
-      return img;
-    }
-    vk::Image3D img(ctx_, uint32_t(d.x), uint32_t(d.y), uint32_t(d.z), half ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT,
-                    what.c_str());
-    if (half) img.upload(ctx_, g->half_bits.data(), g->half_bits.size() * sizeof(uint16_t));
-    else img.upload(ctx_, g->grid.values.data(), g->grid.values.size() * sizeof(float));
+    // The texels to upload: the grid's own, or (density, temperature) pairs.
+    DensityTemperatureTexels pairs;
+    if (temperature) pairs = density_temperature_texels(*g, *temperature);
+    const bool half_texels = temperature ? pairs.half : half;
+    const VkFormat format = temperature ? (half_texels ? VK_FORMAT_R16G16_SFLOAT : VK_FORMAT_R32G32_SFLOAT)
+                                        : (half_texels ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT);
+    const std::vector<uint16_t>& half_bits = temperature ? pairs.half_bits : g->half_bits;
+    const std::vector<float>& values = temperature ? pairs.values : g->grid.values;
+    vk::Image3D img(ctx_, uint32_t(d.x), uint32_t(d.y), uint32_t(d.z), format, what.c_str());
+    if (half_texels) img.upload(ctx_, half_bits.data(), half_bits.size() * sizeof(uint16_t));
+    else img.upload(ctx_, values.data(), values.size() * sizeof(float));
     return img;
   };
   auto make_lut = [&](const color::BlackbodyLut* lut) {
