@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "light/AnalyticLights.h"
 #include "light/EmissionCdf.h"
 #include "light/EnvironmentMap.h"
 
@@ -12,6 +13,8 @@ namespace pyrolume {
 bool LightSelection::any() const {
   if (p_env > 0.0) return true;
   for (double p : p_medium)
+    if (p > 0.0) return true;
+  for (double p : p_light)
     if (p > 0.0) return true;
   return false;
 }
@@ -41,12 +44,13 @@ LightCandidates light_candidates(const Scene& scene) {
   const bool asked = in.mis == true || in.light_only;
   c.environment = scatters;
   c.media = asked ? scatters : surfaces;
+  c.lights = scatters && !scene.lights.empty();
   return c;
 }
 
 LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs) {
   const Integrator& in = scene.integrator;
-  if (const std::optional<IntegratorConflict> c = integrator_conflict(in))
+  if (const std::optional<IntegratorConflict> c = integrator_conflict(in, !scene.lights.empty()))
     throw std::invalid_argument("integrator." + c->key + ": " + c->reason);
   if (in.emission_estimator != "auto" && in.emission_estimator != "absorption" && in.emission_estimator != "collision")
     throw std::invalid_argument("integrator.emission_estimator: unknown \"" + in.emission_estimator + "\"");
@@ -55,13 +59,28 @@ LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, cons
   s.p_medium.assign(cdfs.size(), 0.0);
   const bool env_light = want.environment && env && env->has_distribution();
   auto medium_light = [&](const EmissionCdf* c) { return want.media && c && !c->empty() && c->power() > 0.0; };
-  double media_power = 0.0;
+  // Weights within the two groups (at infinity, in the scene), then 1/2 per
+  // group that has a light.
+  constexpr double kFourPi = 4.0 * 3.14159265358979323846;
+  double far_power = env_light ? env->power() : 0.0, near_power = 0.0;
   for (const EmissionCdf* c : cdfs)
-    if (medium_light(c)) media_power += c->power();
-  const double media_share = media_power > 0.0 ? (env_light ? 0.5 : 1.0) : 0.0;
-  s.p_env = env_light ? 1.0 - media_share : 0.0;
+    if (medium_light(c)) near_power += kFourPi * c->power();
+  std::vector<double> power(scene.lights.size(), 0.0);
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    if (!want.lights) break;
+    power[i] = light_power(scene.lights[i]);
+    (scene.lights[i].type == Light::Type::Distant ? far_power : near_power) += power[i];
+  }
+  const bool far = far_power > 0.0, near = near_power > 0.0;
+  const double far_share = far ? (near ? 0.5 : 1.0) : 0.0, near_share = near ? 1.0 - far_share : 0.0;
+  s.p_env = env_light && far ? far_share * env->power() / far_power : 0.0;
   for (size_t i = 0; i < cdfs.size(); ++i)
-    if (medium_light(cdfs[i])) s.p_medium[i] = media_share * cdfs[i]->power() / media_power;
+    if (medium_light(cdfs[i]) && near) s.p_medium[i] = near_share * kFourPi * cdfs[i]->power() / near_power;
+  s.p_light.assign(scene.lights.size(), 0.0);
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const bool distant = scene.lights[i].type == Light::Type::Distant;
+    if (power[i] > 0.0) s.p_light[i] = distant ? far_share * power[i] / far_power : near_share * power[i] / near_power;
+  }
   s.strategy = !s.any() ? LightStrategy::Bsdf : (in.light_only ? LightStrategy::LightOnly : LightStrategy::Mis);
   s.estimator = in.emission_estimator == "collision" ? EmissionEstimator::Collision
                 : in.emission_estimator == "absorption"

@@ -36,9 +36,12 @@ const char* strategy_name(LightStrategy k);
 //     its own emission for its in-scattering costs more than it saves
 //     (docs/mis.md "When light sampling runs by default").
 //   "mis": true or "light_only": true: both, wherever something scatters.
+//   The scene's `lights` wherever something can be lit (they are reached
+//     only by light sampling: "mis": false contradicts them).
 struct LightCandidates {
   bool environment = false;
   bool media = false;
+  bool lights = false;
 };
 LightCandidates light_candidates(const Scene& scene);
 
@@ -53,6 +56,8 @@ struct LightSelection {
   double p_env = 0.0;
   // Per scene medium: probability of picking its emission CDF (0: not a light).
   std::vector<double> p_medium;
+  // Per entry of Scene::lights: probability of picking it.
+  std::vector<double> p_light;
   LightStrategy strategy = LightStrategy::Bsdf;
   // What both backends render with: the file's estimator, or for "auto" the
   // collision estimator with light sampling (what MIS is written for) and
@@ -88,10 +93,14 @@ struct LightSelection {
 // Continuation: p_continue_own = 1 − integrator.guided_continuation (unset:
 // kContinueOwn) with next-event estimation, 1 without.
 //
-// Choice between lights: the environment and the emissive media get 1/2 each
-// when both are sampled (their powers, ∫Y dω and ∫Y(σa Le) dV, have different
-// units, so their ratio means nothing without a distance); among the emissive
-// media, by power ∫ w dV (EmissionCdf::power).
+// Choice between lights (docs/lights.md "Choosing a light"): two groups, the
+// lights at infinity (the environment, distant lights) and the lights in the
+// scene (emissive media; point, spot and sphere lights). Their powers have
+// different units (per unit area against watts), so their ratio means
+// nothing without a distance: each group that has a light gets 1/2 (1 when it
+// is alone). Within a group, by power: the environment ∫Y dω against a
+// distant light's irradiance Y(E); an emissive medium's 4π ∫ w dV
+// (EmissionCdf::power) against light_power's watts.
 //
 // Strategy: Mis (LightOnly with integrator.light_only) when at least one light
 // is sampled, otherwise Bsdf. Estimator: as the file says, "auto" resolved by

@@ -179,6 +179,30 @@ struct Shape {
   std::filesystem::path texture;  // empty: constant albedo
 };
 
+// A light of the scene's `lights` array (docs/lights.md "Analytic lights").
+// Its value is scale × rgb, or scale × the blackbody colour of luminance 1 at
+// temperature_k (light_value, host/light/AnalyticLights.h).
+struct Light {
+  enum class Type { Distant, Point, Spot, Sphere };
+  Type type = Type::Point;
+  // distant: irradiance (W/m² on a plane facing the light); point, spot:
+  // radiant intensity (W/sr); sphere: radiance (W/(m²·sr)). Exactly one of
+  // rgb / temperature_k is set.
+  std::optional<glm::dvec3> rgb;
+  std::optional<double> temperature_k;
+  double scale = 1.0;
+  glm::dvec3 direction{0, 0, 1};  // unit; distant: toward the light; spot: where it shines
+  double angle_deg = 0.0;         // distant: the disc's angular diameter (0: a delta light)
+  glm::dvec3 position{0.0};       // point, spot
+  double cone_deg = 45.0;         // spot: half-angle of the cone, dark outside
+  double falloff_deg = 0.0;       // spot: width of the soft edge inside the cone
+  glm::dvec3 center{0.0};         // sphere
+  double radius = 1.0;            // sphere
+  // Delta lights (point, spot, a distant light of angle 0) are reached only
+  // by next-event estimation; the others can also be hit by rays.
+  bool is_delta() const { return type == Type::Point || type == Type::Spot || (type == Type::Distant && angle_deg == 0.0); }
+};
+
 enum class UpAxis { Y, Z };
 
 struct Scene {
@@ -194,6 +218,7 @@ struct Scene {
   std::optional<Environment> environment;
   std::vector<Medium> media;
   std::vector<Shape> shapes;
+  std::vector<Light> lights;
 };
 
 // Integrator keys that contradict each other ("mis": true with the absorption
@@ -204,7 +229,9 @@ struct IntegratorConflict {
   std::string key;  // under "integrator"
   std::string reason;
 };
-std::optional<IntegratorConflict> integrator_conflict(const Integrator& integrator);
+// has_lights: the scene has a `lights` array, which only light sampling
+// reaches ("mis": false and the absorption estimator contradict it).
+std::optional<IntegratorConflict> integrator_conflict(const Integrator& integrator, bool has_lights = false);
 
 // Parse and validate. Throws InputError("FILE: key.path: reason").
 // Keyframed values are also stored evaluated at frame 0 (clamped), the frame

@@ -351,8 +351,14 @@ Shape read_shape(Reader r, const std::filesystem::path& base) {
 
 }  // namespace
 
-std::optional<IntegratorConflict> integrator_conflict(const Integrator& in) {
+std::optional<IntegratorConflict> integrator_conflict(const Integrator& in, bool has_lights) {
   const bool absorption = in.emission_estimator == "absorption";
+  if (has_lights && in.mis == false)
+    return IntegratorConflict{"mis", "false turns off light sampling, the only way the scene's \"lights\" are reached "
+                                     "(remove it, or remove the lights)"};
+  if (has_lights && absorption)
+    return IntegratorConflict{"emission_estimator", "\"absorption\" turns off light sampling, the only way the scene's "
+                                                    "\"lights\" are reached (write \"auto\" or leave it out)"};
   if (in.light_only && in.mis == false)
     return IntegratorConflict{"light_only", "true asks for light sampling, which \"mis\": false turns off"};
   if (in.light_only && absorption)
@@ -362,6 +368,65 @@ std::optional<IntegratorConflict> integrator_conflict(const Integrator& in) {
     return IntegratorConflict{"emission_estimator", "\"absorption\" contradicts \"mis\": true (light sampling needs "
                                                     "the collision estimator: write \"auto\" or leave it out)"};
   return std::nullopt;
+}
+
+Light read_light(Reader r) {
+  Light l;
+  if (!r.has("type")) r.fail("type", "missing required key (\"distant\", \"point\", \"spot\" or \"sphere\")");
+  const std::string type = r.choice("type", "", {"distant", "point", "spot", "sphere"});
+  l.type = type == "distant" ? Light::Type::Distant
+           : type == "point" ? Light::Type::Point
+           : type == "spot"  ? Light::Type::Spot
+                             : Light::Type::Sphere;
+  // The colour key names the quantity: what a plane facing a distant light
+  // receives, what a point or spot radiates per steradian, a sphere's radiance.
+  const char* value_key = l.type == Light::Type::Distant ? "irradiance"
+                          : l.type == Light::Type::Sphere ? "radiance"
+                                                          : "intensity";
+  if (r.has(value_key)) l.rgb = r.nonnegative_rgb(value_key, {});
+  if (r.has("temperature_k")) {
+    const double t = r.number("temperature_k", 0.0);
+    if (!(t > 0)) r.fail("temperature_k", "must be > 0 kelvin");
+    l.temperature_k = t;
+  }
+  if (l.rgb && l.temperature_k) r.fail(value_key, std::string("give either ") + value_key + " or temperature_k, not both");
+  if (!l.rgb && !l.temperature_k) r.fail(value_key, std::string("missing: give ") + value_key + " (rgb) or temperature_k");
+  l.scale = r.number("scale", 1.0);
+  if (l.scale < 0) r.fail("scale", "must be >= 0");
+  auto unit_direction = [&](const char* key) {
+    const glm::dvec3 d = r.vec3_required(key);
+    if (!(glm::length(d) > 0)) r.fail(key, "must not be zero");
+    return glm::normalize(d);
+  };
+  switch (l.type) {
+    case Light::Type::Distant:
+      l.direction = unit_direction("direction");
+      l.angle_deg = r.number("angle_deg", 0.0);
+      if (!(l.angle_deg >= 0 && l.angle_deg < 180)) r.fail("angle_deg", "must be in [0, 180) degrees");
+      break;
+    case Light::Type::Point:
+      l.position = r.vec3_required("position");
+      break;
+    case Light::Type::Spot:
+      l.position = r.vec3_required("position");
+      l.direction = unit_direction("direction");
+      l.cone_deg = r.number("cone_deg", l.cone_deg);
+      if (!(l.cone_deg > 0 && l.cone_deg <= 180)) r.fail("cone_deg", "must be in (0, 180] degrees");
+      l.falloff_deg = r.number("falloff_deg", l.falloff_deg);
+      if (!(l.falloff_deg >= 0)) r.fail("falloff_deg", "must be >= 0 degrees");
+      if (l.cone_deg < l.falloff_deg)
+        r.fail("cone_deg", "must be >= falloff_deg (the soft edge lies inside the cone), got cone_deg " +
+                               json(l.cone_deg).dump() + " < falloff_deg " + json(l.falloff_deg).dump());
+      break;
+    case Light::Type::Sphere:
+      l.center = r.vec3_required("center");
+      l.radius = r.number("radius", 0.0);
+      if (!r.has("radius")) r.fail("radius", "missing required key");
+      if (!(l.radius > 0)) r.fail("radius", "must be > 0");
+      break;
+  }
+  r.finish();
+  return l;
 }
 
 Scene parse_scene(const std::string& json_text, const std::filesystem::path& file) {
@@ -470,6 +535,14 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
     if (!shapes.is_array()) r.fail("shapes", "expected an array");
     for (size_t k = 0; k < shapes.size(); ++k)
       s.shapes.push_back(read_shape(Reader(shapes[k], "shapes[" + std::to_string(k) + "]", fname), base));
+  }
+  if (r.has("lights")) {
+    const json& lights = r.raw("lights");
+    if (!lights.is_array()) r.fail("lights", "expected an array");
+    for (size_t k = 0; k < lights.size(); ++k)
+      s.lights.push_back(read_light(Reader(lights[k], "lights[" + std::to_string(k) + "]", fname)));
+    if (const std::optional<IntegratorConflict> c = integrator_conflict(s.integrator, !s.lights.empty()))
+      throw input_error(fname, "integrator." + c->key, c->reason);
   }
   r.finish();
   return s;
