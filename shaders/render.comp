@@ -49,6 +49,8 @@ layout(constant_id = SPEC_EARLY_EVENT_EXIT) const bool EARLY_EVENT_EXIT = false;
 // at a collision reads it too, and the emission there needs no lookup of its own
 // (docs/rendering.md "One texture for density and temperature").
 layout(constant_id = SPEC_TEMPERATURE_IN_DENSITY) const bool TEMPERATURE_IN_DENSITY = false;
+// The scene's analytic lights (shaders/analytic_lights.glsl); 0: none of their code.
+layout(constant_id = SPEC_LIGHT_COUNT) const uint LIGHT_COUNT = 0;
 
 layout(std140, set = 0, binding = BINDING_FRAME) uniform FrameBlock { FrameConstants frame; };
 // Media and grids are uniform blocks: every lane reads the same entries, which
@@ -91,6 +93,10 @@ layout(std140, set = 0, binding = BINDING_EMISSION_HEADERS) uniform EmissionHead
   GpuEmissionCdf emission_lights[MAX_GRIDS];  // by grid slot; measure.w: probability of picking it
 };
 #include "lights.glsl"
+layout(std430, set = 0, binding = BINDING_LIGHTS) readonly buffer AnalyticLightBlock { GpuLight analytic_lights[]; };
+#include "analytic_lights.glsl"
+// What a ray hits: a sphere light, or where a delta light ray meets its light.
+const uint SURFACE_HIT_LIGHT = 2u;
 
 const float INF = 1.0 / 0.0;
 
@@ -415,14 +421,21 @@ float light_direction_pdf(vec3 o, vec4 norm, vec3 d) {
       GpuEmissionCdf e = emission_lights[uint(media[i].bounds0.x)];
       if (e.measure.w > 0.0) p += e.measure.w * emission_direction_pdf(e, o, norm[uint(media[i].bounds0.x)], d);
     }
+  for (uint i = 0u; i < LIGHT_COUNT; ++i)
+    if (analytic_lights[i].value.w > 0.0) p += analytic_lights[i].value.w * analytic_light_pdf(analytic_lights[i], o, d);
   return p;
 }
 
 // A light direction for next-event estimation from point o: the environment
-// map's, or toward a point drawn from an emissive grid's emission CDF (the
-// light chosen by frame.lights.x and each grid's measure.w). false: none.
-bool sample_light_direction(vec3 o, vec4 norm, inout uint rng, out vec3 dir) {
+// map's, toward a point drawn from an emissive grid's emission CDF, or toward
+// an analytic light (the light chosen by frame.lights.x, each grid's
+// measure.w and each analytic light's value.w). false: none. A delta light
+// sets delta_light to its index and delta_w to what it delivers along dir per
+// unit of f, over its probability; otherwise delta_light = LIGHT_COUNT.
+bool sample_light_direction(vec3 o, vec4 norm, inout uint rng, out vec3 dir, out vec3 delta_w, out uint delta_light) {
   dir = vec3(0.0, 0.0, 1.0);
+  delta_w = vec3(0.0);
+  delta_light = LIGHT_COUNT;
   float u = rng_next(rng);
   vec2 u2 = vec2(rng_next(rng), rng_next(rng));
   float u_z = rng_next(rng);
@@ -431,20 +444,40 @@ bool sample_light_direction(vec3 o, vec4 norm, inout uint rng, out vec3 dir) {
     dir = es.dir;
     return es.pdf > 0.0;
   }
-  if (!HAS_GRIDS || !HAS_EMISSION) return false;
   u -= frame.lights.x;
   // The grid medium whose light probability covers u.
   // (The last light when rounding leaves u past them all, like the CPU reference.)
   uint pick = MEDIUM_COUNT;
   bool found = false;
-  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-    if (!is_grid(media[i])) continue;
-    float p = emission_lights[uint(media[i].bounds0.x)].measure.w;
-    if (!(p > 0.0) || found) continue;
-    pick = i;
-    if (u < p) found = true; else u -= p;
+  if (HAS_GRIDS && HAS_EMISSION)
+    for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+      if (!is_grid(media[i])) continue;
+      float p = emission_lights[uint(media[i].bounds0.x)].measure.w;
+      if (!(p > 0.0) || found) continue;
+      pick = i;
+      if (u < p) found = true; else u -= p;
+    }
+  if (LIGHT_COUNT > 0u && !found) {
+    // Past the grids: the analytic light whose probability covers u (the last one when rounding leaves u past them).
+    uint light = LIGHT_COUNT;
+    for (uint i = 0u; i < LIGHT_COUNT; ++i) {
+      const float p = analytic_lights[i].value.w;
+      if (!(p > 0.0) || found) continue;
+      light = i;
+      if (u < p) found = true; else u -= p;
+    }
+    if (light < LIGHT_COUNT) {
+      const GpuLight l = analytic_lights[light];
+      vec3 delta_value;
+      if (!analytic_light_sample(l, o, u2, dir, delta_value)) return false;
+      if (light_is_delta(l.kind.x)) {
+        delta_light = light;
+        delta_w = delta_value / l.value.w;
+      }
+      return true;
+    }
   }
-  if (pick == MEDIUM_COUNT) return false;
+  if (!HAS_GRIDS || !HAS_EMISSION || pick == MEDIUM_COUNT) return false;
   const uint slot = uint(media[pick].bounds0.x);
   const float u_cluster = rng_next(rng), u_cell = rng_next(rng);
   EmissionSample es = emission_sample(emission_lights[slot], o, norm[slot], u_cluster, u_cell, vec3(u2, u_z));
@@ -505,14 +538,27 @@ struct PathState {
   vec3 vertex_d_in;
   vec3 vertex_share[MEDIA_N];
   float vertex_q[MEDIA_N];
+  // A light ray toward delta light `delta_light` (LIGHT_COUNT: none): it
+  // collects nothing on its way (skip_segment) and adds its weight where it
+  // reaches the light (a point or spot: path_begin puts a hit there; a
+  // distant light: escaping).
+  uint delta_light;
 };
 
 // Radiance of a ray that leaves the scene: the environment map (+Z up,
 // docs/lights.md), or the constant background.
-vec3 escaped_radiance(vec3 d) { return HAS_ENVIRONMENT ? env_radiance(environment, d) : frame.background.rgb; }
+vec3 escaped_radiance(vec3 d) {
+  const vec3 sky = HAS_ENVIRONMENT ? env_radiance(environment, d) : frame.background.rgb;
+  return LIGHT_COUNT > 0u ? sky + disc_lights_radiance(d) : sky;
+}
 
-// The ray leaves the scene: add what it sees, MIS-weighted.
+// The ray leaves the scene: add what it sees, MIS-weighted. A light ray
+// toward a delta distant light has reached it.
 void escape(inout PathState p) {
+  if (LIGHT_COUNT > 0u && p.delta_light < LIGHT_COUNT) {
+    if (analytic_lights[p.delta_light].kind.x == LIGHT_DISTANT) p.L += p.w;
+    return;
+  }
   if (!p.skip_segment) p.L += unidirectional_weight(p.pdf_dir, p.p_light) * p.w * escaped_radiance(p.d);
 }
 
@@ -525,6 +571,7 @@ void new_ray(inout PathState p, vec3 o, vec3 d, float pdf_dir, float p_light) {
   p.p_light = p_light;
   p.light_T = 1.0;
   p.skip_segment = false;
+  p.delta_light = LIGHT_COUNT;
 }
 
 // The continuation's solid-angle pdf of a direction that the vertex's lobe
@@ -559,9 +606,10 @@ void phase_mixture(vec3 d_in, vec3 w, vec3 share[MEDIA_N], float q[MEDIA_N], out
 void next_light_ray(inout PathState p, inout uint rng) {
   const float n = p.vertex_medium ? 1.0 : frame.lights.z;
   --p.lights_left;
-  vec3 dir;
+  vec3 dir, delta_w;
+  uint delta_light;
   vec3 w = vec3(0.0);
-  if (sample_light_direction(p.next_o, p.vertex_norm, rng, dir)) {
+  if (sample_light_direction(p.next_o, p.vertex_norm, rng, dir, delta_w, delta_light)) {
     vec3 f;
     float pdf_own;
     if (p.vertex_medium) {
@@ -570,11 +618,19 @@ void next_light_ray(inout PathState p, inout uint rng) {
       pdf_own = max(dot(p.vertex_n, dir), 0.0) * (1.0 / PI);  // Lambertian: f·cos = albedo·cos/π
       f = vec3(pdf_own);
     }
-    const float p_l = pdf_own > 0.0 && max3(p.vertex_wa * f) > 0.0 ? light_direction_pdf(p.next_o, p.vertex_norm, dir) : 0.0;
-    if (p_l > 0.0) w = p.vertex_wa * f * (light_weight(n * p_l, continuation_pdf(pdf_own, p_l)) / (n * p_l));
+    if (LIGHT_COUNT > 0u && delta_light < LIGHT_COUNT) {
+      w = p.vertex_wa * f * delta_w / n;  // no MIS: only light sampling finds a delta light
+    } else {
+      const float p_l = pdf_own > 0.0 && max3(p.vertex_wa * f) > 0.0 ? light_direction_pdf(p.next_o, p.vertex_norm, dir) : 0.0;
+      if (p_l > 0.0) w = p.vertex_wa * f * (light_weight(n * p_l, continuation_pdf(pdf_own, p_l)) / (n * p_l));
+    }
   }
   p.w = w;
   new_ray(p, p.next_o, dir, 0.0, 0.0);
+  if (LIGHT_COUNT > 0u && delta_light < LIGHT_COUNT) {
+    p.delta_light = delta_light;
+    p.skip_segment = true;
+  }
 }
 
 // The vertex's light rays are done: the continuation starts (true: the path
@@ -621,7 +677,12 @@ bool continue_toward_light(vec3 o, vec4 norm, inout uint rng, out vec3 dir, out 
   dir = vec3(0.0, 0.0, 1.0);
   none = false;
   if (!NEE || !GUIDED_CONTINUATION || rng_next(rng) < frame.lights.y) return false;
-  none = !sample_light_direction(o, norm, rng, dir);
+  vec3 delta_w;
+  uint delta_light;
+  // A delta light has no direction density: drawing one leaves the
+  // continuation without a direction (weight 0), so the continuation's density
+  // is still continuation_pdf's.
+  none = !sample_light_direction(o, norm, rng, dir, delta_w, delta_light) || delta_light < LIGHT_COUNT;
   return true;
 }
 
@@ -774,6 +835,26 @@ struct Collision {
 // any (the path goes on with its next ray, or has ended).
 const int RAY_READY = -1, RAY_ENDED = 0, PATH_ENDED = 1;
 
+// Sphere lights that a fresh ray meets before its surface hit, and where a
+// light ray toward a point or spot light reaches it: a hit of kind
+// SURFACE_HIT_LIGHT (primitive: the light).
+void lights_on_ray(inout PathState p) {
+  float t = p.has_hit ? p.hit.t : INF;
+  uint light = intersect_sphere_lights(p.o, p.d, t);
+  if (p.delta_light < LIGHT_COUNT && analytic_lights[p.delta_light].kind.x != LIGHT_DISTANT) {
+    const float r = length(analytic_lights[p.delta_light].position.xyz - p.o);
+    if (r < t) {
+      t = r;
+      light = p.delta_light;
+    }
+  }
+  if (light == LIGHT_COUNT) return;
+  p.has_hit = true;
+  p.hit.t = t;
+  p.hit.kind = SURFACE_HIT_LIGHT;
+  p.hit.primitive = light;
+}
+
 // The start of a path_step: the vertex's next light ray when one is pending,
 // and a fresh ray's media spans and surface hit.
 int path_begin(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng) {
@@ -786,6 +867,7 @@ int path_begin(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng) {
     bool any_hit;
     media_spans(p.o, p.d, span, any_hit);
     p.has_hit = HAS_SURFACES && intersect_surfaces(p.o, p.d, 1e30, p.hit);
+    if (LIGHT_COUNT > 0u) lights_on_ray(p);
     p.fresh = false;
     p.t = 0.0;
     if (!any_hit && !p.has_hit) {
@@ -935,6 +1017,13 @@ bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, 
     escape(p);
     return ray_ends(p);
   }
+  if (LIGHT_COUNT > 0u && event == EVENT_SURFACE && p.hit.kind == SURFACE_HIT_LIGHT) {
+    // A delta light ray arrives (its weight holds f·I/(r²·P)); any other ray
+    // sees the sphere light's radiance, MIS-weighted, and ends: it is opaque.
+    if (p.hit.primitive == p.delta_light) p.L += p.w;
+    else if (!p.skip_segment) p.L += unidirectional_weight(p.pdf_dir, p.p_light) * p.w * analytic_lights[p.hit.primitive].value.rgb;
+    return ray_ends(p);
+  }
   if (event == EVENT_END || (event == EVENT_SURFACE && NEE && p.light_ray)) return ray_ends(p);
   const bool surface = HAS_SURFACES && event == EVENT_SURFACE;
   if (!surface) {
@@ -995,6 +1084,7 @@ void camera_path(uvec2 pixel, uint k, out uint rng, inout PathState p) {
   p.lights_left = 0u;
   p.vertex_wa = p.vertex_n = vec3(0.0);
   p.light_pending = false;
+  p.delta_light = LIGHT_COUNT;
   p.vertex_norm = vec4(0.0);
   p.vertex_medium = false;
   p.vertex_d_in = vec3(0.0);

@@ -50,6 +50,7 @@ PYRO_CONST uint BINDING_EMISSION_HEADERS = 20; // uniform GpuEmissionCdf[MAX_GRI
 PYRO_CONST uint BINDING_EMISSION_CLUSTERS = 22; // readonly buffer GpuEmissionCluster[]: their clusters
 PYRO_CONST uint BINDING_PASS_STATUS = 21;      // buffer PassStatus: what the pass could not finish
 PYRO_CONST uint BINDING_PATHS = 23;    // uimageBuffer (rgba32ui): the wavefront's path states (shaders/wavefront.glsl path_io)
+PYRO_CONST uint BINDING_LIGHTS = 25;    // readonly buffer GpuLight[]: the scene's analytic lights (shared/light_types.h)
 PYRO_CONST uint BINDING_QUEUES = 24;   // buffer WavefrontQueues, then its queues of path slots
 
 // Specialisation constants of render.comp: a scene pays only for what it uses.
@@ -82,6 +83,7 @@ PYRO_CONST uint SPEC_WAVEFRONT_SPLIT = 17;  // the event stage leaves the next r
 // Every emitting grid's temperature is the second channel of its density
 // texture (GpuScene::temperature_in_density): one lookup reads both.
 PYRO_CONST uint SPEC_TEMPERATURE_IN_DENSITY = 18;
+PYRO_CONST uint SPEC_LIGHT_COUNT = 19;  // analytic lights (the scene's `lights`); 0 compiles their code out
 PYRO_CONST uint WAVEFRONT_GROUP = 64;      // lanes per workgroup of the queue stages
 // 16-byte words of one path's state: a fixed part and a part per medium.
 PYRO_CONST uint WAVEFRONT_PATH_WORDS = 22;

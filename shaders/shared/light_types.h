@@ -66,7 +66,29 @@ struct GpuEmissionCluster {
   uvec4 entries;   // x: its first entry (relative to offsets.x); y: its entry count; zw: 0
 };
 
+// The kinds of analytic light (the scene's `lights`; docs/lights.md
+// "Analytic lights"). The first three are delta lights.
+PYRO_CONST uint LIGHT_POINT = 0;
+PYRO_CONST uint LIGHT_SPOT = 1;
+PYRO_CONST uint LIGHT_DISTANT = 2;  // a delta distant light (angle_deg 0)
+PYRO_CONST uint LIGHT_DISC = 3;     // a distant light of angular diameter > 0
+PYRO_CONST uint LIGHT_SPHERE = 4;
+
+// One analytic light (80 bytes; buffer analytic_lights[], shaders/analytic_lights.glsl).
+struct GpuLight {
+  vec4 position;   // xyz: point or spot position, sphere centre; w: sphere radius
+  vec4 direction;  // xyz unit: distant, disc: toward the light; spot: where it shines; w: 0
+  vec4 value;      // rgb: intensity (point, spot; W/sr), irradiance (distant), radiance (disc, sphere);
+                   // w: probability that next-event estimation picks this light
+  vec4 cone;       // spot: x cos of the cone's half-angle, y cos of where the falloff starts;
+                   // disc: z 1 − cos θ, w sin²θ (θ its angular radius); else 0
+  uvec4 kind;      // x: LIGHT_*; yzw: 0
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(GpuLight) == 80);
+static_assert(offsetof(GpuLight, cone) == 48);
+static_assert(offsetof(GpuLight, kind) == 64);
 static_assert(sizeof(GpuEmissionCluster) == 48);
 static_assert(sizeof(GpuEnvironment) == 32);
 static_assert(offsetof(GpuEnvironment, size) == 16);

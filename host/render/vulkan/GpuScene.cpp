@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "color/Blackbody.h"
+#include "light/AnalyticLights.h"
 #include "util/Error.h"
 #include "volume/MajorantGrid.h"
 
@@ -176,4 +177,43 @@ gpu::FrameConstants build_frame_constants(const Scene& scene, const RenderSettin
   return f;
 }
 
+}  // namespace pyrolume
+
+namespace pyrolume {
+std::vector<gpu::GpuLight> pack_gpu_lights(const Scene& scene, const LightSelection& selection) {
+  std::vector<gpu::GpuLight> out;
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& l = scene.lights[i];
+    gpu::GpuLight g{};
+    const glm::dvec3 value = l.type == Light::Type::Distant && !l.is_delta() ? disc_radiance(l) : light_value(l);
+    g.value = glm::vec4(glm::vec3(value), float(i < selection.p_light.size() ? selection.p_light[i] : 0.0));
+    g.direction = glm::vec4(glm::vec3(l.direction), 0.0f);
+    switch (l.type) {
+      case Light::Type::Point:
+        g.kind.x = gpu::LIGHT_POINT;
+        g.position = glm::vec4(glm::vec3(l.position), 0.0f);
+        break;
+      case Light::Type::Spot: {
+        g.kind.x = gpu::LIGHT_SPOT;
+        g.position = glm::vec4(glm::vec3(l.position), 0.0f);
+        const SpotCone c = spot_cone(l);
+        g.cone = glm::vec4(float(c.cos_end), float(c.cos_start), 0.0f, 0.0f);
+        break;
+      }
+      case Light::Type::Distant: {
+        g.kind.x = l.is_delta() ? gpu::LIGHT_DISTANT : gpu::LIGHT_DISC;
+        const double s = std::sin(disc_half_angle(l));
+        g.cone = glm::vec4(0.0f, 0.0f, float(disc_one_minus_cos(l)), float(s * s));
+        break;
+      }
+      case Light::Type::Sphere:
+        g.kind.x = gpu::LIGHT_SPHERE;
+        g.position = glm::vec4(glm::vec3(l.center), float(l.radius));
+        break;
+    }
+    out.push_back(g);
+  }
+  if (out.empty()) out.push_back(gpu::GpuLight{});
+  return out;
+}
 }  // namespace pyrolume

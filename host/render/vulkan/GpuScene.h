@@ -6,9 +6,11 @@
 #include <vector>
 
 #include "color/BlackbodyLut.h"
+#include "light/LightSelection.h"
 #include "render/Render.h"
 #include "scene/Scene.h"
 #include "shared/gpu_types.h"
+#include "shared/light_types.h"
 #include "volume/StoredVolume.h"
 
 namespace pyrolume {
@@ -60,4 +62,11 @@ GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<Sto
                          uint64_t max_texture_bytes = std::numeric_limits<uint64_t>::max());
 gpu::FrameConstants build_frame_constants(const Scene& scene, const RenderSettings& settings, uint32_t medium_count);
 
+}  // namespace pyrolume
+
+namespace pyrolume {
+// The scene's analytic lights as GpuLight (docs/lights.md "Analytic lights"),
+// with light selection's probabilities; one zero placeholder when there are
+// none (a storage buffer cannot be empty).
+std::vector<gpu::GpuLight> pack_gpu_lights(const Scene& scene, const LightSelection& selection);
 }  // namespace pyrolume

@@ -108,6 +108,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                         {gpu::BINDING_EMISSION_PMF, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_EMISSION_CLUSTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_EMISSION_HEADERS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+                        {gpu::BINDING_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_PASS_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_PATHS, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER},
                         {gpu::BINDING_QUEUES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
@@ -178,6 +179,7 @@ std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const S
           {gpu::SPEC_SURFACE_SHAPE_COUNT, gpu_surfaces_.shape_count},
           {gpu::SPEC_SURFACE_HAS_TRIANGLES, flag(gpu_surfaces_.triangle_count > 0)},
           {gpu::SPEC_HAS_ENVIRONMENT, flag(scene.environment.has_value())},
+          {gpu::SPEC_LIGHT_COUNT, uint32_t(scene.lights.size())},
           {gpu::SPEC_LIGHT_STRATEGY, lights.strategy == LightStrategy::Mis         ? gpu::LIGHT_STRATEGY_MIS
                                      : lights.strategy == LightStrategy::LightOnly ? gpu::LIGHT_STRATEGY_LIGHT_ONLY
                                                                                    : gpu::LIGHT_STRATEGY_BSDF},
@@ -201,6 +203,7 @@ void RenderSession::write_grid_descriptors() {
   set_->write_buffer(gpu::BINDING_EMISSION_PMF, emission_pmf_);
   set_->write_buffer(gpu::BINDING_EMISSION_CLUSTERS, emission_clusters_);
   set_->write_buffer(gpu::BINDING_EMISSION_HEADERS, emission_headers_);
+  set_->write_buffer(gpu::BINDING_LIGHTS, analytic_lights_);
   // textures_3d_[0] / textures_1d_[0] are 1-texel placeholders for unused slots.
   for (uint32_t slot = 0; slot < gpu::MAX_GRIDS; ++slot) {
     const bool used = slot < gpu_scene_.grid_sources.size();
@@ -421,6 +424,7 @@ RenderSession::EmissionLights RenderSession::build_emission_lights(
       if (!cdfs[src.medium]->empty()) by_medium[src.medium] = &*cdfs[src.medium];
     }
   out.selection = select_lights(scene, environment_ ? &*environment_ : nullptr, by_medium);
+  out.analytic = pack_gpu_lights(scene, out.selection);
   if (out.selection.strategy == LightStrategy::Bsdf) return out;
   for (size_t slot = 0; slot < g.grid_sources.size(); ++slot) {
     const size_t i = g.grid_sources[slot].medium;
@@ -444,6 +448,7 @@ void RenderSession::upload_emission_lights(const EmissionLights& lights) {
   emission_cells_ = storage_buffer(ctx_, lights.cells, "emission cells");
   emission_pmf_ = storage_buffer(ctx_, lights.pmf, "emission pmf");
   emission_clusters_ = storage_buffer(ctx_, lights.clusters, "emission clusters");
+  analytic_lights_ = storage_buffer(ctx_, lights.analytic, "analytic lights");
   emission_headers_.upload(ctx_, lights.headers.data(), lights.headers.size() * sizeof(gpu::GpuEmissionCdf));
 }
 
@@ -510,7 +515,12 @@ void RenderSession::record_band(VkCommandBuffer cmd, int spp, int row_begin, int
 void RenderSession::create_wavefront(const std::vector<uint32_t>& code) {
   const char* env = std::getenv("PYROLUME_WAVEFRONT");
   const std::string mode = env ? env : "";
-  const bool on = (mode == "1" || mode == "2") && settings_.debug_mode == 0;
+  // Not with analytic lights: the wavefront's path state does not carry a
+  // delta light ray's target (PathState::delta_light).
+  bool has_lights = false;
+  for (const auto& [id, value] : spec_)
+    if (id == gpu::SPEC_LIGHT_COUNT) has_lights = value > 0;
+  const bool on = (mode == "1" || mode == "2") && settings_.debug_mode == 0 && !has_lights;
   wavefront_split_ = on && mode == "2";
   const size_t slots = on ? size_t(settings_.width) * size_t(settings_.height) : 1;
   const size_t words = gpu::WAVEFRONT_PATH_WORDS + gpu::WAVEFRONT_PATH_WORDS_PER_MEDIUM *

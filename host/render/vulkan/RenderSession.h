@@ -103,6 +103,7 @@ class RenderSession {
     std::vector<uint32_t> cells;
     std::vector<gpu::GpuEmissionCluster> clusters;
     std::vector<gpu::GpuEmissionCdf> headers;  // per grid slot (MAX_GRIDS)
+    std::vector<gpu::GpuLight> analytic;       // the scene's `lights` (one placeholder when none)
   };
   EmissionLights build_emission_lights(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes,
                                        const GpuScene& gpu_scene) const;
@@ -129,6 +130,7 @@ class RenderSession {
   std::optional<EnvironmentMap> environment_;
   // The emissive grids as lights: CDF entries, their cells, per-cell pmf, headers.
   vk::Buffer emission_cdf_, emission_cells_, emission_pmf_, emission_clusters_, emission_headers_;
+  vk::Buffer analytic_lights_;
   LightSelection light_selection_;
   std::optional<vk::ComputePipeline> pipeline_;
   std::optional<vk::DescriptorSet> set_;
