@@ -191,5 +191,49 @@ TEST_F(VulkanLights, SphereLightIrradianceIsPiLTimesRadiusOverDistanceSquared) {
   expect_closed_form(r, exact, "sphere light");
 }
 
+// The part of the segment o + t·d, t in [0, t_max], inside a sphere.
+double segment_chord(glm::dvec3 c, double radius, glm::dvec3 o, glm::dvec3 d, double t_max) {
+  const glm::dvec3 oc = o - c;
+  const double b = glm::dot(oc, d), q = glm::dot(oc, oc) - radius * radius, disc = b * b - q;
+  if (disc <= 0) return 0.0;
+  const double t0 = std::max(0.0, -b - std::sqrt(disc)), t1 = std::min(t_max, -b + std::sqrt(disc));
+  return std::max(0.0, t1 - t0);
+}
+
+// Light rays toward delta lights are ratio-tracked through the media: a
+// point light and a delta sun seen through an absorbing sphere give
+// ρ/π · E · e^(−σa·chord) on the plane (the camera ray's own chord too).
+TEST_F(VulkanLights, DeltaLightRaysAreAttenuatedByTheMedia) {
+  const glm::dvec3 c(0.2, 0.7, 0.6);
+  const double radius = 0.45, sigma = 1.5;
+  for (bool sun : {false, true}) {
+    Scene s = lit_plane_scene(256);
+    s.media.push_back(test::homogeneous_sphere("absorber", c, radius, glm::dvec3(sigma), glm::dvec3(0.0), 0.0,
+                                               std::nullopt));
+    const glm::dvec3 pos(0.3, 1.6, 0.5), toward = glm::normalize(glm::dvec3(-0.3, 1.0, 0.2));
+    s.lights.push_back(sun ? distant_light(toward, 2.0, 0.0) : point_light(pos, 4.0));
+    const RenderResult r = render(s);
+    auto exact = test::exact_image(s.film.width, s.film.height, [&](double fx, double fy, int* sig) {
+      const glm::dvec3 o = s.camera.position, d = test::film_ray(s.camera, s.film.width, s.film.height, fx, fy);
+      *sig = 0;
+      if (!(d.y < 0)) return glm::dvec3(0.0);
+      const double t = -o.y / d.y;
+      const glm::dvec3 p = o + t * d;
+      const double seen = std::exp(-sigma * segment_chord(c, radius, o, d, t));
+      if (sun) {
+        const double chord = segment_chord(c, radius, p, toward, 1e9);
+        *sig = chord > 0 ? 1 : 0;
+        return glm::dvec3(1.0, 1.0, 0.9) * (seen * kAlbedo / kPi * 2.0 * toward.y * std::exp(-sigma * chord));
+      }
+      const glm::dvec3 v = pos - p;
+      const double chord = segment_chord(c, radius, p, glm::normalize(v), glm::length(v));
+      *sig = chord > 0 ? 1 : 0;
+      return glm::dvec3(1.0, 0.8, 0.6) *
+             (seen * kAlbedo / kPi * point_irradiance(p, pos, 4.0) * std::exp(-sigma * chord));
+    }, 16);
+    expect_closed_form(r, exact, sun ? "delta sun through an absorbing sphere" : "point light through an absorbing sphere");
+  }
+}
+
 }  // namespace
 }  // namespace pyrolume
