@@ -17,8 +17,10 @@
 
 #include <gtest/gtest.h>
 
+#include "render/cpu/CpuRenderer.h"
 #include "scene/Scene.h"
 #include "support/AnalyticScenes.h"
+#include "support/MisScenes.h"
 #include "support/Stats.h"
 #include "support/SurfaceScenes.h"
 #include "support/VulkanFixture.h"
@@ -76,12 +78,6 @@ ZTestOptions pooled() {
 
 class VulkanLights : public test::VulkanFixture {
  protected:
-  RenderResult render(const Scene& s) {
-    RenderResult r = backend_->render(s, test::settings_for(s), {});
-    EXPECT_EQ(r.spp, s.film.spp);
-    EXPECT_EQ(r.nonfinite_samples, 0u);
-    return r;
-  }
   // Accepts `exact` and rejects it scaled by 1.1.
   void expect_closed_form(const RenderResult& r, const std::function<glm::dvec3(int, int)>& exact, const char* what) {
     const ZTestReport ok = test::ztest_against_exact(r, exact, pooled());
@@ -233,6 +229,38 @@ TEST_F(VulkanLights, DeltaLightRaysAreAttenuatedByTheMedia) {
     }, 16);
     expect_closed_form(r, exact, sun ? "delta sun through an absorbing sphere" : "point light through an absorbing sphere");
   }
+}
+
+// Every kind of light at once, with a scattering fire over the plane and a
+// sky: light selection over both groups (the sky and the disc sun; the fire,
+// the point, spot and sphere lights), MIS of the fire, the sky, the disc and
+// the sphere, delta light rays through the fire. GPU against the
+// independently written CPU reference.
+TEST_F(VulkanLights, EveryKindOfLightWithFireAndSkyMatchesCpu) {
+  const auto dir = test::temp_dir("vk_lights_fire");
+  Scene s = test::fire_over_plane_scene(dir, test::Strategy::Mis, true, true, 24, 18, 512);
+  s.lights.push_back(distant_light({-0.5, 1.0, -0.4}, 1.5, 5.0));
+  s.lights.push_back(point_light({0.8, 0.6, -0.2}, 0.6));
+  Light spot = point_light({-0.6, 1.2, 0.3}, 2.0);
+  spot.type = Light::Type::Spot;
+  spot.direction = glm::normalize(glm::dvec3(0.3, -1.0, -0.2));
+  spot.cone_deg = 40.0;
+  spot.falloff_deg = 10.0;
+  s.lights.push_back(spot);
+  Light ball;
+  ball.type = Light::Type::Sphere;
+  ball.center = {0.6, 0.0, 0.5};
+  ball.radius = 0.15;
+  ball.temperature_k = 3000.0;
+  ball.scale = 4.0;
+  s.lights.push_back(ball);
+  RenderResult gpu = render(s);
+  test::expect_strategy_as_written(s, gpu);
+  Scene c = s;
+  CpuRenderer cpu(0);
+  RenderResult ref = cpu.render(c, test::settings_for(c), {});
+  EXPECT_EQ(cpu.majorant_violations(), 0u);
+  test::expect_same_image(gpu, ref, 0.02, "GPU vs CPU, every kind of light with a fire and a sky");
 }
 
 }  // namespace

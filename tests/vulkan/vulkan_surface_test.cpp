@@ -65,13 +65,6 @@ constexpr double kFloatTol = 2e-6;
 
 class VulkanSurface : public test::VulkanFixture {
  protected:
-
-  RenderResult render(const Scene& s) {
-    RenderResult r = backend_->render(s, test::settings_for(s), {});
-    EXPECT_EQ(r.spp, s.film.spp);
-    EXPECT_EQ(r.nonfinite_samples, 0u);
-    return r;
-  }
   static RenderResult render_cpu(const Scene& s) {
     CpuRenderer cpu;
     RenderResult r = cpu.render(s, test::settings_for(s), {});

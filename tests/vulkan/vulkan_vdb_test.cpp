@@ -51,14 +51,6 @@ const char* kEstimators[] = {"absorption", "collision"};
 class VulkanVdb : public test::VulkanFixture, public test::ConstantBoxSetup {
  protected:
 
-  RenderResult render(const Scene& s) {
-    RenderResult r = backend_->render(s, settings_for(s), {});
-    EXPECT_EQ(r.spp, s.film.spp);
-    EXPECT_EQ(r.nonfinite_samples, 0u) << "non-finite samples";
-    for (double v : r.sum) EXPECT_TRUE(std::isfinite(v)) << "non-finite pixel sum";
-    return r;
-  }
-
 
   VulkanVdb() : test::ConstantBoxSetup("vulkan_vdb") {}
 
