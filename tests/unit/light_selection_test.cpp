@@ -4,6 +4,8 @@
 // it holds (surfaces, scattering media, an environment map, emissive grids),
 // the integrator keys a scene file may not combine, and that the automatic
 // choice on a fire alone renders today's image, sample for sample.
+#include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -280,6 +282,212 @@ TEST_F(LightResolution, FireAloneRendersAsBefore) {
   const RenderResult rc = cpu.render(collision, test::settings_for(collision), {});
   EXPECT_EQ(rc.emission_estimator, "collision");
   EXPECT_NE(rc.sum, ra.sum);
+}
+
+// ------------------------------------------------------ analytic lights ----
+// docs/lights.md "Choosing a light": the lights at infinity (the environment,
+// distant lights) and the lights in the scene (emissive grids, point, spot and
+// sphere lights) get 1/2 each when both have a light (1 when alone), by power
+// within; the powers are computed here from their definitions.
+
+double luminance(glm::dvec3 c) { return 0.2126729 * c.r + 0.7151522 * c.g + 0.0721750 * c.b; }
+constexpr double kPi = 3.14159265358979323846;
+
+Light point_light(glm::dvec3 intensity) {
+  Light l;
+  l.type = Light::Type::Point;
+  l.position = {0, 1, 0};
+  l.rgb = intensity;
+  return l;
+}
+
+Light distant_light(glm::dvec3 irradiance, double angle_deg) {
+  Light l;
+  l.type = Light::Type::Distant;
+  l.direction = {0, 1, 0};
+  l.rgb = irradiance;
+  l.angle_deg = angle_deg;
+  return l;
+}
+
+Light spot_light(glm::dvec3 intensity, double cone_deg, double falloff_deg) {
+  Light l = point_light(intensity);
+  l.type = Light::Type::Spot;
+  l.direction = {0, -1, 0};
+  l.cone_deg = cone_deg;
+  l.falloff_deg = falloff_deg;
+  return l;
+}
+
+Light sphere_light(glm::dvec3 radiance, double radius) {
+  Light l;
+  l.type = Light::Type::Sphere;
+  l.center = {0, 1, 0};
+  l.radius = radius;
+  l.rgb = radiance;
+  return l;
+}
+
+class LightSelectionLights : public LightResolution {
+ protected:
+  // The fire over a plane (surfaces: every kind of light is sampled), with
+  // "mis" left out; its sky, emission CDF and light selection built as the
+  // backends build them.
+  Scene plane(bool sky) {
+    Scene s = fire_over_plane();
+    if (sky) s.environment = Environment{test::write_uniform_sky(dir, glm::vec3(0.2f, 0.3f, 0.4f)), 1.0, 0.0};
+    return s;
+  }
+  double sky_power(const Scene& s) { return EnvironmentMap::load(s.environment->file).power(); }
+  double fire_power(const Scene& s) {
+    return 4.0 * kPi * EmissionCdf::build_light(s.media[0], load_stored_volume(s.media[0])).power();
+  }
+  // The selection without the fire as a light (no emission CDF given).
+  LightSelection without_fire(const Scene& s) {
+    std::optional<EnvironmentMap> env;
+    if (s.environment) env = EnvironmentMap::load(s.environment->file);
+    return select_lights(s, env ? &*env : nullptr, {nullptr});
+  }
+};
+
+void expect_rel(double a, double b, const char* what) { EXPECT_NEAR(a, b, 1e-12 * std::abs(b)) << what; }
+
+// No lights array: the environment against the grids as before, 1/2 each,
+// each alone 1; no per-light probabilities.
+TEST_F(LightSelectionLights, WithoutLightsUnchanged) {
+  Scene s = plane(true);
+  s.integrator.mis = true;
+  LightSelection l = resolve(s);
+  EXPECT_TRUE(l.p_light.empty());
+  EXPECT_DOUBLE_EQ(l.p_env, 0.5);
+  EXPECT_DOUBLE_EQ(l.p_medium[0], 0.5);
+  EXPECT_DOUBLE_EQ(without_fire(s).p_env, 1.0);
+  EXPECT_DOUBLE_EQ(resolve(plane(false)).p_medium[0], 1.0);
+  EXPECT_EQ(l.strategy, LightStrategy::Mis);
+}
+
+// A sky and a sun are both at infinity: by power, ∫Y(L) dω against Y(E).
+TEST_F(LightSelectionLights, SkyAndSunByPower) {
+  Scene s = plane(true);
+  s.lights.push_back(distant_light({3, 2, 1}, 0.53));
+  const LightSelection l = without_fire(s);
+  const double sky = sky_power(s), sun = luminance({3, 2, 1});
+  expect_rel(l.p_env, sky / (sky + sun), "sky");
+  expect_rel(l.p_light[0], sun / (sky + sun), "sun");
+  EXPECT_EQ(l.strategy, LightStrategy::Mis);
+  // A delta sun the same way.
+  s.lights[0].angle_deg = 0.0;
+  expect_rel(without_fire(s).p_light[0], sun / (sky + sun), "delta sun");
+}
+
+// A fire and a point light are both in the scene: by power in watts,
+// 4π ∫Y(σa Le) dV against 4π Y(I); a sky beside them takes the other half.
+TEST_F(LightSelectionLights, FireAndPointLightByPower) {
+  Scene s = plane(false);
+  s.lights.push_back(point_light({5, 4, 3}));
+  const double fire = fire_power(s), point = 4.0 * kPi * luminance({5, 4, 3});
+  LightSelection l = resolve(s);
+  expect_rel(l.p_medium[0], fire / (fire + point), "fire");
+  expect_rel(l.p_light[0], point / (fire + point), "point");
+  // The point light and a sky: 1/2 each.
+  Scene t = plane(true);
+  t.lights.push_back(point_light({5, 4, 3}));
+  l = without_fire(t);
+  EXPECT_DOUBLE_EQ(l.p_env, 0.5);
+  EXPECT_DOUBLE_EQ(l.p_light[0], 0.5);
+  // A point light alone: 1.
+  EXPECT_DOUBLE_EQ(without_fire(s).p_light[0], 1.0);
+}
+
+// Every kind at once: the sky, a delta and a disc sun share one half by
+// power; the fire, a point, a spot (2π Y(I)(1 − (cos θ_start + cos θ_end)/2))
+// and a sphere (π Y(L) · 4πr²) the other.
+TEST_F(LightSelectionLights, EveryKind) {
+  Scene s = plane(true);
+  s.lights = {distant_light({1, 1, 1}, 0.0), point_light({2, 1, 0.5}), distant_light({0.5, 2, 1}, 5.0),
+              spot_light({4, 4, 4}, 40.0, 15.0), sphere_light({3, 1, 2}, 0.3)};
+  const LightSelection l = resolve(s);
+  const double far[] = {sky_power(s), luminance({1, 1, 1}), luminance({0.5, 2, 1})};
+  const double c_end = std::cos(40.0 * kPi / 180.0), c_start = std::cos(25.0 * kPi / 180.0);
+  const double near[] = {fire_power(s), 4.0 * kPi * luminance({2, 1, 0.5}),
+                         2.0 * kPi * luminance({4, 4, 4}) * (1.0 - 0.5 * (c_start + c_end)),
+                         kPi * luminance({3, 1, 2}) * 4.0 * kPi * 0.3 * 0.3};
+  const double far_sum = far[0] + far[1] + far[2], near_sum = near[0] + near[1] + near[2] + near[3];
+  expect_rel(l.p_env, 0.5 * far[0] / far_sum, "sky");
+  expect_rel(l.p_light[0], 0.5 * far[1] / far_sum, "delta sun");
+  expect_rel(l.p_light[2], 0.5 * far[2] / far_sum, "disc sun");
+  expect_rel(l.p_medium[0], 0.5 * near[0] / near_sum, "fire");
+  expect_rel(l.p_light[1], 0.5 * near[1] / near_sum, "point");
+  expect_rel(l.p_light[3], 0.5 * near[2] / near_sum, "spot");
+  expect_rel(l.p_light[4], 0.5 * near[3] / near_sum, "sphere");
+  double sum = l.p_env + l.p_medium[0];
+  for (double p : l.p_light) sum += p;
+  EXPECT_NEAR(sum, 1.0, 1e-12);
+}
+
+// A light of zero power is never picked, and a group that holds only such
+// lights gets nothing: the other group takes all.
+TEST_F(LightSelectionLights, ZeroPowerLights) {
+  Scene s = plane(true);
+  s.lights = {point_light({0, 0, 0}), distant_light({1, 1, 1}, 0.0)};
+  s.lights[1].scale = 0.0;
+  const LightSelection l = without_fire(s);
+  EXPECT_DOUBLE_EQ(l.p_env, 1.0);
+  EXPECT_DOUBLE_EQ(l.p_light[0], 0.0);
+  EXPECT_DOUBLE_EQ(l.p_light[1], 0.0);
+}
+
+// temperature_k: the value's luminance is `scale` (docs/lights.md).
+TEST_F(LightSelectionLights, TemperatureLightHasLuminanceScale) {
+  Scene s = plane(false);
+  Light a = point_light({1, 1, 1}), b;
+  a.scale = 3.0;
+  b.type = Light::Type::Point;
+  b.temperature_k = 2700.0;
+  b.scale = 1.0;
+  s.lights = {a, b};
+  const LightSelection l = without_fire(s);
+  // 4π·3·Y(1, 1, 1) = 4π·3 against 4π·1.
+  EXPECT_NEAR(l.p_light[0], 0.75, 1e-6);
+  EXPECT_NEAR(l.p_light[1], 0.25, 1e-6);
+}
+
+// Lights with nothing to light (no surface, nothing scatters) or max_depth 0
+// are not sampled: BSDF sampling only (camera rays still see spheres and discs).
+TEST_F(LightSelectionLights, NothingToLight) {
+  Scene s = fire_alone();
+  s.media[0].sigma_s = glm::dvec3(0.0);
+  s.lights = {point_light({1, 1, 1}), sphere_light({1, 1, 1}, 0.5)};
+  LightSelection l = resolve(s);
+  EXPECT_EQ(l.strategy, LightStrategy::Bsdf);
+  EXPECT_EQ(l.estimator, EmissionEstimator::Absorption);
+  EXPECT_DOUBLE_EQ(l.p_light[0], 0.0);
+  EXPECT_DOUBLE_EQ(l.p_light[1], 0.0);
+  Scene t = plane(false);
+  t.lights = s.lights;
+  t.integrator.max_depth = 0;
+  l = resolve(t);
+  EXPECT_EQ(l.strategy, LightStrategy::Bsdf);
+  EXPECT_DOUBLE_EQ(l.p_light[0], 0.0);
+  // A smoke that scatters is something to light.
+  Scene u = fire_alone();
+  u.lights = s.lights;
+  l = without_fire(u);
+  EXPECT_EQ(l.strategy, LightStrategy::Mis);
+  EXPECT_GT(l.p_light[0], 0.0);
+}
+
+// "mis": false and the absorption estimator contradict lights: refused.
+TEST_F(LightSelectionLights, ContradictionsWithLights) {
+  Scene s = plane(false);
+  s.lights = {point_light({1, 1, 1})};
+  s.integrator.mis = false;
+  EXPECT_THROW(resolve(s), std::invalid_argument);
+  s.integrator.mis.reset();
+  s.integrator.emission_estimator = "absorption";
+  EXPECT_THROW(resolve(s), std::invalid_argument);
+  s.integrator.emission_estimator = "collision";
+  EXPECT_EQ(resolve(s).strategy, LightStrategy::Mis);
 }
 
 }  // namespace

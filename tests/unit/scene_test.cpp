@@ -201,7 +201,58 @@ INSTANTIATE_TEST_SUITE_P(
                 R"({"media": [{}, {"type": "homogeneous", "g": 0.1, "g": 0.2}]})", "bad.json: media[1].g: duplicate key"},
         BadCase{"duplicate key nested in arrays",
                 R"({"camera": {"position": {"keys": [[0, [0, 0, 1]]], "keys": []}}})",
-                "bad.json: camera.position.keys: duplicate key"}),
+                "bad.json: camera.position.keys: duplicate key"},
+        // The lights array (docs/scene-format.md "lights").
+        BadCase{"lights not an array", R"({"lights": {}})", "lights: expected an array"},
+        BadCase{"light type", R"({"lights": [{"type": "area", "radiance": [1, 1, 1]}]})",
+                "lights[0].type: must be one of"},
+        BadCase{"light without type", R"({"lights": [{"intensity": [1, 1, 1], "position": [0, 0, 0]}]})",
+                "lights[0].type: missing"},
+        BadCase{"negative intensity",
+                R"({"lights": [{"type": "point", "position": [0, 1, 0], "intensity": [1, -1, 1]}]})",
+                "lights[0].intensity: must be >= 0"},
+        BadCase{"negative irradiance",
+                R"({"lights": [{"type": "distant", "direction": [0, 1, 0], "irradiance": [-1, 1, 1]}]})",
+                "lights[0].irradiance: must be >= 0"},
+        BadCase{"negative light scale",
+                R"({"lights": [{"type": "point", "position": [0, 1, 0], "intensity": [1, 1, 1], "scale": -2}]})",
+                "lights[0].scale: must be >= 0"},
+        BadCase{"zero distant direction",
+                R"({"lights": [{"type": "distant", "direction": [0, 0, 0], "irradiance": [1, 1, 1]}]})",
+                "lights[0].direction: must not be zero"},
+        BadCase{"zero spot direction",
+                R"({"lights": [{"type": "point", "position": [0, 1, 0], "intensity": [1, 1, 1]},
+                               {"type": "spot", "position": [0, 1, 0], "direction": [0, 0, 0], "intensity": [1, 1, 1]}]})",
+                "lights[1].direction: must not be zero"},
+        BadCase{"cone below falloff",
+                R"({"lights": [{"type": "spot", "position": [0, 1, 0], "direction": [0, -1, 0], "intensity": [1, 1, 1],
+                                "cone_deg": 20, "falloff_deg": 30}]})",
+                "lights[0].cone_deg: must be >= falloff_deg"},
+        BadCase{"sphere radius zero",
+                R"({"lights": [{"type": "sphere", "center": [0, 1, 0], "radius": 0, "radiance": [1, 1, 1]}]})",
+                "lights[0].radius: must be > 0"},
+        BadCase{"sphere radius negative",
+                R"({"lights": [{"type": "sphere", "center": [0, 1, 0], "radius": -0.5, "radiance": [1, 1, 1]}]})",
+                "lights[0].radius: must be > 0"},
+        BadCase{"sphere without radius",
+                R"({"lights": [{"type": "sphere", "center": [0, 1, 0], "radiance": [1, 1, 1]}]})",
+                "lights[0].radius: missing"},
+        BadCase{"both value and temperature",
+                R"({"lights": [{"type": "point", "position": [0, 1, 0], "intensity": [1, 1, 1], "temperature_k": 3000}]})",
+                "lights[0].intensity: give either"},
+        BadCase{"neither value nor temperature", R"({"lights": [{"type": "point", "position": [0, 1, 0]}]})",
+                "lights[0].intensity: missing"},
+        BadCase{"value key of another type",
+                R"({"lights": [{"type": "point", "position": [0, 1, 0], "intensity": [1, 1, 1], "radiance": [1, 1, 1]}]})",
+                "lights[0].radiance: unknown key"},
+        BadCase{"mis false with lights",
+                R"({"integrator": {"mis": false},
+                    "lights": [{"type": "point", "position": [0, 1, 0], "intensity": [1, 1, 1]}]})",
+                "integrator.mis: false turns off light sampling"},
+        BadCase{"absorption with lights",
+                R"({"integrator": {"emission_estimator": "absorption"},
+                    "lights": [{"type": "distant", "direction": [0, 1, 0], "irradiance": [1, 1, 1]}]})",
+                "integrator.emission_estimator: \"absorption\" turns off light sampling"}),
     [](const ::testing::TestParamInfo<BadCase>& info) {
       std::string n = info.param.label;
       for (auto& ch : n)
@@ -225,4 +276,42 @@ TEST(Scene, RatioTrackedContinuation) {
   EXPECT_FALSE(parse_scene("{}", "a.json").integrator.ratio_tracked_continuation);
   EXPECT_TRUE(parse_scene(R"({"integrator": {"ratio_tracked_continuation": true}})", "a.json")
                   .integrator.ratio_tracked_continuation);
+}
+
+// A lights array: each type's keys and defaults; directions are normalised;
+// an empty array is no lights (and "mis": false is then fine).
+TEST(Scene, Lights) {
+  const Scene s = parse_scene(R"({"lights": [
+    {"type": "distant", "direction": [0, 2, 0], "irradiance": [40, 38, 34], "angle_deg": 0.53},
+    {"type": "point", "position": [0, 3, 0], "intensity": [10, 10, 10]},
+    {"type": "spot", "position": [0, 3, 0], "direction": [0, -3, 0], "temperature_k": 3200, "scale": 50,
+     "cone_deg": 30, "falloff_deg": 10},
+    {"type": "spot", "position": [1, 3, 0], "direction": [0, -1, 0], "intensity": [1, 2, 3]},
+    {"type": "sphere", "center": [2, 1, 0], "radius": 0.25, "radiance": [5, 5, 5]}]})", "l.json");
+  ASSERT_EQ(s.lights.size(), 5u);
+  EXPECT_EQ(s.lights[0].type, Light::Type::Distant);
+  EXPECT_EQ(s.lights[0].direction, glm::dvec3(0, 1, 0));
+  EXPECT_DOUBLE_EQ(s.lights[0].angle_deg, 0.53);
+  EXPECT_EQ(*s.lights[0].rgb, glm::dvec3(40, 38, 34));
+  EXPECT_FALSE(s.lights[0].is_delta());
+  EXPECT_EQ(s.lights[1].type, Light::Type::Point);
+  EXPECT_EQ(s.lights[1].position, glm::dvec3(0, 3, 0));
+  EXPECT_TRUE(s.lights[1].is_delta());
+  EXPECT_EQ(s.lights[2].type, Light::Type::Spot);
+  EXPECT_EQ(s.lights[2].direction, glm::dvec3(0, -1, 0));
+  EXPECT_FALSE(s.lights[2].rgb.has_value());
+  EXPECT_DOUBLE_EQ(*s.lights[2].temperature_k, 3200.0);
+  EXPECT_DOUBLE_EQ(s.lights[2].scale, 50.0);
+  EXPECT_DOUBLE_EQ(s.lights[2].cone_deg, 30.0);
+  EXPECT_DOUBLE_EQ(s.lights[2].falloff_deg, 10.0);
+  EXPECT_DOUBLE_EQ(s.lights[3].cone_deg, 45.0);  // defaults
+  EXPECT_DOUBLE_EQ(s.lights[3].falloff_deg, 0.0);
+  EXPECT_DOUBLE_EQ(s.lights[3].scale, 1.0);
+  EXPECT_EQ(s.lights[4].type, Light::Type::Sphere);
+  EXPECT_EQ(s.lights[4].center, glm::dvec3(2, 1, 0));
+  EXPECT_DOUBLE_EQ(s.lights[4].radius, 0.25);
+  EXPECT_FALSE(s.lights[4].is_delta());
+  EXPECT_TRUE(parse_scene(R"({"lights": [{"type": "distant", "direction": [1, 1, 1], "irradiance": [1, 1, 1]}]})",
+                          "d.json").lights[0].is_delta());  // angle_deg 0
+  EXPECT_TRUE(parse_scene(R"({"integrator": {"mis": false}, "lights": []})", "e.json").lights.empty());
 }

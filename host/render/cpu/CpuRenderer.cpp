@@ -16,11 +16,13 @@
 #include "color/Blackbody.h"
 #include "geometry/SceneSurfaces.h"
 #include "geometry/Surfaces.h"
+#include "light/AnalyticLights.h"
 #include "light/EmissionCdf.h"
 #include "light/EnvironmentMap.h"
 #include "light/LightSelection.h"
 #include "render/Limits.h"
 #include "render/SceneChecks.h"
+#include "render/cpu/Intersect.h"
 #include "render/cpu/Media.h"
 #include "render/cpu/Rng.h"
 #include "render/cpu/Sampling.h"
@@ -72,12 +74,79 @@ struct ThreadCounters {
   }
 };
 
-// What next-event estimation samples (host/light/LightSelection.h).
+// A light of the scene's `lights` array as the walks read it (docs/lights.md
+// "Analytic lights"), its values computed once.
+struct AnalyticLight {
+  Light light;                  // type, direction (unit), position, center, radius
+  glm::dvec3 value{0.0};        // light_value: E (distant), I (point, spot) or L (sphere)
+  glm::dvec3 disc_L{0.0};       // a disc sun's radiance
+  double disc_omc = 0.0;        // a disc sun's 1 − cos θ (0: a delta light)
+  SpotCone cone;                // a spot's soft edge
+  bool is_disc() const { return light.type == Light::Type::Distant && disc_omc > 0.0; }
+  bool is_sphere() const { return light.type == Light::Type::Sphere; }
+};
+
+// What next-event estimation samples (host/light/LightSelection.h), and the
+// analytic lights, which rays also meet (discs on escape, spheres on the way)
+// whether they are sampled or not.
 struct WalkLights {
   LightSelection selection;
   std::vector<const EmissionCdf*> cdf;  // per scene medium; null: not a light
+  std::vector<AnalyticLight> analytic;  // per entry of Scene::lights (selection.p_light)
   bool active() const { return selection.strategy != LightStrategy::Bsdf; }
 };
+
+// Whether unit w lies in the cone of 1 − cos θ = omc around unit axis:
+// |w − axis|² = 2(1 − cos α), which keeps the sun's 1e-5 (no 1 − cos).
+bool in_cone(const glm::dvec3& w, const glm::dvec3& axis, double omc) {
+  const glm::dvec3 e = w - axis;
+  return glm::dot(e, e) <= 2.0 * omc;
+}
+
+// A direction uniform in that cone, solid-angle pdf 1/(2π omc):
+// 1 − cos α = u₁ omc (docs/lights.md "Sampling").
+glm::dvec3 sample_cone(const glm::dvec3& axis, double omc, double u1, double u2) {
+  const double x = u1 * omc;  // 1 − cos α
+  const double cos_a = 1.0 - x, sin_a = std::sqrt(std::max(0.0, x * (2.0 - x)));
+  const double phi = 2.0 * std::numbers::pi * u2;
+  glm::dvec3 t, b;
+  orthonormal_basis(axis, t, b);
+  return glm::normalize(sin_a * std::cos(phi) * t + sin_a * std::sin(phi) * b + cos_a * axis);
+}
+
+// The cone a sphere light subtends from o: its axis and 1 − cos θ_max =
+// (r²/d²)/(1 + √(1 − r²/d²)) (docs/lights.md "Sampling"); 0 from inside.
+double sphere_cone(const AnalyticLight& l, const glm::dvec3& o, glm::dvec3& axis) {
+  const glm::dvec3 v = l.light.center - o;
+  const double d2 = glm::dot(v, v), s2 = l.light.radius * l.light.radius / d2;
+  if (!(s2 < 1.0)) return 0.0;
+  axis = v / std::sqrt(d2);
+  return s2 / (1.0 + std::sqrt(1.0 - s2));
+}
+
+// The closest sphere light along a ray with 0 < t < t_max. From inside a
+// sphere the ray ends at its far side with nothing: it emits outward only.
+struct SphereLightHit {
+  int light = -1;  // index into WalkLights::analytic; −1: none
+  double t = 0.0;
+  bool outside = false;
+};
+SphereLightHit intersect_sphere_lights(const WalkLights& lights, const glm::dvec3& o, const glm::dvec3& d,
+                                       double t_max) {
+  SphereLightHit best;
+  for (size_t j = 0; j < lights.analytic.size(); ++j) {
+    const AnalyticLight& l = lights.analytic[j];
+    if (!l.is_sphere()) continue;
+    const RayInterval r = intersect_sphere(o, d, l.light.center, l.light.radius);
+    if (!r.hit) continue;
+    const bool outside = r.t0 > 0.0;
+    const double t = outside ? r.t0 : r.t1;
+    if (!(t > 0.0 && t < t_max)) continue;
+    best = {int(j), t, outside};
+    t_max = t;
+  }
+  return best;
+}
 
 // What every walk reads: the media, the surfaces, what escaping rays see, the
 // lights and the integrator's settings.
@@ -91,9 +160,13 @@ struct WalkScene {
   const WalkLights& lights;
 
   // Radiance of channel c seen by a ray escaping along d (camera and scattered
-  // rays alike): the environment map replaces background.rgb (DESIGN.md).
+  // rays alike): the environment map replaces background.rgb (DESIGN.md);
+  // each disc sun whose cone holds d adds its radiance (docs/lights.md).
   double escaped(const glm::dvec3& d, int c) const {
-    return environment ? environment->radiance(d)[c] : background[c];
+    double L = environment ? environment->radiance(d)[c] : background[c];
+    for (const AnalyticLight& l : lights.analytic)
+      if (l.is_disc() && in_cone(d, l.light.direction, l.disc_omc)) L += l.disc_L[c];
+    return L;
   }
 };
 
@@ -150,15 +223,25 @@ double unidirectional_weight(const WalkLights& lights, const RayMis& mis) {
 }
 
 // The solid-angle pdf with which next_event at o picks direction d: the
-// environment map's, and for each emissive grid the pdf of the direction
-// toward a point drawn from its emission CDF (EmissionCdf::direction_pdf),
-// mixed by the light selection probabilities.
+// environment map's, for each emissive grid the pdf of the direction toward a
+// point drawn from its emission CDF (EmissionCdf::direction_pdf), and each
+// disc sun's or sphere light's cone pdf where its cone holds d (docs/lights.md
+// "Sampling"), mixed by the light selection probabilities (docs/mis.md eq. 3).
+// Delta lights have no density here.
 double light_direction_pdf(const WalkScene& ws, const glm::dvec3& o, const glm::dvec3& d) {
   const WalkLights& lights = ws.lights;
   double p = 0.0;
   if (lights.selection.p_env > 0.0) p += lights.selection.p_env * ws.environment->pdf(d);
   for (size_t j = 0; j < lights.cdf.size(); ++j)
     if (lights.selection.p_medium[j] > 0.0) p += lights.selection.p_medium[j] * lights.cdf[j]->direction_pdf(o, d);
+  for (size_t j = 0; j < lights.analytic.size(); ++j) {
+    const double P = lights.selection.p_light[j];
+    const AnalyticLight& l = lights.analytic[j];
+    if (!(P > 0.0)) continue;
+    glm::dvec3 axis = l.light.direction;
+    const double omc = l.is_disc() ? l.disc_omc : l.is_sphere() ? sphere_cone(l, o, axis) : 0.0;
+    if (omc > 0.0 && in_cone(d, axis, omc)) p += P / (2.0 * std::numbers::pi * omc);
+  }
   return p;
 }
 
@@ -174,45 +257,131 @@ enum class WalkRole { Path, LightRay };
 double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
                     Scratch& s, int max_depth, WalkRole role = WalkRole::Path);
 
-// One light direction from vertex o, drawn from the mixture of eq. (3) of
-// docs/mis.md: the environment map's 2D CDF, or a point from an emissive
-// grid's emission CDF and the direction toward it. false: nothing drawn.
-bool light_direction(const WalkScene& ws, const glm::dvec3& o, Pcg32& rng, glm::dvec3& dir) {
+// One light sample: a direction from the mixture of eq. (3) of docs/mis.md,
+// or the direction toward a delta light with what it delivers.
+struct LightPick {
+  glm::dvec3 dir{0.0};
+  int delta = -1;  // a delta light's index in WalkLights::analytic; −1: a direction of eq. (3)
+  double t_max = std::numeric_limits<double>::infinity();  // delta: its distance (∞: a distant light)
+  glm::dvec3 Li{0.0};  // delta: what reaches o without media, I·falloff/r² or E
+};
+
+// One light sample from vertex o: the environment map's 2D CDF, a point from an
+// emissive grid's emission CDF and the direction toward it, a direction in a
+// disc sun's or a sphere light's cone, or a delta light (docs/lights.md
+// "Sampling"), picked with the selection's probabilities in that order.
+// false: nothing drawn.
+bool light_direction(const WalkScene& ws, const glm::dvec3& o, Pcg32& rng, LightPick& pick) {
   const WalkLights& lights = ws.lights;
   double u = rng.uniform();
   const double u_env = rng.uniform(), v_env = rng.uniform();
   const glm::dvec3 u3(rng.uniform(), rng.uniform(), rng.uniform());
+  pick = LightPick{};
   if (u < lights.selection.p_env) {
     const EnvSample es = ws.environment->sample({u_env, v_env});
-    dir = es.dir;
+    pick.dir = es.dir;
     return es.pdf > 0.0;
   }
   u -= lights.selection.p_env;
+  // The media, then the analytic lights; rounding past the last one picks it.
+  const size_t n_media = lights.cdf.size();
   int j = -1;
-  for (size_t i = 0; i < lights.cdf.size(); ++i) {
-    const double p = lights.selection.p_medium[i];
+  for (size_t i = 0; i < n_media + lights.analytic.size(); ++i) {
+    const double p = i < n_media ? lights.selection.p_medium[i] : lights.selection.p_light[i - n_media];
     if (!(p > 0.0)) continue;
     j = int(i);
     if (u < p) break;
     u -= p;
   }
   if (j < 0) return false;
-  const EmissionSample es = lights.cdf[j]->sample_from(o, u_env, v_env, u3);
-  if (!(es.pdf > 0.0)) return false;
-  const glm::dvec3 v = es.p - o;
-  const double r = glm::length(v);
-  if (!(r > 0.0)) return false;
-  dir = v / r;
-  return true;
+  if (size_t(j) < n_media) {
+    const EmissionSample es = lights.cdf[j]->sample_from(o, u_env, v_env, u3);
+    if (!(es.pdf > 0.0)) return false;
+    const glm::dvec3 v = es.p - o;
+    const double r = glm::length(v);
+    if (!(r > 0.0)) return false;
+    pick.dir = v / r;
+    return true;
+  }
+  const int k = j - int(n_media);
+  const AnalyticLight& l = lights.analytic[k];
+  switch (l.light.type) {
+    case Light::Type::Distant:
+      if (l.is_disc()) {
+        pick.dir = sample_cone(l.light.direction, l.disc_omc, u_env, v_env);
+      } else {
+        pick.dir = l.light.direction;
+        pick.delta = k;
+        pick.Li = l.value;
+      }
+      return true;
+    case Light::Type::Sphere: {
+      glm::dvec3 axis;
+      const double omc = sphere_cone(l, o, axis);
+      if (!(omc > 0.0)) return false;  // o inside the sphere: no sample
+      pick.dir = sample_cone(axis, omc, u_env, v_env);
+      return true;
+    }
+    case Light::Type::Point:
+    case Light::Type::Spot: {
+      const glm::dvec3 v = l.light.position - o;
+      const double r2 = glm::dot(v, v);
+      if (!(r2 > 0.0)) return false;
+      const double r = std::sqrt(r2);
+      pick.dir = v / r;
+      pick.delta = k;
+      pick.t_max = r;
+      // The spot's falloff by the angle between its axis and the direction from it to o.
+      const double falloff =
+          l.light.type == Light::Type::Spot ? spot_falloff(l.cone, -glm::dot(l.light.direction, pick.dir)) : 1.0;
+      pick.Li = l.value * (falloff / r2);
+      return true;
+    }
+  }
+  return false;
+}
+
+// The light ray toward a delta light (docs/lights.md "Sampling"): ratio-tracked
+// like a light ray (docs/mis.md eq. 2a) but collecting nothing on its way, so it
+// returns its transmittance W to distance t_max, or 0 when a surface or a
+// sphere light comes first.
+double delta_light_ray(const WalkScene& ws, int c, const glm::dvec3& o, const glm::dvec3& d, double t_max, Pcg32& rng,
+                       ThreadCounters& cnt, Scratch& s) {
+  if (!ws.surfaces.empty() && geometry::occluded(ws.surfaces, geometry::Ray{o, d}, t_max)) return 0.0;
+  if (intersect_sphere_lights(ws.lights, o, d, t_max).light >= 0) return 0.0;
+  ray_spans(ws.md, o, d, s.spans, s.cuts);
+  double W = 1.0;
+  for (size_t k = 0; k + 1 < s.cuts.size(); ++k) {
+    const double a = s.cuts[k];
+    if (!(a < t_max)) break;
+    const double b = std::min(s.cuts[k + 1], t_max);
+    const double sigma_maj = media_present(ws.md, s.spans, a, s.cuts[k + 1], c, s.present);
+    if (!(sigma_maj > 0.0)) continue;
+    for (double t = a;;) {
+      t += sample_free_flight(sigma_maj, rng.uniform());
+      if (!(t < b)) break;
+      double sigma_a, sigma_s;
+      coefficients_at(ws.md, c, o + t * d, s, cnt, sigma_a, sigma_s);
+      if (exceeds_majorant(sigma_a + sigma_s, sigma_maj)) ++cnt.majorant_violations;
+      W *= std::max(0.0, 1.0 - (sigma_a + sigma_s) / sigma_maj);
+      if (W < kRatioTrackingRouletteBelow) {
+        if (!(rng.uniform() < W)) return 0.0;
+        W = 1.0;
+      }
+    }
+  }
+  return W;
 }
 
 // Next-event estimation from vertex o (the offset origin the continuing ray
-// also uses): n directions from the lights (light_direction). The radiance
-// arriving along each before anything scatters it is estimated by a light
+// also uses): n light samples (light_direction). The radiance arriving along
+// a direction of eq. (3) before anything scatters it is estimated by a light
 // ray: the walk itself with max_depth 0, by ratio tracking. Each is weighted by the power
 // heuristic for n samples of pdf p_light against the continuation's one
 // sample of pdf p_m for the same direction, both in solid angle (Veach 1997
-// eq. 9.13 with sample counts; docs/mis.md "Several light samples").
+// eq. 9.13 with sample counts; docs/mis.md "Several light samples"). A delta
+// light adds W·f·Li/(n·P_j), unweighted: nothing else finds it
+// (docs/lights.md "Sampling").
 // Returns the sum of radiance · f · w / (n · p_light), without the path weight β.
 template <class Lobe>
 double next_event(const WalkScene& ws, int c, const glm::dvec3& o, Lobe lobe, int n, Pcg32& rng, ThreadCounters& cnt,
@@ -220,10 +389,17 @@ double next_event(const WalkScene& ws, int c, const glm::dvec3& o, Lobe lobe, in
   const WalkLights& lights = ws.lights;
   double sum = 0.0;
   for (int k = 0; k < n; ++k) {
-    glm::dvec3 dir;
-    if (!light_direction(ws, o, rng, dir)) continue;
+    LightPick pick;
+    if (!light_direction(ws, o, rng, pick)) continue;
+    const glm::dvec3 dir = pick.dir;
     const VertexLobe l = lobe(dir);
     if (!(l.f > 0.0)) continue;
+    if (pick.delta >= 0) {
+      if (!(pick.Li[c] > 0.0)) continue;
+      const double W = delta_light_ray(ws, c, o, dir, pick.t_max, rng, cnt, s.light_ray());
+      sum += l.f * W * pick.Li[c] / (n * lights.selection.p_light[pick.delta]);
+      continue;
+    }
     const double p_light = light_direction_pdf(ws, o, dir);
     if (!(p_light > 0.0)) continue;
     const double radiance = walk_channel(ws, c, o, dir, rng, cnt, s.light_ray(), 0, WalkRole::LightRay);
@@ -250,10 +426,15 @@ bool continue_from(const WalkScene& ws, const glm::dvec3& o, Lobe& lobe, Own sam
     mis = RayMis{l.pdf, 0.0};
     return l.f > 0.0;
   }
+  LightPick pick;
   if (rng.uniform() < ws.lights.selection.p_continue_own) {
     d = sample_own();
-  } else if (!light_direction(ws, o, rng, d)) {
+  } else if (!light_direction(ws, o, rng, pick) || pick.delta >= 0) {
+    // A delta light's direction has no density: the path ends there, so the
+    // directions drawn have exactly the density p_m below.
     return false;
+  } else {
+    d = pick.dir;
   }
   const VertexLobe l = lobe(d);
   if (!(l.f > 0.0)) return false;
@@ -334,6 +515,13 @@ constexpr double kScatterRouletteBelow = 0.1;
 // in ratio_tracking_transmittance (Transmittance.h). E[Σ_k β_k σa Le(x_k)/σ̄] is the
 // same integral as delta tracking's, without the noise of where the first
 // real event falls (docs/mis.md "Light rays").
+//
+// Analytic lights (docs/lights.md "Analytic lights"): a sphere light ends any
+// ray that meets it before a surface (media tracked up to it, as to a
+// surface) and adds its radiance from outside; an escaping ray adds each disc
+// sun whose cone holds it to the environment. Both are weighted by w_ray as
+// the environment is (1 for camera rays). Delta lights only reach vertices
+// through next_event.
 double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
                     Scratch& s, int max_depth, WalkRole role) {
   const MediaData& md = ws.md;
@@ -354,7 +542,12 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
     geometry::SurfaceHit hit;
     const bool hit_surface = has_surfaces && geometry::intersect(ws.surfaces, geometry::Ray{o, d},
                                                                  std::numeric_limits<double>::infinity(), hit);
-    const double t_surf = hit_surface ? hit.t : std::numeric_limits<double>::infinity();
+    // A sphere light in front of it ends the segment instead (opaque).
+    const SphereLightHit sphere = intersect_sphere_lights(
+        lights, o, d, hit_surface ? hit.t : std::numeric_limits<double>::infinity());
+    const double t_surf = sphere.light >= 0 ? sphere.t
+                          : hit_surface     ? hit.t
+                                            : std::numeric_limits<double>::infinity();
 
     // The weight of what this ray finds before its next event.
     const double w_ray = skip_segment ? 0.0 : unidirectional_weight(lights, mis);
@@ -448,6 +641,10 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
       }
     }
     if (scattered) continue;
+    // A sphere light absorbs the ray and adds its radiance, weighted like the
+    // environment's (docs/lights.md "Sampling"); black from inside.
+    if (sphere.light >= 0)
+      return L + (sphere.outside ? beta * w_ray * lights.analytic[sphere.light].value[c] : 0.0);
     if (!hit_surface) return L + beta * w_ray * ws.escaped(d, c);
 
     // Reached the surface: a Lambertian bounce.
@@ -581,6 +778,18 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
         if (!cdfs[i]->empty()) lights.cdf[i] = &*cdfs[i];
       }
   lights.selection = select_lights(scene, environment ? &*environment : nullptr, lights.cdf);
+  for (const Light& l : scene.lights) {
+    AnalyticLight a;
+    a.light = l;
+    a.light.direction = glm::normalize(l.direction);
+    a.value = light_value(l);
+    if (l.type == Light::Type::Distant) {
+      a.disc_omc = disc_one_minus_cos(l);
+      a.disc_L = disc_radiance(l);
+    }
+    if (l.type == Light::Type::Spot) a.cone = spot_cone(l);
+    lights.analytic.push_back(a);
+  }
   const bool collision_estimator = lights.selection.estimator == EmissionEstimator::Collision;
   const WalkScene walk_scene{media,     surfaces,           environment ? &*environment : nullptr, scene.background,
                              max_depth, collision_estimator, lights};

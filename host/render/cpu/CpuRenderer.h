@@ -5,9 +5,11 @@
 // add; delta tracking with one global majorant per medium (Media.h); opaque
 // two-sided Lambertian surfaces (meshes, spheres, planes, albedo textures;
 // geometry/Surfaces.h); a constant background or a lat-long environment map
-// (light/EnvironmentMap.h) for escaping rays; the "absorption" and "collision"
-// emission estimators; Henyey–Greenstein scattering. Directions are sampled
-// from the BSDF / phase function only (no next-event estimation yet).
+// (light/EnvironmentMap.h) for escaping rays; the scene's analytic lights
+// (sun, point, spot, sphere; docs/lights.md); the "absorption" and "collision"
+// emission estimators; Henyey–Greenstein scattering. Directions come from the
+// BSDF / phase function and, with light sampling, next-event estimation
+// combined by MIS (docs/mis.md).
 #include <string>
 
 #include <glm/glm.hpp>
