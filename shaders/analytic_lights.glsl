@@ -102,19 +102,25 @@ vec3 disc_lights_radiance(vec3 d) {
   return L;
 }
 
-// The nearest sphere light that the ray o + t·d (from outside) enters before
-// t_max: its index (t_max then its distance), or LIGHT_COUNT.
+// The nearest sphere light that the ray o + t·d meets before t_max: its index
+// (t_max then its distance), or LIGHT_COUNT. A ray that starts inside one
+// meets it at once (t 0): the sphere is opaque.
 uint intersect_sphere_lights(vec3 o, vec3 d, inout float t_max) {
   uint found = LIGHT_COUNT;
   for (uint i = 0u; i < LIGHT_COUNT; ++i) {
     if (analytic_lights[i].kind.x != LIGHT_SPHERE) continue;
     vec2 t;
-    if (intersect_sphere(o, d, analytic_lights[i].position.xyz, analytic_lights[i].position.w, t) && t.x > 0.0 &&
-        t.x < t_max) {
+    if (intersect_sphere(o, d, analytic_lights[i].position.xyz, analytic_lights[i].position.w, t) && t.x < t_max) {
       t_max = t.x;
       found = i;
     }
   }
   return found;
+}
+
+// The radiance that a ray along d sees where it meets sphere light l at x:
+// its radiance from outside, none from inside (it emits outward only).
+vec3 sphere_light_radiance(GpuLight l, vec3 x, vec3 d) {
+  return dot(d, x - l.position.xyz) < 0.0 ? l.value.rgb : vec3(0.0);
 }
 #endif

@@ -1021,7 +1021,9 @@ bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, 
     // A delta light ray arrives (its weight holds f·I/(r²·P)); any other ray
     // sees the sphere light's radiance, MIS-weighted, and ends: it is opaque.
     if (p.hit.primitive == p.delta_light) p.L += p.w;
-    else if (!p.skip_segment) p.L += unidirectional_weight(p.pdf_dir, p.p_light) * p.w * analytic_lights[p.hit.primitive].value.rgb;
+    else if (!p.skip_segment)
+      p.L += unidirectional_weight(p.pdf_dir, p.p_light) * p.w *
+             sphere_light_radiance(analytic_lights[p.hit.primitive], p.o + p.hit.t * p.d, p.d);
     return ray_ends(p);
   }
   if (event == EVENT_END || (event == EVENT_SURFACE && NEE && p.light_ray)) return ray_ends(p);

@@ -72,8 +72,9 @@ class RealRender : public ::testing::Test {
     return s;
   }
 
-  // GPU at gpu_spp vs CPU at cpu_spp (independent seeds).
-  void compare(Scene s, int gpu_spp, int cpu_spp, const char* what) {
+  // GPU at gpu_spp vs CPU at cpu_spp (independent seeds). informative: the
+  // image-mean bias test must have an SE below half its tolerance.
+  void compare(Scene s, int gpu_spp, int cpu_spp, const char* what, bool informative = true) {
     s.film.spp = gpu_spp;
     s.film.seed = 1;
     RenderResult gpu = backend_->render(s, settings_for(s), {});
@@ -91,6 +92,7 @@ class RealRender : public ::testing::Test {
     EXPECT_GT(total, 0.0) << what << ": the CPU image is black";
     test::ZTestOptions o;
     o.pool3x3 = true;
+    o.require_informative = informative;
     test::ZTestReport rep = test::ztest_images(gpu, ref, o);
     EXPECT_TRUE(rep.ok) << what << ": " << rep.summary();
     std::printf("%s GPU vs CPU: %s; GPU %.2f s (load %.2f s), CPU %.2f s; GPU lookups/sample %.2f\n", what,
@@ -143,7 +145,10 @@ TEST_F(RealRender, HoudiniSmokeLitBySun) {
   sun.angle_deg = 0.53;
   sun.rgb = glm::dvec3(3.0, 2.8, 2.5);
   s.lights.push_back(sun);
-  compare(s, 32, 32, "houdini smoke under a sun");
+  // The per-pixel criterion at 32 spp (issue 24); the image mean's bias
+  // needs more samples to say anything (SE 0.4 % at 32 spp).
+  compare(s, 32, 32, "houdini smoke under a sun, 32 spp", false);
+  compare(s, 256, 256, "houdini smoke under a sun, 256 spp");
 }
 
 // Blender 2.79 fire: density (max 0.19) and `heat` (dimensionless, max 1.57)
