@@ -175,7 +175,7 @@ vec3 density_texel_dir(uint slot, vec3 d) {
   return vec3(dot(grids[slot].density_row0, d0), dot(grids[slot].density_row1, d0), dot(grids[slot].density_row2, d0));
 }
 
-// Emitted radiance Le of grid medium m at world point x (DESIGN.md: T = (v − offset)·scale,
+// Emitted radiance Le of grid medium m at world point x (docs/scene-format.md "media": T = (v − offset)·scale,
 // no emission at or below cutoff_k; the LUT is uniform in ln T). With
 // TEMPERATURE_IN_DENSITY the grid's value v was read with the density at x.
 vec3 grid_le(GpuMedium m, uint slot, vec3 x, float value_read) {

@@ -64,7 +64,7 @@ void check_frame_outputs(const FrameOutputs& out, const Scene& frame_scene, Crea
   check_outputs(outputs, {}, scene_inputs(frame_scene), folders);
 }
 
-// The stats JSON of one render (DESIGN.md "--stats").
+// The stats JSON of one render (README.md "Using it": --stats).
 void write_stats(const std::filesystem::path& file, const RenderArgs& args, const std::filesystem::path& output,
                  const RenderResult& result, std::optional<int> frame) {
   const double samples = double(total_samples(result.width, result.height, result.spp));

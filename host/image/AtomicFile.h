@@ -1,5 +1,5 @@
 #pragma once
-// Every file pyrolume writes goes through here (DESIGN.md "Command line";
+// Every file pyrolume writes goes through here (README.md "Using it";
 // docs/robustness.md "Outputs"): write-then-rename, so a failed or interrupted
 // run never leaves a partial file at the destination, and nothing but a
 // regular file (or a missing path) is ever replaced. Usable for any output:

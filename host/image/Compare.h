@@ -6,7 +6,7 @@
 //   RMSE    = sqrt( mean (a − b)² )
 //   relMSE  = mean( (a − b)² / (b² + 1e-2) )   — pbrt/Mitsuba relative MSE; the
 //             1e-2 keeps black reference pixels from dominating.
-//   bias    = (Σa − Σb) / Σb                   — DESIGN.md "Testing"; 0 when both
+//   bias    = (Σa − Σb) / Σb                   — docs/testing.md; 0 when both
 //             sums are 0, ±inf when only Σb is.
 //   bias_se = sqrt(Σvar_a + Σvar_b) / |Σb|     — standard error of bias, from the
 //             per-pixel variance of the mean; only when variance is known.
@@ -35,7 +35,7 @@ struct ChannelMetrics {
 struct CompareOptions {
   // Per-pixel variance from n samples has n−1 degrees of freedom; averaging it over
   // a (2r+1)² neighbourhood (clipped at the border) steadies the 4σ test
-  // (DESIGN.md "Testing": pool over 3×3, i.e. radius 1). 0 = no pooling.
+  // (docs/testing.md: pool over 3×3, i.e. radius 1). 0 = no pooling.
   int variance_pool_radius = 0;
 };
 
@@ -65,7 +65,7 @@ std::string format_report(const CompareReport& report);
 
 // `pyrolume compare A B [--max-relmse X] [--max-outliers F]`: reads both images,
 // prints format_report to out, returns 0 when within limits and 3 when beyond
-// (DESIGN.md exit status; a limit check uses all.rel_mse and outlier_fraction, and
+// (README.md "Using it": exit status; a limit check uses all.rel_mse and outlier_fraction, and
 // NaN counts as beyond), with one line per exceeded limit on err. Unreadable
 // files, size mismatch, a negative limit, or --max-outliers without variance in
 // either image → InputError (the CLI maps it to exit 2).

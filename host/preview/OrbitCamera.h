@@ -45,7 +45,7 @@ inline void pan(Camera& cam, double dx_px, double dy_px, double viewport_height)
   const double dist = glm::length(offset);
   if (!(dist > 0.0) || !(viewport_height > 0.0)) return;
   const glm::dvec3 forward = -offset / dist;
-  const glm::dvec3 right = glm::normalize(glm::cross(forward, cam.up));  // image x (DESIGN.md camera convention)
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, cam.up));  // image x (docs/scene-format.md "camera")
   const glm::dvec3 image_up = glm::cross(right, forward);
   const double units_per_px = 2.0 * dist * std::tan(glm::radians(cam.fov_deg) * 0.5) / viewport_height;
   const glm::dvec3 move = (-dx_px * right + dy_px * image_up) * units_per_px;

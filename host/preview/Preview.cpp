@@ -48,7 +48,7 @@ using Clock = std::chrono::steady_clock;
 namespace fs = std::filesystem;
 
 // Set by SIGINT/SIGTERM: the loop ends after the current frame, as the window's
-// close button would, and the command exits 130/143 (DESIGN.md exit statuses).
+// close button would, and the command exits 130/143 (README.md "Using it").
 std::atomic<int> g_signal{0};
 extern "C" void on_preview_signal(int sig) { g_signal = sig; }
 

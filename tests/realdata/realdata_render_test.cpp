@@ -2,7 +2,7 @@
 // resolution on the Vulkan backend and on the CPU reference, compared
 // statistically (issue 4 "Real data", issue 5 "GPU vs CPU ... on each real VDB"):
 // per-pixel z-test on 3×3-pooled variances (>= 99.75 % within 4σ) and the
-// DESIGN.md bias formula. Files are read in place, never copied; when the
+// bias formula of docs/testing.md. Files are read in place, never copied; when the
 // folder is absent the tests say so and skip.
 #include <chrono>
 #include <cmath>

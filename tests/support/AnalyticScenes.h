@@ -1,7 +1,7 @@
 #pragma once
 // Scenes with known answers for the renderer tests (header-only). Builders return
 // plain Scene objects (the same as parsed JSON would give); the closed forms are
-// computed here, independently of any renderer: own camera model (DESIGN.md
+// computed here, independently of any renderer: own camera model (docs/scene-format.md "camera"
 // convention), own ray/bounds code, own pixel-area quadrature.
 #include <algorithm>
 #include <cmath>
@@ -168,7 +168,7 @@ inline Scene chromatic_scattering_scene(int width = 32, int height = 32, int spp
 // --------------------------------------------------------- closed forms ----
 
 // Camera ray through continuous film point (fx, fy) in pixels (0,0 = top-left),
-// DESIGN.md: vertical fov, image x along normalize(cross(forward, up)).
+// docs/scene-format.md "camera": vertical fov, image x along normalize(cross(forward, up)).
 inline glm::dvec3 film_ray(const Camera& cam, int width, int height, double fx, double fy) {
   const glm::dvec3 f = glm::normalize(cam.look_at - cam.position);
   const glm::dvec3 r = glm::normalize(glm::cross(f, cam.up));

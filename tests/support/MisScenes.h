@@ -128,7 +128,7 @@ inline ZTestOptions mis_pooled(double tolerance) {
 }
 
 // Two renders of the same scene converge to the same image (pooled z-test,
-// DESIGN.md bias formula); prints the report.
+// bias formula of docs/testing.md); prints the report.
 inline void expect_same_image(const RenderResult& a, const RenderResult& b, double tolerance, const char* what) {
   ZTestReport z = ztest_images(a, b, mis_pooled(tolerance));
   EXPECT_TRUE(z.ok) << what << ": " << z.summary();

@@ -1,6 +1,6 @@
 #pragma once
 // Statistical comparison of Monte Carlo renders (header-only, reused by the CPU,
-// Vulkan and CPU-vs-Vulkan tests). DESIGN.md "Testing": per-pixel z-scores with
+// Vulkan and CPU-vs-Vulkan tests). docs/testing.md: per-pixel z-scores with
 // the render's own standard errors (accept when >= 99.75 % lie within 4σ, the
 // Mitsuba 3 convention), plus the whole-image mean bias
 //   bias = (ΣA − ΣB)/ΣB,  SE_bias = sqrt(Σse_A² + Σse_B²)/|ΣB|,

@@ -41,7 +41,7 @@ TEST(CieTables, CoverVisibleRangeAt1nm) {
 }
 
 TEST(Blackbody, PeakModeReproducesPbrtV4) {
-  // DESIGN.md: pbrt-v4's BlackbodySpectrum -> XYZ -> linear sRGB.
+  // docs/blackbody.md: pbrt-v4's BlackbodySpectrum -> XYZ -> linear sRGB.
   struct Case { double T; glm::dvec3 rgb; };
   const Case cases[] = {{2000, {13.055, 3.3514, 0.1058}}, {3000, {78.713, 37.532, 12.098}}, {6500, {98.754, 93.110, 97.997}}};
   for (const Case& c : cases) {

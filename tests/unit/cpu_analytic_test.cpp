@@ -171,7 +171,7 @@ TEST(CpuAnalytic, ZTestRejectsWrongExact) {
   EXPECT_FALSE(mirrored.fraction_ok) << mirrored.summary();
 }
 
-// Image x grows along cross(forward, up), y grows downwards (DESIGN.md), checked
+// Image x grows along cross(forward, up), y grows downwards (docs/scene-format.md "camera"), checked
 // without the test-side camera model.
 TEST(CpuAnalytic, CameraOrientation) {
   Scene s = test::analytic_base_scene(32, 32, 4);

@@ -1,5 +1,5 @@
 // Samplers and geometry of the CPU reference: chi-square tests against the
-// analytic distributions (DESIGN.md: "sampling routines get chi-square tests").
+// analytic distributions (docs/testing.md: samplers get chi-square tests).
 #include <cmath>
 #include <numbers>
 #include <set>

@@ -1,4 +1,4 @@
-// Scene format v1: the DESIGN.md example parses; every malformed case names the key.
+// Scene format v1: a full example scene parses; every malformed case names the key.
 #include <gtest/gtest.h>
 
 #include "scene/Scene.h"

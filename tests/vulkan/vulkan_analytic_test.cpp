@@ -67,7 +67,7 @@ TEST_F(VulkanAnalytic, WhiteFurnaceConservesEnergy) {
 }
 
 // Shader vs CPU on a scattering scene with chromatic sigma, g != 0 and two
-// overlapping media: per-pixel z-test and the DESIGN.md bias formula.
+// overlapping media: per-pixel z-test and the bias formula of docs/testing.md.
 TEST_F(VulkanAnalytic, AgreesWithCpuReferenceOnChromaticScattering) {
   Scene s = test::chromatic_scattering_scene();
   RenderResult gpu = render(s);

@@ -1,7 +1,7 @@
 // The scene's analytic lights on the Vulkan backend (docs/lights.md
 // "Analytic lights"), validation layers on: a Lambertian plane under each
 // kind of light against its closed form, per pixel (z-tests with the
-// render's own standard errors, DESIGN.md "Testing"):
+// render's own standard errors, docs/testing.md):
 //   point:    L = ρ/π · I cos θ / r²
 //   spot:     the point light times the smoothstep falloff; 0 outside the cone
 //   distant:  L = ρ/π · E cos θ, the delta light and the disc sun alike (over

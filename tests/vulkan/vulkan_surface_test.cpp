@@ -7,7 +7,7 @@
 //    lat-long orientation against expectations computed here, by z-tests that
 //    must also REJECT the wrong conventions (no flip, no sRGB decode,
 //    unrotated, mirrored, Y-up);
-//  - GPU vs the CPU reference (z-tests with the DESIGN.md bias formula) on a
+//  - GPU vs the CPU reference (z-tests with the bias formula of docs/testing.md) on a
 //    small terrain_explosion and on an emissive scattering medium above a
 //    textured plane under an environment map (there with two perturbed
 //    references that must be rejected).

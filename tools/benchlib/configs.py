@@ -14,7 +14,7 @@ class Config:
         if estimator is None:
             self.name = backend
         elif backend == "cpu":
-            # The CPU reference always tracks with one global majorant (DESIGN.md).
+            # The CPU reference always tracks with one global majorant (docs/benchmarks.md).
             self.name = f"cpu/{estimator}"
         else:
             self.name = f"{backend}/{estimator}/{majorant}"

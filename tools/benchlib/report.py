@@ -141,7 +141,9 @@ def report(args, run, rows, scenes, skipped, refs, plotted):
                 if g and gl and g["density_lookups_per_ray"] > 0 else float("nan")
             target = TARGET_MAJORANT.get(s)
             verdict = "–"
-            if target:
+            if target and not (g and gl):
+                verdict = f"≥ {target:g}×: not measured (needs the grid and the global configs)"
+            elif target:
                 ok = ratio >= target
                 verdict = f"≥ {target:g}×: {'met' if ok else '**missed**'}"
                 if not ok:

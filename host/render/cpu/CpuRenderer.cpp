@@ -160,7 +160,7 @@ struct WalkScene {
   const WalkLights& lights;
 
   // Radiance of channel c seen by a ray escaping along d (camera and scattered
-  // rays alike): the environment map replaces background.rgb (DESIGN.md);
+  // rays alike): the environment map replaces background.rgb (docs/scene-format.md "environment");
   // each disc sun whose cone holds d adds its radiance (docs/lights.md).
   double escaped(const glm::dvec3& d, int c) const {
     double L = environment ? environment->radiance(d)[c] : background[c];

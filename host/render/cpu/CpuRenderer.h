@@ -48,7 +48,7 @@ class CpuRenderer : public Backend {
 namespace cpu {
 
 // Camera ray through the continuous film position (fx, fy) in pixels, (0,0) =
-// top-left corner of the image, y down (DESIGN.md camera convention: vertical
+// top-left corner of the image, y down (docs/scene-format.md "camera": vertical
 // fov, image x along normalize(cross(forward, up))). Returns a unit direction.
 glm::dvec3 camera_ray_direction(const Camera& camera, int width, int height, double fx, double fy);
 

@@ -5,7 +5,7 @@
 // (StoredVolume: R16F-rounded values, one texture per grid with its own
 // transform), so both backends render the same field.
 //
-// Grid medium at x (DESIGN.md):
+// Grid medium at x (docs/scene-format.md "media"):
 //   σa(x) = sigma_a · density_scale · ρ(x),  σs(x) = sigma_s · density_scale · ρ(x),
 //   emitted radiance per unit length σa(x) · Le(x), with
 //   Le(x) = emission.scale · blackbody(T(x)),  T(x) = (temperature(x) − offset) · scale,

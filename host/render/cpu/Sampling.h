@@ -19,7 +19,7 @@ inline constexpr double kHgSmallG = 1e-3;
 
 // Henyey–Greenstein phase function, in the *propagation* convention:
 // cos_theta = dot(incoming travel direction, outgoing travel direction), so g > 0
-// peaks at cos_theta = 1 (forward scattering, DESIGN.md).
+// peaks at cos_theta = 1 (forward scattering, docs/scene-format.md "media").
 //   p(cos θ) = (1 − g²) / (4π (1 + g² − 2 g cos θ)^{3/2})      [Henyey & Greenstein 1941]
 // pbrt-v4 (eq. 11.12, HenyeyGreenstein()) writes "+ 2 g cos θ" because its cos θ is
 // measured against wo = −(travel direction); the two are the same function.

@@ -88,7 +88,7 @@ GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<Sto
       bool sphere = m.bounds.kind == Bounds::Kind::Sphere;
       g.sigma_a = v4(m.sigma_a, sphere ? gpu::SHAPE_SPHERE : gpu::SHAPE_BOX);
       out.has_analytic = true;
-      // A medium emits sigma_a·Le per unit length (DESIGN.md).
+      // A medium emits sigma_a·Le per unit length (docs/scene-format.md "media").
       g.emission = v4(m.sigma_a * homogeneous_le(m.emission), 0.0);
       if (sphere) {
         g.bounds0 = v4(m.bounds.center, m.bounds.radius);

@@ -23,8 +23,6 @@ int find_memory_type(const VkPhysicalDeviceMemoryProperties& props, uint32_t typ
 // Global memory barrier (all buffers and images).
 void memory_barrier(VkCommandBuffer cmd, VkPipelineStageFlags src_stage, VkAccessFlags src_access,
                     VkPipelineStageFlags dst_stage, VkAccessFlags dst_access);
-// Compute shader writes -> later compute shader reads/writes (between passes).
-void compute_to_compute_barrier(VkCommandBuffer cmd);
 // Compute shader or transfer writes -> host reads (before reading a Readback buffer).
 void to_host_read_barrier(VkCommandBuffer cmd);
 
@@ -32,10 +30,6 @@ class Buffer {
  public:
   Buffer() = default;
   Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryKind kind, const char* name = nullptr);
-  static Buffer create(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryKind kind,
-                       const char* name = nullptr) {
-    return Buffer(ctx, size, usage, kind, name);
-  }
   Buffer(Buffer&& o) noexcept;
   Buffer& operator=(Buffer&& o) noexcept;
 

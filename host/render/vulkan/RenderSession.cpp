@@ -134,7 +134,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   upload_constants(scene);
   // lavapipe compiles a pipeline inside its first dispatch (~0.1–0.5 s,
   // docs/rendering.md): dispatch one empty workgroup now so that cost counts as
-  // loading, not rendering (DESIGN.md: `seconds` starts at the first real pass).
+  // loading, not rendering (docs/benchmarks.md: `seconds` starts at the first real pass).
   ctx.submit_and_wait([&](VkCommandBuffer cmd) {
     gpu::PassConstants nothing{0u, 0u, 0u, 0u};
     pipeline_->bind(cmd, set_->set());
