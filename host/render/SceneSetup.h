@@ -38,7 +38,8 @@ SceneSetup complete_scene(Scene& scene, int frame, bool film_size_fixed);
 Camera framing_camera(const std::vector<WorldBox>& boxes, UpAxis up, double fov_deg, double aspect);
 
 // "" when something in the scene gives light (an emitting medium, a
-// background or an environment); otherwise a one-line reason.
+// background, an environment, or `lights` with something to light: a
+// surface or a scattering medium); otherwise a one-line reason.
 std::string nothing_emits(const Scene& scene);
 
 // "" when some box is in the camera's view; otherwise a one-line reason.

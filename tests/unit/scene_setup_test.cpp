@@ -236,3 +236,24 @@ TEST(FilmLook, WarnsAboutAnAlmostBlackOrAlmostClippedImage) {
   EXPECT_EQ(film_look_warning(img, 0.0, ViewTransform::Standard, false), "");  // EXR: nothing clips
   EXPECT_EQ(film_look_warning(img, -10.0, ViewTransform::Standard, true), "");
 }
+
+// The warning that the image will be black: lights count as light only where
+// they have something to light (a surface or a scattering medium).
+TEST(NothingEmits, LightsNeedSomethingThatScatters) {
+  Scene s;
+  Medium smoke;
+  smoke.type = Medium::Type::Homogeneous;
+  smoke.emission.scale = 0.0;
+  s.media.push_back(smoke);
+  EXPECT_NE(nothing_emits(s).find("nothing in the scene gives light"), std::string::npos) << nothing_emits(s);
+  Light sun;
+  sun.type = Light::Type::Distant;
+  sun.rgb = glm::dvec3(1.0);
+  s.lights.push_back(sun);
+  EXPECT_NE(nothing_emits(s).find("lights light nothing"), std::string::npos) << nothing_emits(s);
+  s.media[0].sigma_s = glm::dvec3(0.0, 0.5, 0.0);
+  EXPECT_EQ(nothing_emits(s), "");
+  s.media[0].sigma_s = glm::dvec3(0.0);
+  s.shapes.push_back(Shape{});
+  EXPECT_EQ(nothing_emits(s), "");
+}
