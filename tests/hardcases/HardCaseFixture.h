@@ -55,17 +55,8 @@ inline const char* const kEstimators[] = {"absorption", "collision"};
 
 // Absorption-estimator samples are Bernoulli-like: pool the variance over 3×3
 // (Stats.h explains).
-inline test::ZTestOptions pooled(double tolerance = 0.005) {
-  test::ZTestOptions o;
-  o.pool3x3 = true;
-  o.bias_tolerance = tolerance;
-  return o;
-}
-
-inline glm::dvec3 pixel_mean(const RenderResult& r, int x, int y) {
-  const size_t i = (size_t(y) * r.width + x) * 3;
-  return glm::dvec3(r.sum[i], r.sum[i + 1], r.sum[i + 2]) / double(r.spp);
-}
+using test::pixel_mean;
+using test::pooled;
 
 // The rectangle [x0, x0 + w) × [y0, y0 + h) of a render, as a render of its own
 // (for closed forms that hold on part of the image only).

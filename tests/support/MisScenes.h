@@ -120,17 +120,10 @@ inline Scene smoky_furnace_scene(const std::filesystem::path& dir, Strategy k, b
 
 // --------------------------------------------------------------- checks ----
 
-inline ZTestOptions mis_pooled(double tolerance) {
-  ZTestOptions o;
-  o.pool3x3 = true;
-  o.bias_tolerance = tolerance;
-  return o;
-}
-
 // Two renders of the same scene converge to the same image (pooled z-test,
 // bias formula of docs/testing.md); prints the report.
 inline void expect_same_image(const RenderResult& a, const RenderResult& b, double tolerance, const char* what) {
-  ZTestReport z = ztest_images(a, b, mis_pooled(tolerance));
+  ZTestReport z = ztest_images(a, b, pooled(tolerance));
   EXPECT_TRUE(z.ok) << what << ": " << z.summary();
   std::printf("%s: %s\n", what, z.summary().c_str());
 }

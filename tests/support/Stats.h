@@ -219,6 +219,37 @@ inline std::string check_spp(int n, const ZTestOptions& o) {
 
 }  // namespace detail
 
+// Options for renders whose samples are Bernoulli-like (the absorption
+// estimator returns Le or the background; a light is hit or missed): the
+// per-pixel variance pooled over 3×3 (pixel_stats explains; pooling only
+// widens), with the given whole-image bias tolerance (relative).
+inline ZTestOptions pooled(double bias_tolerance = ZTestOptions{}.bias_tolerance) {
+  ZTestOptions o;
+  o.pool3x3 = true;
+  o.bias_tolerance = bias_tolerance;
+  return o;
+}
+
+// The mean of pixel (x, y): sum / spp per channel.
+inline glm::dvec3 pixel_mean(const RenderResult& r, int x, int y) {
+  const size_t p = (size_t(y) * r.width + x) * 3;
+  return glm::dvec3(r.sum[p], r.sum[p + 1], r.sum[p + 2]) / double(r.spp);
+}
+
+// Largest per-channel sample variance of pixel (x, y) relative to 1 + mean²:
+// ~0 when every sample had the same value (what an exact per-sample closed
+// form predicts): Σx²/n − mean² cancels to ~1e-16 with double sums (CPU),
+// ~1e-7 with float sums (GPU).
+inline double pixel_spread(const RenderResult& r, int x, int y) {
+  const size_t p = (size_t(y) * r.width + x) * 3;
+  double worst = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const double m = r.sum[p + c] / r.spp;
+    worst = std::max(worst, std::abs(r.sum_sq[p + c] / r.spp - m * m) / (1.0 + m * m));
+  }
+  return worst;
+}
+
 // Render vs closed form. `exact(x, y)` is the expected pixel value (the average
 // of the radiance over the pixel's area: the renderer jitters, box filter).
 inline ZTestReport ztest_against_exact(const RenderResult& r, const std::function<glm::dvec3(int x, int y)>& exact,

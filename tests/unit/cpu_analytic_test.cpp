@@ -35,11 +35,7 @@ bool all_finite(const RenderResult& r) {
 
 // Absorption-estimator samples are Le or background (Bernoulli-like): silhouette
 // pixels with few hits can show s² = 0 by chance, so pool (Stats.h explains).
-ZTestOptions pooled() {
-  ZTestOptions o;
-  o.pool3x3 = true;
-  return o;
-}
+using test::pooled;
 
 TEST(CpuAnalytic, AbsorbingSphereMatchesClosedForm) {
   Scene s = test::absorbing_sphere_scene();

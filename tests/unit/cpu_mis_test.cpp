@@ -76,7 +76,7 @@ TEST(CpuMis, FurnaceSphereIsOneWithSkyAsLight) {
     // n next-event samples per surface vertex; the last with the ratio-tracked continuation.
     for (auto [n, ratio] : {std::pair{1, false}, std::pair{3, false}, std::pair{3, true}}) {
       RenderResult r = render(test::furnace_sphere_scene(dir, k, n, ratio));
-      ZTestReport z = test::ztest_against_exact(r, [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
+      ZTestReport z = test::ztest_against_exact(r, [](int, int) { return glm::dvec3(1.0); }, test::pooled(0.01));
       EXPECT_TRUE(z.ok) << n << " light samples" << (ratio ? ", ratio-tracked continuation: " : ": ") << z.summary();
       std::printf("furnace, %d light samples%s: %s\n", n, ratio ? ", ratio-tracked continuation" : "",
                   z.summary().c_str());
@@ -94,7 +94,7 @@ TEST(CpuMis, ScatteringFurnaceIsOneWithSkyAsLight) {
   s.environment = Environment{test::write_uniform_sky(dir, glm::vec3(1.0f)), 1.0, 0.0};
   test::set_strategy(s, Strategy::Mis);
   RenderResult r = render(s);
-  ZTestReport z = test::ztest_against_exact(r, [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
+  ZTestReport z = test::ztest_against_exact(r, [](int, int) { return glm::dvec3(1.0); }, test::pooled(0.01));
   EXPECT_TRUE(z.ok) << z.summary();
 }
 
@@ -104,7 +104,7 @@ TEST(CpuMis, SmokyFurnaceIsOneWithRatioTrackedContinuation) {
   const auto dir = test::temp_dir("cpu_mis_furnace");
   for (bool ratio : {false, true}) {
     ZTestReport z = test::ztest_against_exact(render(test::smoky_furnace_scene(dir, Strategy::Mis, ratio)),
-                                              [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
+                                              [](int, int) { return glm::dvec3(1.0); }, test::pooled(0.01));
     EXPECT_TRUE(z.ok) << (ratio ? "ratio-tracked continuation: " : "path continuation: ") << z.summary();
     std::printf("smoky furnace%s: %s\n", ratio ? ", ratio-tracked continuation" : "", z.summary().c_str());
   }

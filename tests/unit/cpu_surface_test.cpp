@@ -26,7 +26,10 @@
 namespace pyrolume {
 namespace {
 
+using test::pixel_mean;
+using test::pixel_spread;
 using test::plane_shape;
+using test::pooled;
 using test::srgb_to_linear;
 using test::sphere_shape;
 using test::TexelBytes;
@@ -50,33 +53,6 @@ RenderResult render(const Scene& s, int threads = 0) {
   return res;
 }
 
-glm::dvec3 pixel_mean(const RenderResult& r, int x, int y) {
-  const size_t p = (size_t(y) * r.width + x) * 3;
-  return glm::dvec3(r.sum[p], r.sum[p + 1], r.sum[p + 2]) / double(r.spp);
-}
-
-// Largest per-channel sample variance of a pixel relative to its squared mean
-// (plus 1): 0 up to rounding when every sample had the same value (what an
-// exact per-sample closed form predicts). Σx²/n − mean² cancels to ~1e-16.
-double pixel_spread(const RenderResult& r, int x, int y) {
-  const size_t p = (size_t(y) * r.width + x) * 3;
-  double worst = 0.0;
-  for (int c = 0; c < 3; ++c) {
-    const double m = r.sum[p + c] / r.spp;
-    worst = std::max(worst, std::abs(r.sum_sq[p + c] / r.spp - m * m) / (1.0 + m * m));
-  }
-  return worst;
-}
-
-
-// size 0: unbounded along that axis.
-
-ZTestOptions pooled(double tolerance = 0.005) {
-  ZTestOptions o;
-  o.pool3x3 = true;
-  o.bias_tolerance = tolerance;
-  return o;
-}
 
 
 // ------------------------------------------------------------- sampler ----

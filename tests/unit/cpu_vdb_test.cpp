@@ -42,11 +42,7 @@ RenderResult render(const Scene& s, uint64_t* violations = nullptr) {
 
 // Absorption-estimator samples are Bernoulli-like (Le or background): pool the
 // variance over 3×3 (Stats.h explains).
-ZTestOptions pooled() {
-  ZTestOptions o;
-  o.pool3x3 = true;
-  return o;
-}
+using test::pooled;
 
 const char* kEstimators[] = {"absorption", "collision"};
 

@@ -20,11 +20,7 @@ class VulkanAnalytic : public test::VulkanFixture {
 
 };
 
-test::ZTestOptions pooled() {
-  test::ZTestOptions o;
-  o.pool3x3 = true;
-  return o;
-}
+using test::pooled;
 
 TEST_F(VulkanAnalytic, AbsorbingSphereMatchesClosedForm) {
   Scene s = test::absorbing_sphere_scene();

@@ -74,7 +74,7 @@ TEST_F(VulkanMis, FurnaceSphereIsOneWithSkyAsLight) {
     for (Strategy st : {Strategy::Mis, Strategy::LightOnly}) {
       const char* name = st == Strategy::Mis ? "MIS" : "light only";
       ZTestReport z = test::ztest_against_exact(gpu(test::furnace_sphere_scene(dir, st, n, ratio)),
-                                                [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
+                                                [](int, int) { return glm::dvec3(1.0); }, test::pooled(0.01));
       EXPECT_TRUE(z.ok) << n << " light samples" << (ratio ? ", ratio-tracked continuation, " : ", ") << name << ": "
                         << z.summary();
       std::printf("GPU furnace, %d light samples%s, %s: %s\n", n, ratio ? ", ratio-tracked continuation" : "", name,
@@ -90,7 +90,7 @@ TEST_F(VulkanMis, SmokyFurnaceIsOneWithRatioTrackedContinuation) {
   for (Strategy st : {Strategy::Mis, Strategy::LightOnly}) {
     const char* name = st == Strategy::Mis ? "MIS" : "light only";
     ZTestReport z = test::ztest_against_exact(gpu(test::smoky_furnace_scene(dir, st, true)),
-                                              [](int, int) { return glm::dvec3(1.0); }, test::mis_pooled(0.01));
+                                              [](int, int) { return glm::dvec3(1.0); }, test::pooled(0.01));
     EXPECT_TRUE(z.ok) << name << ": " << z.summary();
     std::printf("GPU smoky furnace, ratio-tracked continuation, %s: %s\n", name, z.summary().c_str());
   }

@@ -35,29 +35,9 @@ namespace {
 using test::ZTestOptions;
 using test::ZTestReport;
 
-glm::dvec3 pixel_mean(const RenderResult& r, int x, int y) {
-  const size_t p = (size_t(y) * r.width + x) * 3;
-  return glm::dvec3(r.sum[p], r.sum[p + 1], r.sum[p + 2]) / double(r.spp);
-}
-
-// Largest per-channel sample variance of a pixel relative to 1 + mean²: ~0
-// when every sample had the same value (float sums on the GPU: ~1e-7).
-double pixel_spread(const RenderResult& r, int x, int y) {
-  const size_t p = (size_t(y) * r.width + x) * 3;
-  double worst = 0.0;
-  for (int c = 0; c < 3; ++c) {
-    const double m = r.sum[p + c] / r.spp;
-    worst = std::max(worst, std::abs(r.sum_sq[p + c] / r.spp - m * m) / (1.0 + m * m));
-  }
-  return worst;
-}
-
-ZTestOptions pooled(double tolerance = 0.005) {
-  ZTestOptions o;
-  o.pool3x3 = true;
-  o.bias_tolerance = tolerance;
-  return o;
-}
+using test::pixel_mean;
+using test::pixel_spread;
+using test::pooled;
 
 // Per-sample values on the GPU are float: a product of a few floats or a
 // bilinear blend of equal texels is within a few ulps of the exact value.

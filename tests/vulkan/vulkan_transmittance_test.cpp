@@ -31,12 +31,8 @@ using test::ZTestReport;
 // whole-image bias tolerance is 0.2 % (not 0.5 %): transmittance estimates are
 // cheap, SE_bias is ~0.02–0.1 % at these spp, and a tighter bound catches a
 // small σt error that the many T = 1 pixels around the grid would dilute.
-ZTestOptions pooled(double tolerance = 0.002) {
-  ZTestOptions o;
-  o.pool3x3 = true;
-  o.bias_tolerance = tolerance;
-  return o;
-}
+constexpr double kBiasTolerance = 0.002;
+using test::pooled;
 
 const char* tracker_name(uint32_t mode) { return mode == 1 ? "ratio" : "delta"; }
 
@@ -65,7 +61,7 @@ class VulkanTransmittance : public test::VulkanFixture {
     RenderResult ratio;
     for (uint32_t mode : {1u, 2u}) {
       RenderResult r = render(s, mode);
-      ZTestReport rep = test::ztest_against_exact(r, exact, pooled());
+      ZTestReport rep = test::ztest_against_exact(r, exact, pooled(kBiasTolerance));
       EXPECT_TRUE(rep.ok) << what << " [" << tracker_name(mode) << "] " << rep.summary();
       EXPECT_GT(r.density_lookups, 0.0) << what;
       EXPECT_EQ(r.events, 0.0) << what << ": transmittance estimates have no real events";
@@ -103,7 +99,7 @@ TEST_F(VulkanTransmittance, DensityRampMatchesClosedForm) {
 
   Scene wrong = s;
   wrong.media[0].density_scale *= 1.02;
-  ZTestReport rep = test::ztest_against_exact(ratio, test::transmittance_exact(wrong, f), pooled());
+  ZTestReport rep = test::ztest_against_exact(ratio, test::transmittance_exact(wrong, f), pooled(kBiasTolerance));
   EXPECT_FALSE(rep.ok) << "a 2 % larger sigma_t was accepted: " << rep.summary();
   std::printf("deliberately wrong (σt +2 %%): %s\n", rep.summary().c_str());
 }
@@ -129,7 +125,7 @@ TEST_F(VulkanTransmittance, CheckerboardMatchesQuadrature) {
 
   // The check can fail: the same checkerboard one voxel over (cells swapped).
   const test::TrilinearVoxelField shifted(lat, box, [&](int i, int j, int k) { return checker(i + 1, j, k); });
-  ZTestReport rep = test::ztest_against_exact(ratio, test::transmittance_exact(s, shifted), pooled());
+  ZTestReport rep = test::ztest_against_exact(ratio, test::transmittance_exact(s, shifted), pooled(kBiasTolerance));
   EXPECT_FALSE(rep.ok) << "a shifted checkerboard was accepted: " << rep.summary();
   std::printf("deliberately wrong (shifted checkerboard): %s\n", rep.summary().c_str());
 }

@@ -35,12 +35,7 @@ using test::settings_for;
 
 // Absorption-estimator samples are Bernoulli-like (Le or background): pool the
 // variance over 3×3 (Stats.h explains).
-ZTestOptions pooled(double tolerance = 0.005) {
-  ZTestOptions o;
-  o.pool3x3 = true;
-  o.bias_tolerance = tolerance;
-  return o;
-}
+using test::pooled;
 
 double per_sample(double count, const RenderResult& r) { return count / (double(r.width) * r.height * r.spp); }
 
