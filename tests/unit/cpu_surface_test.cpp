@@ -1,42 +1,36 @@
-// CPU reference with surfaces and the environment map (issue 6, BSDF/phase
-// sampling only): closed forms wherever a path's value is known exactly
-// (furnaces, one bounce under a constant sky, occluders), the linearised
-// texture and the lat-long orientation against independent implementations of
-// the documented conventions, and a surface lit by an emissive medium.
+// CPU reference with surfaces (issue 6, BSDF/phase sampling only): the cases
+// both backends share run from tests/support/SurfaceSuite.h (Surface.*/cpu);
+// here, the CPU-only ones: the cosine-hemisphere sampler, a surface clipping
+// the medium behind it against a closed form, a surface lit by an emissive
+// medium (both estimators agree) and determinism across thread counts.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
+#include <functional>
+#include <memory>
 #include <numbers>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
-#include "image/Image.h"
-#include "image/ImageIo.h"
 #include "render/cpu/CpuRenderer.h"
 #include "render/cpu/Rng.h"
 #include "render/cpu/Sampling.h"
-#include "support/AnalyticScenes.h"
 #include "support/Stats.h"
-#include "support/SurfaceScenes.h"
-#include "support/TestSupport.h"
+#include "support/SurfaceSuite.h"
 
 namespace pyrolume {
+
+namespace test {
+INSTANTIATE_BACKEND_SUITE(Surface, "cpu");
+}  // namespace test
+
 namespace {
 
 using test::pixel_mean;
-using test::pixel_spread;
 using test::plane_shape;
 using test::pooled;
-using test::srgb_to_linear;
-using test::sphere_shape;
-using test::TexelBytes;
-using test::texture_lookup;
-using test::TexVariant;
-using test::write_open_box_obj;
-using test::ZTestOptions;
 using test::ZTestReport;
 
 constexpr double kPi = std::numbers::pi;
@@ -91,226 +85,7 @@ TEST(CpuSurfaceSampling, CosineHemisphereChiSquare) {
   }
 }
 
-// ------------------------------------------------------------ furnaces ----
-
-// A convex diffuse sphere under a constant sky: a path that reaches it bounces
-// once and escapes (nothing else to hit), so EVERY sample of a pixel fully on
-// the sphere is exactly albedo · background, and 0 when max_depth = 0 (the
-// bounce would be the first scattering event). Pixels fully off it are
-// exactly the background. The escaped ray must leave on the side it arrived:
-// a direction into the sphere would meet its inside and pick up albedo twice.
-struct ConvexSphereCase {
-  Scene scene;
-  glm::dvec3 center{0.3, -0.2, 0.0};
-  double radius = 1.0;
-};
-
-ConvexSphereCase convex_sphere_case(glm::dvec3 albedo, glm::dvec3 background, int max_depth) {
-  ConvexSphereCase k;
-  k.scene = test::analytic_base_scene(32, 24, 16);
-  k.scene.background = background;
-  k.scene.integrator.max_depth = max_depth;
-  k.scene.shapes.push_back(sphere_shape(k.center, k.radius, albedo));
-  return k;
-}
-
-// Classify pixels by the distance of their centre ray from the sphere's centre
-// (margin ≫ the pixel footprint there, ~0.09 units): +1 fully on it, −1 fully
-// off, 0 silhouette.
-int classify(const ConvexSphereCase& k, int x, int y) {
-  const Scene& s = k.scene;
-  glm::dvec3 d = test::film_ray(s.camera, s.film.width, s.film.height, x + 0.5, y + 0.5);
-  glm::dvec3 oc = k.center - s.camera.position;
-  double perp = glm::length(oc - glm::dot(oc, d) * d);
-  if (perp < k.radius - 0.25) return 1;
-  if (perp > k.radius + 0.25) return -1;
-  return 0;
-}
-
-void expect_convex_sphere(const ConvexSphereCase& k, const RenderResult& r, glm::dvec3 on, glm::dvec3 off) {
-  int n_on = 0, n_off = 0;
-  for (int y = 0; y < r.height; ++y)
-    for (int x = 0; x < r.width; ++x) {
-      const int cls = classify(k, x, y);
-      const glm::dvec3 m = pixel_mean(r, x, y);
-      if (cls == 0) {
-        for (int c = 0; c < 3; ++c) {
-          EXPECT_GE(m[c], std::min(on[c], off[c]) - 1e-12);
-          EXPECT_LE(m[c], std::max(on[c], off[c]) + 1e-12);
-        }
-        continue;
-      }
-      const glm::dvec3 want = cls > 0 ? on : off;
-      (cls > 0 ? n_on : n_off)++;
-      for (int c = 0; c < 3; ++c) EXPECT_NEAR(m[c], want[c], 1e-12) << "pixel " << x << "," << y << " c " << c;
-      EXPECT_LE(pixel_spread(r, x, y), 1e-12) << "pixel " << x << "," << y;
-    }
-  EXPECT_GT(n_on, 50);
-  EXPECT_GT(n_off, 50);
-  EXPECT_EQ(r.nonfinite_samples, 0u);
-}
-
-TEST(CpuSurface, FurnaceConvexSphereAlbedoOneIsOne) {
-  ConvexSphereCase k = convex_sphere_case(glm::dvec3(1.0), glm::dvec3(1.0), 100);
-  expect_convex_sphere(k, render(k.scene), glm::dvec3(1.0), glm::dvec3(1.0));
-}
-
-TEST(CpuSurface, ConvexSphereOneBounceIsAlbedoTimesBackground) {
-  const glm::dvec3 a(0.25, 0.5, 0.75), bg(0.8, 1.0, 1.2);
-  for (int depth : {1, 8}) {
-    ConvexSphereCase k = convex_sphere_case(a, bg, depth);
-    RenderResult r = render(k.scene);
-    expect_convex_sphere(k, r, a * bg, bg);
-    EXPECT_GT(r.events, 0.0);
-  }
-}
-
-TEST(CpuSurface, MaxDepthZeroEndsAtTheSurface) {
-  ConvexSphereCase k = convex_sphere_case(glm::dvec3(1.0), glm::dvec3(1.0), 0);
-  RenderResult r = render(k.scene);
-  expect_convex_sphere(k, r, glm::dvec3(0.0), glm::dvec3(1.0));
-  EXPECT_GT(r.events, 0.0);  // the bounce that max_depth ends still counts
-}
-
-// Every camera sample of this scene meets exactly one surface (an infinite
-// plane filling the view) and escapes: events = one per camera sample.
-TEST(CpuSurface, SurfaceBounceCountsAsOneEvent) {
-  Scene s = test::analytic_base_scene(8, 8, 8);
-  s.background = glm::dvec3(1.0);
-  s.shapes.push_back(plane_shape({0, 0, 1}, {0, 0, -1}, {0, 0}, glm::dvec3(0.5)));
-  RenderResult r = render(s);
-  EXPECT_DOUBLE_EQ(r.events, 8.0 * 8.0 * 8.0);
-  for (int y = 0; y < 8; ++y)
-    for (int x = 0; x < 8; ++x) EXPECT_NEAR(pixel_mean(r, x, y).x, 0.5, 1e-12);
-}
-
-// A concave world with inter-reflections: an open-topped box (an OBJ mesh,
-// through the BVH) with a sphere standing in it and a scattering,
-// non-absorbing, non-emitting medium overlapping both (rays start inside it,
-// surfaces sit inside it). Albedo 1 everywhere and a white sky: every path
-// that escapes returns exactly 1 (white furnace), whatever the number of
-// bounces, with either estimator; with max_depth = 1 paths needing a second
-// bounce die, so the image must darken (this scene does inter-reflect).
-
-Scene concave_furnace_scene(const std::filesystem::path& obj, int max_depth) {
-  Scene s = test::analytic_base_scene(24, 24, 16);
-  s.camera.position = {0.6, 4.0, -2.5};
-  s.camera.look_at = {0.0, -0.5, 0.0};
-  s.background = glm::dvec3(1.0);
-  s.integrator.max_depth = max_depth;
-  Shape box;
-  box.type = Shape::Type::Mesh;
-  box.mesh = obj;
-  box.albedo = glm::dvec3(1.0);
-  s.shapes.push_back(box);
-  s.shapes.push_back(sphere_shape({0.2, -0.4, 0.1}, 0.55, glm::dvec3(1.0)));
-  s.media.push_back(test::homogeneous_box("fog", {-1.5, -1.5, -1.5}, {1.5, 0.5, 1.5}, glm::dvec3(0.0),
-                                          {0.6, 1.0, 1.6}, 0.4, std::nullopt));
-  return s;
-}
-
-TEST(CpuSurface, FurnaceConcaveMeshSphereAndMediumIsOne) {
-  auto obj = write_open_box_obj(test::temp_dir("cpu_surface_furnace"));
-  for (const char* estimator : {"absorption", "collision"}) {
-    Scene s = concave_furnace_scene(obj, 1000);
-    s.integrator.emission_estimator = estimator;
-    RenderResult r = render(s);
-    EXPECT_EQ(r.nonfinite_samples, 0u);
-    for (int y = 0; y < r.height; ++y)
-      for (int x = 0; x < r.width; ++x) {
-        const glm::dvec3 m = pixel_mean(r, x, y);
-        for (int c = 0; c < 3; ++c) EXPECT_NEAR(m[c], 1.0, 1e-12) << estimator << " pixel " << x << "," << y;
-      }
-    EXPECT_GT(r.events / (double(r.width) * r.height * r.spp), 1.5) << "paths should bounce and scatter";
-  }
-  // Surface bounces and medium scatterings share max_depth: allow one event
-  // and the concave box loses light.
-  RenderResult shallow = render(concave_furnace_scene(obj, 1));
-  double total = 0.0;
-  for (double v : shallow.sum) total += v;
-  EXPECT_LT(total / (double(shallow.sum.size()) * shallow.spp), 0.9);
-}
-
-// --------------------------------------------------------------- texture ----
-
-// A textured plane under a white sky, max_depth 1: a sample that hits the
-// plane bounces once and escapes, L = albedo(uv) exactly, so each pixel's mean
-// is the texture averaged over the pixel footprint. The expectation uses an
-// independent decode of the PNG's bytes (IEC 61966-2-1) and an independent
-// bilinear/wrap lookup with the documented v flip (uv (0, 0) = the image's
-// bottom-left). Wrong decoding (bytes taken as linear) or a missing flip must
-// fail the same z-test.
-
-TEST(CpuSurface, TexturedPlaneShowsLinearisedTexture) {
-  const TexelBytes bytes;
-  auto dir = test::temp_dir("cpu_surface_texture");
-  // Linear values that encode to exactly these bytes (round(255·encode(decode(b/255))) = b).
-  const auto png = test::write_texel_png(bytes, dir);
-
-  Scene s = test::analytic_base_scene(24, 24, 128);
-  s.background = glm::dvec3(1.0);
-  s.integrator.max_depth = 1;
-  // Plane z = 0, normal +z (facing away: the camera sees its back side), 4 × 4
-  // units. SceneSurfaces: u axis = world +X projected; v axis = cross(n, u) = +Y.
-  const glm::dvec3 tint(1.0, 0.9, 0.8);
-  Shape plane = plane_shape({0, 0, 0}, {0, 0, 1}, {4, 4}, tint);
-  plane.texture = png;
-  s.shapes.push_back(plane);
-  RenderResult r = render(s);
-  EXPECT_EQ(r.nonfinite_samples, 0u);
-
-  auto exact_for = [&](TexVariant v) {
-    const int W = s.film.width, H = s.film.height;
-    auto vals = std::make_shared<std::vector<glm::dvec3>>(size_t(W) * H);
-    auto L = [&](double fx, double fy, int* sig) {
-      const glm::dvec3 d = test::film_ray(s.camera, W, H, fx, fy);
-      const double t = -s.camera.position.z / d.z;
-      const glm::dvec3 p = s.camera.position + t * d;
-      if (std::abs(p.x) > 2.0 || std::abs(p.y) > 2.0) {
-        *sig = -1;
-        return s.background;
-      }
-      return tint * texture_lookup(bytes, {p.x / 4.0 + 0.5, p.y / 4.0 + 0.5}, v, sig);
-    };
-    for (int y = 0; y < H; ++y)
-      for (int x = 0; x < W; ++x) (*vals)[size_t(y) * W + x] = test::pixel_average(L, x, y);
-    return std::function<glm::dvec3(int, int)>([vals, W](int x, int y) { return (*vals)[size_t(y) * W + x]; });
-  };
-  ZTestReport ok = test::ztest_against_exact(r, exact_for(TexVariant::Correct), pooled());
-  EXPECT_TRUE(ok.ok) << ok.summary();
-  std::printf("texture: %s\n", ok.summary().c_str());
-  ZTestReport no_flip = test::ztest_against_exact(r, exact_for(TexVariant::NoFlip), pooled());
-  EXPECT_FALSE(no_flip.fraction_ok) << no_flip.summary();
-  ZTestReport no_decode = test::ztest_against_exact(r, exact_for(TexVariant::NoDecode), pooled());
-  EXPECT_FALSE(no_decode.fraction_ok) << no_decode.summary();
-}
-
 // ----------------------------------------------------------- occlusion ----
-
-// An infinite plane between the camera and a bright emissive sphere: the
-// camera sees only the plane, and the plane's bounce leaves toward the camera's
-// side where there is nothing, so every sample is exactly albedo · background
-// (the glow must not leak through). Without the plane the glow shows.
-TEST(CpuSurface, PlaneOccludesEmissiveMedium) {
-  const glm::dvec3 a(0.5, 0.25, 0.8), bg(0.2, 0.4, 0.6);
-  for (const char* estimator : {"absorption", "collision"}) {
-    Scene s = test::analytic_base_scene(16, 16, 16);
-    s.background = bg;
-    s.integrator.emission_estimator = estimator;
-    s.media.push_back(test::homogeneous_sphere("glow", {0, 0, 0}, 1.0, {2, 2, 2}, {0.5, 0.5, 0.5}, 0.0,
-                                               glm::dvec3(5.0, 3.0, 1.0)));
-    Scene open = s;
-    s.shapes.push_back(plane_shape({0, 0, -1.5}, {0, 0, 1}, {0, 0}, a));
-    RenderResult r = render(s);
-    for (int y = 0; y < r.height; ++y)
-      for (int x = 0; x < r.width; ++x) {
-        const glm::dvec3 m = pixel_mean(r, x, y);
-        for (int c = 0; c < 3; ++c) EXPECT_NEAR(m[c], a[c] * bg[c], 1e-12) << estimator << " " << x << "," << y;
-      }
-    RenderResult glow = render(open);
-    EXPECT_GT(pixel_mean(glow, 8, 8).x, 1.0) << estimator;
-  }
-}
 
 // A black infinite plane through the centre of an absorbing emissive sphere:
 // only the half in front of the plane is seen, so with the chord ℓ clipped at
@@ -396,109 +171,6 @@ TEST(CpuSurface, DeterministicAcrossThreadCounts) {
   EXPECT_EQ(a.sum, b.sum);
   EXPECT_EQ(a.sum_sq, b.sum_sq);
   EXPECT_EQ(a.events, b.events);
-}
-
-// ---------------------------------------------------------- environment ----
-
-// The documented lat-long convention (EnvironmentMap.h, Blender's), written
-// here independently: +Z up, θ from +Z, φ = atan2(y, x), u = (π − φ)/(2π),
-// v = θ/π (row 0 = top = +Z); rotation_deg turns the map about +Z, so a
-// direction d sees the unrotated map at Rz(−rotation)·d; bilinear between
-// texel centres, wrapping in u, clamping in v; × scale.
-struct EnvTexels {
-  int w = 8, h = 4;
-  std::vector<float> rgb;
-  EnvTexels() {
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        rgb.push_back(0.1f + 0.3f * x);                      // r grows with u
-        rgb.push_back(2.0f - 0.5f * y);                      // g: bright at the top
-        rgb.push_back((x + 2 * y) % 3 == 0 ? 1.5f : 0.25f);  // b: a pattern
-      }
-  }
-};
-
-glm::dvec3 env_radiance(const EnvTexels& e, glm::dvec3 d, double scale, double rot_deg, int* sig) {
-  d = glm::normalize(d);
-  const double r = rot_deg * kPi / 180.0;
-  const double x = std::cos(r) * d.x + std::sin(r) * d.y, y = -std::sin(r) * d.x + std::cos(r) * d.y;
-  double u = (kPi - std::atan2(y, x)) / (2.0 * kPi);
-  u -= std::floor(u);
-  const double v = std::acos(std::clamp(d.z, -1.0, 1.0)) / kPi;
-  const double X = u * e.w - 0.5, Y = v * e.h - 0.5;
-  const double x0 = std::floor(X), y0 = std::floor(Y), fx = X - x0, fy = Y - y0;
-  if (sig) *sig = int(x0) * 1000 + int(y0);
-  auto texel = [&](int i, int j) {
-    i = ((i % e.w) + e.w) % e.w;
-    j = std::clamp(j, 0, e.h - 1);
-    const size_t k = (size_t(j) * e.w + i) * 3;
-    return glm::dvec3(e.rgb[k], e.rgb[k + 1], e.rgb[k + 2]);
-  };
-  const int i = int(x0), j = int(y0);
-  return scale * ((1 - fy) * ((1 - fx) * texel(i, j) + fx * texel(i + 1, j)) +
-                  fy * ((1 - fx) * texel(i, j + 1) + fx * texel(i + 1, j + 1)));
-}
-
-TEST(CpuSurface, EnvironmentMapSeenByCameraRays) {
-  const EnvTexels env;
-  auto dir = test::temp_dir("cpu_surface_env");
-  Image img = make_image(env.w, env.h);
-  img.rgb = env.rgb;
-  const auto exr = dir / "sky.exr";
-  write_image(exr, img);
-
-  const double scale = 1.5, rot = 30.0;
-  Scene s = test::analytic_base_scene(32, 20, 32);
-  s.camera.position = {0, 0, 0};
-  s.camera.look_at = {1.0, 0.4, 0.3};
-  s.camera.up = {0, 0, 1};
-  s.camera.fov_deg = 100.0;
-  s.background = glm::dvec3(7.0);  // must not be seen
-  s.environment = Environment{exr, scale, rot};
-  RenderResult r = render(s);
-  EXPECT_EQ(r.nonfinite_samples, 0u);
-  EXPECT_EQ(r.events, 0.0);
-
-  auto exact_for = [&](double rotation, bool mirror_u) {
-    const int W = s.film.width, H = s.film.height;
-    auto vals = std::make_shared<std::vector<glm::dvec3>>(size_t(W) * H);
-    auto L = [&](double fx, double fy, int* sig) {
-      glm::dvec3 d = test::film_ray(s.camera, W, H, fx, fy);
-      if (mirror_u) d.y = -d.y;  // u growing counter-clockwise instead
-      return env_radiance(env, d, scale, rotation, sig);
-    };
-    for (int y = 0; y < H; ++y)
-      for (int x = 0; x < W; ++x) (*vals)[size_t(y) * W + x] = test::pixel_average(L, x, y);
-    return std::function<glm::dvec3(int, int)>([vals, W](int x, int y) { return (*vals)[size_t(y) * W + x]; });
-  };
-  ZTestReport ok = test::ztest_against_exact(r, exact_for(rot, false), pooled());
-  EXPECT_TRUE(ok.ok) << ok.summary();
-  std::printf("environment: %s\n", ok.summary().c_str());
-  ZTestReport unrotated = test::ztest_against_exact(r, exact_for(0.0, false), pooled());
-  EXPECT_FALSE(unrotated.fraction_ok) << unrotated.summary();
-  ZTestReport mirrored = test::ztest_against_exact(r, exact_for(rot, true), pooled());
-  EXPECT_FALSE(mirrored.fraction_ok) << mirrored.summary();
-}
-
-// Scattered rays see the environment too (not background.rgb): a uniform map
-// around the convex sphere gives albedo · scale · value on it, exactly, by
-// BSDF sampling alone (light sampling the map would add noise to the exact
-// value, so it is turned off).
-TEST(CpuSurface, EnvironmentMapSeenByScatteredRays) {
-  auto dir = test::temp_dir("cpu_surface_env_uniform");
-  Image img = make_image(4, 2);
-  for (size_t p = 0; p < img.pixel_count(); ++p) {
-    img.rgb[p * 3 + 0] = 0.25f;  // exact in float and half
-    img.rgb[p * 3 + 1] = 0.5f;
-    img.rgb[p * 3 + 2] = 0.75f;
-  }
-  const auto exr = dir / "uniform.exr";
-  write_image(exr, img);
-  const glm::dvec3 a(0.5, 0.8, 1.0), sky = 2.0 * glm::dvec3(0.25, 0.5, 0.75);
-  ConvexSphereCase k = convex_sphere_case(a, glm::dvec3(9.0), 4);
-  k.scene.environment = Environment{exr, 2.0, 45.0};
-  k.scene.integrator.mis = false;
-  expect_convex_sphere(k, render(k.scene), a * sky, sky);
 }
 
 }  // namespace
