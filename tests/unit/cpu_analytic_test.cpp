@@ -1,5 +1,7 @@
-// CPU reference vs closed forms (issue 2: analytic tests), plus determinism,
-// progressive control and robustness of the reference itself.
+// CPU reference vs closed forms (issue 2: analytic tests): the cases both
+// backends share run from tests/support/AnalyticSuite.h (Analytic.*/cpu);
+// here, the CPU-only ones, plus determinism, progressive control and
+// robustness of the reference.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -9,10 +11,15 @@
 
 #include "color/Blackbody.h"
 #include "render/cpu/CpuRenderer.h"
-#include "support/AnalyticScenes.h"
+#include "support/AnalyticSuite.h"
 #include "support/Stats.h"
 
 namespace pyrolume {
+
+namespace test {
+INSTANTIATE_BACKEND_SUITE(Analytic, "cpu");
+}  // namespace test
+
 namespace {
 
 using test::ZTestOptions;
@@ -33,44 +40,9 @@ bool all_finite(const RenderResult& r) {
   return true;
 }
 
-// Absorption-estimator samples are Le or background (Bernoulli-like): silhouette
-// pixels with few hits can show s² = 0 by chance, so pool (Stats.h explains).
+// Absorption-estimator samples are Le or background (Bernoulli-like): pooled
+// (Stats.h explains).
 using test::pooled;
-
-TEST(CpuAnalytic, AbsorbingSphereMatchesClosedForm) {
-  Scene s = test::absorbing_sphere_scene();
-  RenderResult r = render(s);
-  EXPECT_EQ(r.spp, s.film.spp);
-  EXPECT_EQ(r.nonfinite_samples, 0u);
-  ZTestReport rep = test::ztest_against_exact(r, test::single_collision_exact(s), pooled());
-  EXPECT_TRUE(rep.ok) << rep.summary();
-  EXPECT_LE(rep.se_bias, 0.0025) << rep.summary();
-  std::printf("%s\n", rep.summary().c_str());
-}
-
-TEST(CpuAnalytic, AbsorbingBoxMatchesClosedForm) {
-  Scene s = test::absorbing_box_scene();
-  RenderResult r = render(s);
-  EXPECT_EQ(r.nonfinite_samples, 0u);
-  ZTestReport rep = test::ztest_against_exact(r, test::single_collision_exact(s), pooled());
-  EXPECT_TRUE(rep.ok) << rep.summary();
-  EXPECT_LE(rep.se_bias, 0.0025) << rep.summary();
-  std::printf("%s\n", rep.summary().c_str());
-}
-
-TEST(CpuAnalytic, MaxDepthZeroTreatsScatteringAsExtinction) {
-  Scene s = test::depth0_sphere_scene();
-  RenderResult r = render(s);
-  ZTestReport rep = test::ztest_against_exact(r, test::single_collision_exact(s), pooled());
-  EXPECT_TRUE(rep.ok) << rep.summary();
-  std::printf("%s\n", rep.summary().c_str());
-  // The same scene with scattering allowed is brighter (in-scattered emission):
-  // max_depth really truncates.
-  s.integrator.max_depth = 8;
-  ZTestReport deeper = test::ztest_against_exact(render(s), test::single_collision_exact(s), pooled());
-  EXPECT_FALSE(deeper.bias_ok) << deeper.summary();
-  EXPECT_GT(deeper.bias, 0.0);
-}
 
 // The closed-form pixel means are quadrature; a finer quadrature must agree far
 // below the render's standard errors, or the z-tests above would test it instead.
@@ -111,24 +83,6 @@ TEST(CpuAnalytic, ChromaticScatteringSelfConsistentAndSensitiveToG) {
   std::printf("g flipped: %s\n", flipped.summary().c_str());
 }
 
-TEST(CpuAnalytic, EquilibriumInsideLargeSphere) {
-  Scene s = test::equilibrium_sphere_scene();
-  RenderResult r = render(s);
-  glm::dvec3 Le = test::equilibrium_radiance(s);
-  ZTestReport rep = test::ztest_against_exact(r, [&](int, int) { return Le; });
-  EXPECT_TRUE(rep.ok) << rep.summary();
-  std::printf("%s\n", rep.summary().c_str());
-  // Expected collisions per channel walk until absorption: σt/σa (geometric).
-  double expect = 0.0;
-  for (int c = 0; c < 3; ++c) {
-    const Medium& m = s.media[0];
-    expect += (m.sigma_a[c] + m.sigma_s[c]) / m.sigma_a[c] / 3.0;
-  }
-  double per_sample = r.events / (double(r.width) * r.height * r.spp);
-  EXPECT_NEAR(per_sample, expect, 0.02 * expect);
-  EXPECT_EQ(r.density_lookups, 0.0);
-}
-
 // emission.temperature_k: Le = scale × color::blackbody_rgb(T, mode, observer,
 // adapt_to_k); equilibrium makes the pixel value exactly that.
 TEST(CpuAnalytic, BlackbodyEmissionInEquilibrium) {
@@ -141,13 +95,6 @@ TEST(CpuAnalytic, BlackbodyEmissionInEquilibrium) {
   glm::dvec3 Le = 3.0 * color::blackbody_rgb(1800.0, BlackbodyMode::Seed, 2, std::nullopt);
   ASSERT_GT(Le.r, 0.0);
   ZTestReport rep = test::ztest_against_exact(render(s), [&](int, int) { return Le; });
-  EXPECT_TRUE(rep.ok) << rep.summary();
-}
-
-TEST(CpuAnalytic, WhiteFurnaceConservesEnergy) {
-  Scene s = test::white_furnace_scene();
-  RenderResult r = render(s);
-  ZTestReport rep = test::ztest_against_exact(r, [&](int, int) { return s.background; });
   EXPECT_TRUE(rep.ok) << rep.summary();
 }
 

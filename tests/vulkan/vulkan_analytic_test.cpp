@@ -1,66 +1,32 @@
 // The Vulkan backend against closed forms and against the CPU reference
 // (issue 2 tests), with validation layers on: any validation message fails.
+// The closed-form cases both backends share run from
+// tests/support/AnalyticSuite.h (Analytic.*/vulkan); here, the GPU-only ones.
 #include <gtest/gtest.h>
 
 #include "render/Backend.h"
 #include "render/cpu/CpuRenderer.h"
-#include "support/VulkanFixture.h"
-#include "support/AnalyticScenes.h"
+#include "support/AnalyticSuite.h"
 #include "support/Stats.h"
 
 namespace pyrolume {
+
+namespace test {
+INSTANTIATE_BACKEND_SUITE(Analytic, "vulkan");
+}  // namespace test
+
 namespace {
 
 using test::settings_for;
 
-class VulkanAnalytic : public test::VulkanFixture {
+// TimeLimitAndCancelStopEarly renders through vulkan_backend() directly:
+// render() would insist on every sample asked for.
+class VulkanAnalytic : public test::AnalyticFixture {
  protected:
-
-  RenderResult render(const Scene& s) { return backend_->render(s, settings_for(s), {}); }
-
+  VulkanAnalytic() : test::AnalyticFixture("vulkan") {}
 };
 
 using test::pooled;
-
-TEST_F(VulkanAnalytic, AbsorbingSphereMatchesClosedForm) {
-  Scene s = test::absorbing_sphere_scene();
-  RenderResult r = render(s);
-  EXPECT_EQ(r.spp, s.film.spp);
-  EXPECT_EQ(r.nonfinite_samples, 0u);
-  test::ZTestReport rep = test::ztest_against_exact(r, test::single_collision_exact(s), pooled());
-  EXPECT_TRUE(rep.ok) << rep.summary();
-  EXPECT_LE(rep.se_bias, 0.0025) << rep.summary();
-  std::printf("%s\n", rep.summary().c_str());
-}
-
-TEST_F(VulkanAnalytic, AbsorbingBoxMatchesClosedForm) {
-  Scene s = test::absorbing_box_scene();
-  RenderResult r = render(s);
-  test::ZTestReport rep = test::ztest_against_exact(r, test::single_collision_exact(s), pooled());
-  EXPECT_TRUE(rep.ok) << rep.summary();
-  std::printf("%s\n", rep.summary().c_str());
-}
-
-TEST_F(VulkanAnalytic, MaxDepthZeroTreatsScatteringAsExtinction) {
-  Scene s = test::depth0_sphere_scene();
-  test::ZTestReport rep = test::ztest_against_exact(render(s), test::single_collision_exact(s), pooled());
-  EXPECT_TRUE(rep.ok) << rep.summary();
-}
-
-TEST_F(VulkanAnalytic, EquilibriumInsideLargeSphere) {
-  Scene s = test::equilibrium_sphere_scene();
-  RenderResult r = render(s);
-  glm::dvec3 Le = test::equilibrium_radiance(s);
-  test::ZTestReport rep = test::ztest_against_exact(r, [&](int, int) { return Le; });
-  EXPECT_TRUE(rep.ok) << rep.summary();
-  std::printf("%s\n", rep.summary().c_str());
-}
-
-TEST_F(VulkanAnalytic, WhiteFurnaceConservesEnergy) {
-  Scene s = test::white_furnace_scene();
-  test::ZTestReport rep = test::ztest_against_exact(render(s), [&](int, int) { return s.background; });
-  EXPECT_TRUE(rep.ok) << rep.summary();
-}
 
 // Shader vs CPU on a scattering scene with chromatic sigma, g != 0 and two
 // overlapping media: per-pixel z-test and the bias formula of docs/testing.md.
@@ -107,7 +73,7 @@ TEST_F(VulkanAnalytic, TimeLimitAndCancelStopEarly) {
   ctl.progress = [&](int, int) {
     if (++passes == 2) cancel = true;
   };
-  RenderResult r = backend_->render(s, rs, ctl);
+  RenderResult r = vulkan_backend().render(s, rs, ctl);
   EXPECT_TRUE(r.cancelled);
   EXPECT_EQ(passes, 2);
   EXPECT_LT(r.spp, rs.spp);

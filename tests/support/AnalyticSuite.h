@@ -1,0 +1,81 @@
+#pragma once
+// Homogeneous media against closed forms (issue 2: analytic tests) on either
+// backend. One body per case, instantiated for the CPU reference by
+// tests/unit/cpu_analytic_test.cpp and for Vulkan by
+// tests/vulkan/vulkan_analytic_test.cpp (BackendSuite.h explains); the cases
+// only one backend has stay in those files. Absorption-estimator samples are
+// Le or background (Bernoulli-like): silhouette pixels with few hits can show
+// s² = 0 by chance, so the z-tests pool (Stats.h explains).
+#include <cstdio>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "support/AnalyticScenes.h"
+#include "support/BackendSuite.h"
+#include "support/Stats.h"
+
+namespace pyrolume::test {
+
+class AnalyticFixture : public BackendFixture {
+ protected:
+  explicit AnalyticFixture(const std::string& backend) : BackendFixture(backend) {}
+
+  // The render against single_collision_exact, informative to SE_bias 0.25 %.
+  void expect_single_collision_closed_form(const Scene& s) {
+    RenderResult r = render(s);
+    ZTestReport rep = ztest_against_exact(r, single_collision_exact(s), pooled());
+    EXPECT_TRUE(rep.ok) << rep.summary();
+    EXPECT_LE(rep.se_bias, 0.0025) << rep.summary();
+    std::printf("%s\n", rep.summary().c_str());
+  }
+};
+
+using Analytic = BackendSuite<AnalyticFixture>;
+
+TEST_P(Analytic, AbsorbingSphereMatchesClosedForm) { expect_single_collision_closed_form(absorbing_sphere_scene()); }
+
+TEST_P(Analytic, AbsorbingBoxMatchesClosedForm) { expect_single_collision_closed_form(absorbing_box_scene()); }
+
+TEST_P(Analytic, MaxDepthZeroTreatsScatteringAsExtinction) {
+  Scene s = depth0_sphere_scene();
+  RenderResult r = render(s);
+  ZTestReport rep = ztest_against_exact(r, single_collision_exact(s), pooled());
+  EXPECT_TRUE(rep.ok) << rep.summary();
+  std::printf("%s\n", rep.summary().c_str());
+  // The same scene with scattering allowed is brighter (in-scattered emission):
+  // max_depth really truncates.
+  s.integrator.max_depth = 8;
+  ZTestReport deeper = ztest_against_exact(render(s), single_collision_exact(s), pooled());
+  EXPECT_FALSE(deeper.bias_ok) << deeper.summary();
+  EXPECT_GT(deeper.bias, 0.0);
+}
+
+TEST_P(Analytic, EquilibriumInsideLargeSphere) {
+  Scene s = equilibrium_sphere_scene();
+  RenderResult r = render(s);
+  glm::dvec3 Le = equilibrium_radiance(s);
+  ZTestReport rep = ztest_against_exact(r, [&](int, int) { return Le; });
+  EXPECT_TRUE(rep.ok) << rep.summary();
+  std::printf("%s\n", rep.summary().c_str());
+  if (cpu()) {
+    // The CPU tracks each channel's walk: expected collisions per channel walk
+    // until absorption: σt/σa (geometric).
+    double expect = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      const Medium& m = s.media[0];
+      expect += (m.sigma_a[c] + m.sigma_s[c]) / m.sigma_a[c] / 3.0;
+    }
+    double per_sample = r.events / (double(r.width) * r.height * r.spp);
+    EXPECT_NEAR(per_sample, expect, 0.02 * expect);
+    EXPECT_EQ(r.density_lookups, 0.0);
+  }
+}
+
+TEST_P(Analytic, WhiteFurnaceConservesEnergy) {
+  Scene s = white_furnace_scene();
+  ZTestReport rep = ztest_against_exact(render(s), [&](int, int) { return s.background; });
+  EXPECT_TRUE(rep.ok) << rep.summary();
+}
+
+}  // namespace pyrolume::test
