@@ -58,6 +58,18 @@ class VdbFixture : public BackendFixture, public ConstantBoxSetup {
     return r;
   }
 
+  // The view of the sparse explosion shell (write_explosion_shell_vdb) that the
+  // estimator and majorant comparisons render: camera on −z looking at the
+  // origin, a coloured sky, paths up to max_depth.
+  static Scene shell_view(int w, int h, int spp, glm::dvec3 background, int max_depth, double camera_z = -3.5) {
+    Scene s = vdb_base_scene(w, h, spp);
+    s.camera.position = {0.3, 0.4, camera_z};
+    s.camera.look_at = {0.0, 0.0, 0.0};
+    s.background = background;
+    s.integrator.max_depth = max_depth;
+    return s;
+  }
+
   // Two scenes with the same grid, one with NaN in some voxels, the other with
   // 0 there.
   std::pair<Scene, Scene> nan_and_zero_scenes() {

@@ -38,11 +38,7 @@ class CpuVdb : public test::VdbFixture {
 // overlapping a homogeneous emissive sphere.
 TEST_F(CpuVdb, AbsorptionAndCollisionEstimatorsAgreeWithScattering) {
   const test::Lattice shell_lat{0.07, {0.0, 0.0, 0.0}};
-  Scene s = test::vdb_base_scene(24, 24, 512);
-  s.camera.position = {0.3, 0.4, -3.5};
-  s.camera.look_at = {0.0, 0.0, 0.0};
-  s.background = {0.1, 0.15, 0.3};
-  s.integrator.max_depth = 8;
+  Scene s = shell_view(24, 24, 512, {0.1, 0.15, 0.3}, 8);
   s.media.push_back(test::vdb_medium("shell", test::write_explosion_shell_vdb(dir / "shell.vdb", shell_lat),
                                      {1.0, 1.5, 2.0}, {2.0, 1.5, 1.0}, 0.5, glm::dvec3(1.5, 0.7, 0.2), 1.0));
   s.media[0].density_scale = 2.0;
@@ -64,11 +60,7 @@ TEST_F(CpuVdb, AbsorptionAndCollisionEstimatorsAgreeWithScattering) {
 // the collision estimator evaluates Planck at every tentative collision).
 TEST_F(CpuVdb, EstimatorsAgreeWithTemperatureEmission) {
   const test::Lattice shell_lat{0.07, {0.0, 0.0, 0.0}};
-  Scene s = test::vdb_base_scene(16, 16, 256);
-  s.camera.position = {0.3, 0.4, -3.5};
-  s.camera.look_at = {0.0, 0.0, 0.0};
-  s.background = {0.1, 0.1, 0.1};
-  s.integrator.max_depth = 4;
+  Scene s = shell_view(16, 16, 256, {0.1, 0.1, 0.1}, 4);
   s.media.push_back(test::vdb_medium("shell", test::write_explosion_shell_vdb(dir / "shell.vdb", shell_lat),
                                      {1.0, 1.0, 1.0}, {1.0, 1.0, 1.0}, 0.3, std::nullopt, 2.0, true));
   s.media[0].emission.blackbody = BlackbodyMode::Seed;

@@ -96,11 +96,7 @@ TEST_F(VulkanVdb, ZeroMajorantRegionsAreSkipped) {
 // coloured background.
 TEST_F(VulkanVdb, EstimatorsAgreeOnScatteringChromaticTemperatureScene) {
   const test::Lattice shell_lat{0.07, {0.0, 0.0, 0.0}};
-  Scene s = test::vdb_base_scene(32, 32, 1024);
-  s.camera.position = {0.3, 0.4, -3.5};
-  s.camera.look_at = {0.0, 0.0, 0.0};
-  s.background = {0.1, 0.15, 0.3};
-  s.integrator.max_depth = 8;
+  Scene s = shell_view(32, 32, 1024, {0.1, 0.15, 0.3}, 8);
   s.media.push_back(test::vdb_medium("shell", test::write_explosion_shell_vdb(dir / "shell.vdb", shell_lat),
                                      {1.0, 1.5, 2.0}, {2.0, 1.5, 1.0}, 0.5, std::nullopt, 2.0, true));
   s.media[0].density_scale = 2.0;
@@ -133,11 +129,7 @@ TEST_F(VulkanVdb, EstimatorsAgreeOnScatteringChromaticTemperatureScene) {
 // density lookups: at the default resolution and at 16³ cells.
 TEST_F(VulkanVdb, MajorantGridMatchesGlobalWithFewerLookups) {
   const test::Lattice shell_lat{0.05, {0.0, 0.0, 0.0}};
-  Scene s = test::vdb_base_scene(32, 32, 512);
-  s.camera.position = {0.3, 0.4, -4.0};
-  s.camera.look_at = {0.0, 0.0, 0.0};
-  s.background = {0.1, 0.15, 0.3};
-  s.integrator.max_depth = 4;
+  Scene s = shell_view(32, 32, 512, {0.1, 0.15, 0.3}, 4, -4.0);
   s.integrator.emission_estimator = "collision";
   s.media.push_back(test::vdb_medium("shell",
                                      test::write_explosion_shell_vdb(dir / "shell.vdb", shell_lat, 20.0, 30.0, 1.0f),
