@@ -1,8 +1,8 @@
-// Next-event estimation and MIS in the CPU reference (docs/mis.md): MIS,
-// BSDF/phase sampling only and light sampling only converge to the same image
-// (z-tests, with and without surfaces and sky), furnaces stay exactly 1 with
-// the sky sampled as a light, and MIS lowers the noise where the fire lights a
-// surface.
+// Next-event estimation and MIS in the CPU reference (docs/mis.md): the cases
+// both backends share run from tests/support/MisSuite.h (Mis.*/cpu); here,
+// the CPU-only ones: MIS and BSDF/phase sampling only converge to the same
+// image with a scattering emitter, a scattering furnace stays 1 with the sky
+// as a light, and the light choice and strategy rules.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,10 +14,15 @@
 #include "light/EnvironmentMap.h"
 #include "light/LightSelection.h"
 #include "render/cpu/CpuRenderer.h"
-#include "support/MisScenes.h"
+#include "support/MisSuite.h"
 #include "support/Stats.h"
 
 namespace pyrolume {
+
+namespace test {
+INSTANTIATE_BACKEND_SUITE(Mis, "cpu");
+}  // namespace test
+
 namespace {
 
 using test::Strategy;
@@ -31,12 +36,6 @@ RenderResult render(const Scene& s) {
   EXPECT_EQ(res.nonfinite_samples, 0u);
   test::expect_strategy_as_written(s, res);
   return res;
-}
-
-// Terrain-like: an absorbing fire over a plane under a sky. All three
-// strategies have finite variance here.
-TEST(CpuMis, FireOverPlaneWithSkyStrategiesAgree) {
-  test::expect_strategies_agree([](const Scene& s) { return render(s); }, test::temp_dir("cpu_mis_plane"), 1024, "");
 }
 
 // The fire scatters too: MIS at medium vertices inside the emitter.
@@ -53,36 +52,6 @@ TEST(CpuMis, ScatteringEmissiveMediumMisAgrees) {
   test::expect_same_image(mis, bsdf, 0.02, "MIS vs phase only");
 }
 
-// The fire lights the plane: at equal spp, MIS has far less variance on plane
-// pixels than BSDF sampling, which must hit the small box by chance (measured
-// 17–130× by row; the bar for terrain_explosion is 4×).
-TEST(CpuMis, MisLowersVarianceOnLitPlane) {
-  const auto dir = test::temp_dir("cpu_mis_plane");
-  Scene s_bsdf = test::fire_over_plane_scene(dir, Strategy::Bsdf, false, false, 24, 18, 64);
-  RenderResult bsdf = render(s_bsdf);
-  RenderResult mis = render(test::fire_over_plane_scene(dir, Strategy::Mis, false, false, 24, 18, 64));
-  // The bottom quarter: plane in front of the box, camera rays through no medium.
-  const int first = s_bsdf.film.height * 3 / 4;
-  const double v_bsdf = test::lower_rows_variance(bsdf, first), v_mis = test::lower_rows_variance(mis, first);
-  std::printf("plane variance: BSDF %.4g, MIS %.4g, ratio %.1f\n", v_bsdf, v_mis, v_bsdf / v_mis);
-  EXPECT_GT(v_bsdf, 4.0 * v_mis);
-}
-
-// A white diffuse sphere (albedo 1) in a uniform white sky is exactly 1
-// everywhere, with the sky sampled as a light and combined by MIS.
-TEST(CpuMis, FurnaceSphereIsOneWithSkyAsLight) {
-  const auto dir = test::temp_dir("cpu_mis_furnace");
-  for (Strategy k : {Strategy::Mis, Strategy::LightOnly})
-    // n next-event samples per surface vertex; the last with the ratio-tracked continuation.
-    for (auto [n, ratio] : {std::pair{1, false}, std::pair{3, false}, std::pair{3, true}}) {
-      RenderResult r = render(test::furnace_sphere_scene(dir, k, n, ratio));
-      ZTestReport z = test::ztest_against_exact(r, [](int, int) { return glm::dvec3(1.0); }, test::pooled(0.01));
-      EXPECT_TRUE(z.ok) << n << " light samples" << (ratio ? ", ratio-tracked continuation: " : ": ") << z.summary();
-      std::printf("furnace, %d light samples%s: %s\n", n, ratio ? ", ratio-tracked continuation" : "",
-                  z.summary().c_str());
-    }
-}
-
 // A purely scattering medium (σa = 0) in a uniform white sky: energy is
 // conserved, L = 1, with next-event estimation through the medium.
 TEST(CpuMis, ScatteringFurnaceIsOneWithSkyAsLight) {
@@ -96,18 +65,6 @@ TEST(CpuMis, ScatteringFurnaceIsOneWithSkyAsLight) {
   RenderResult r = render(s);
   ZTestReport z = test::ztest_against_exact(r, [](int, int) { return glm::dvec3(1.0); }, test::pooled(0.01));
   EXPECT_TRUE(z.ok) << z.summary();
-}
-
-// The furnace with smoke around the sphere (test::smoky_furnace_scene): the
-// ratio-tracked continuation's rays cross the smoke before they reach the sky.
-TEST(CpuMis, SmokyFurnaceIsOneWithRatioTrackedContinuation) {
-  const auto dir = test::temp_dir("cpu_mis_furnace");
-  for (bool ratio : {false, true}) {
-    ZTestReport z = test::ztest_against_exact(render(test::smoky_furnace_scene(dir, Strategy::Mis, ratio)),
-                                              [](int, int) { return glm::dvec3(1.0); }, test::pooled(0.01));
-    EXPECT_TRUE(z.ok) << (ratio ? "ratio-tracked continuation: " : "path continuation: ") << z.summary();
-    std::printf("smoky furnace%s: %s\n", ratio ? ", ratio-tracked continuation" : "", z.summary().c_str());
-  }
 }
 
 // Light choice and strategy rules (host/light/LightSelection.h).

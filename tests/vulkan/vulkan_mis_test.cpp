@@ -1,8 +1,10 @@
 // Next-event estimation and MIS on the Vulkan backend (docs/mis.md), validation
-// layers on: GPU against the CPU reference with MIS (scattering fire over a
-// plane under a sky, an emissive scattering grid, chromatic σ for the spectral
-// MIS pdfs), MIS / BSDF only / light only agreeing on the GPU, a furnace with
-// the sky as a light, and the variance MIS saves on the lit plane.
+// layers on. The cases both backends share (strategies agreeing, furnaces
+// with the sky as a light, the variance MIS saves on the lit plane) run from
+// tests/support/MisSuite.h (Mis.*/vulkan); here, GPU against the CPU
+// reference with MIS (scattering fire over a plane under a sky, an emissive
+// scattering grid, chromatic σ for the spectral MIS pdfs, several light
+// samples, guided and ratio-tracked continuations, the automatic choice).
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -10,25 +12,26 @@
 #include <gtest/gtest.h>
 
 #include "render/cpu/CpuRenderer.h"
-#include "support/MisScenes.h"
+#include "support/MisSuite.h"
 #include "support/Stats.h"
-#include "support/VulkanFixture.h"
 
 namespace pyrolume {
+
+namespace test {
+INSTANTIATE_BACKEND_SUITE(Mis, "vulkan");
+}  // namespace test
+
 namespace {
 
 using test::Strategy;
 using test::ZTestOptions;
 using test::ZTestReport;
 
-class VulkanMis : public test::VulkanFixture {
+class VulkanMis : public test::MisFixture {
  protected:
-  RenderResult gpu(const Scene& s) {
-    RenderResult r = backend_->render(s, test::settings_for(s), {});
-    EXPECT_EQ(r.nonfinite_samples, 0u);
-    test::expect_strategy_as_written(s, r);
-    return r;
-  }
+  VulkanMis() : test::MisFixture("vulkan") {}
+
+  RenderResult gpu(const Scene& s) { return render_as_written(s); }
   RenderResult cpu(const Scene& s, int spp) {
     Scene c = s;
     c.film.spp = spp;
@@ -58,42 +61,6 @@ TEST_F(VulkanMis, EmissiveScatteringGridMatchesCpu) {
   const auto dir = test::temp_dir("vk_mis_scattering");
   Scene s = test::scattering_fire_scene(dir, Strategy::Mis, 12, 12, 4096);
   test::expect_same_image(gpu(s), cpu(s, 4096), 0.02, "GPU vs CPU, MIS, scattering emitter");
-}
-
-TEST_F(VulkanMis, StrategiesAgreeOnGpu) {
-  test::expect_strategies_agree([this](const Scene& s) { return gpu(s); }, test::temp_dir("vk_mis_plane"), 2048,
-                                "GPU ");
-}
-
-TEST_F(VulkanMis, FurnaceSphereIsOneWithSkyAsLight) {
-  const auto dir = test::temp_dir("vk_mis_furnace");
-  // Light only as well: a light ray lost on its way (as on llvmpipe once, see
-  // next_light_ray) darkens it about 5x more than it darkens MIS.
-  // n next-event samples per surface vertex; the last with the ratio-tracked continuation.
-  for (auto [n, ratio] : {std::pair{1, false}, std::pair{3, false}, std::pair{3, true}}) {
-    for (Strategy st : {Strategy::Mis, Strategy::LightOnly}) {
-      const char* name = st == Strategy::Mis ? "MIS" : "light only";
-      ZTestReport z = test::ztest_against_exact(gpu(test::furnace_sphere_scene(dir, st, n, ratio)),
-                                                [](int, int) { return glm::dvec3(1.0); }, test::pooled(0.01));
-      EXPECT_TRUE(z.ok) << n << " light samples" << (ratio ? ", ratio-tracked continuation, " : ", ") << name << ": "
-                        << z.summary();
-      std::printf("GPU furnace, %d light samples%s, %s: %s\n", n, ratio ? ", ratio-tracked continuation" : "", name,
-                  z.summary().c_str());
-    }
-  }
-}
-
-// The furnace with smoke around the sphere (test::smoky_furnace_scene), MIS
-// and light only, with the ratio-tracked continuation.
-TEST_F(VulkanMis, SmokyFurnaceIsOneWithRatioTrackedContinuation) {
-  const auto dir = test::temp_dir("vk_mis_furnace");
-  for (Strategy st : {Strategy::Mis, Strategy::LightOnly}) {
-    const char* name = st == Strategy::Mis ? "MIS" : "light only";
-    ZTestReport z = test::ztest_against_exact(gpu(test::smoky_furnace_scene(dir, st, true)),
-                                              [](int, int) { return glm::dvec3(1.0); }, test::pooled(0.01));
-    EXPECT_TRUE(z.ok) << name << ": " << z.summary();
-    std::printf("GPU smoky furnace, ratio-tracked continuation, %s: %s\n", name, z.summary().c_str());
-  }
 }
 
 // Several next-event samples per surface vertex: the GPU's light-ray
@@ -175,17 +142,6 @@ TEST_F(VulkanMis, SkySampledGridNotMatchesCpu) {
   const RenderResult g = gpu(s);
   ASSERT_EQ(g.light_strategy, "mis");
   test::expect_same_image(g, cpu(s, 2048), 0.02, "GPU vs CPU, automatic: the sky sampled, the grid not");
-}
-
-TEST_F(VulkanMis, MisLowersVarianceOnLitPlane) {
-  const auto dir = test::temp_dir("vk_mis_plane");
-  Scene sb = test::fire_over_plane_scene(dir, Strategy::Bsdf, false, false, 24, 18, 64);
-  RenderResult bsdf = gpu(sb);
-  RenderResult mis = gpu(test::fire_over_plane_scene(dir, Strategy::Mis, false, false, 24, 18, 64));
-  const int first = sb.film.height * 3 / 4;
-  const double vb = test::lower_rows_variance(bsdf, first), vm = test::lower_rows_variance(mis, first);
-  std::printf("GPU plane variance: BSDF %.4g, MIS %.4g, ratio %.1f\n", vb, vm, vb / vm);
-  EXPECT_GT(vb, 4.0 * vm);
 }
 
 }  // namespace
