@@ -66,6 +66,8 @@ class BackendFixture : public ::testing::Test {
     }
     return *vulkan_;
   }
+  // This fixture's backend, as the interface both implement.
+  Backend& backend() { return cpu() ? static_cast<Backend&>(cpu_renderer()) : vulkan_backend(); }
   CpuRenderer& cpu_renderer() {
     if (!cpu_) cpu_ = std::make_unique<CpuRenderer>();
     return *cpu_;

@@ -1,24 +1,25 @@
-// The CPU reference's accumulation (issue 10): exact constant radiance at
-// 65 536 spp, non-finite samples counted and recorded as 0, bit-identical
-// resume from an interruption or a checkpoint; the checkpoint file format; the
-// 64-bit sample arithmetic.
+// The CPU reference's accumulation (issue 10): the cases both backends share
+// (exact constant radiance at 65 536 spp, non-finite samples counted and
+// recorded as 0, bit-identical resume from an interruption or a checkpoint,
+// another backend's state refused) run from tests/support/AccumulationSuite.h
+// (Accumulation.*/cpu); here, the equilibrium medium exact at 65 536 spp, the
+// checkpoint file format and the 64-bit sample arithmetic.
 #include <gtest/gtest.h>
 
 #include "render/Checkpoint.h"
 #include "render/cpu/CpuRenderer.h"
 #include "render/cpu/Rng.h"
 #include "shared/gpu_types.h"
-#include "support/AccumulationChecks.h"
+#include "support/AccumulationSuite.h"
 #include "util/Error.h"
 
 namespace pyrolume {
-namespace {
 
-TEST(CpuAccumulation, ConstantBackgroundIsExactAt65536Spp) {
-  CpuRenderer cpu(2);
-  const glm::dvec3 bg(0.3, 0.7123, 1.1);
-  test::expect_constant_radiance_exact(cpu, test::constant_background_scene(4, 4, 65536, bg), bg, 1e-6);
-}
+namespace test {
+INSTANTIATE_BACKEND_SUITE(Accumulation, "cpu");
+}  // namespace test
+
+namespace {
 
 // An emissive absorbing and scattering medium around the camera is in
 // equilibrium: every sample ends in an absorption and returns Le exactly.
@@ -27,27 +28,6 @@ TEST(CpuAccumulation, EquilibriumMediumIsExactAt65536Spp) {
   Scene s = test::equilibrium_sphere_scene(4, 4, 65536);
   s.integrator.max_depth = 1000;  // P(a path is cut short) ~ 0.75^1000
   test::expect_constant_radiance_exact(cpu, s, test::equilibrium_radiance(s), 1e-6);
-}
-
-TEST(CpuAccumulation, NonFiniteSamplesAreCountedAndRecordedAsZero) {
-  CpuRenderer cpu(2);
-  auto dir = test::temp_dir("cpu-inf");
-  test::expect_nonfinite_samples_counted(cpu, dir);
-  std::filesystem::remove_all(dir);
-}
-
-TEST(CpuAccumulation, ResumeIsBitIdenticalToAnUninterruptedRender) {
-  CpuRenderer cpu(2);
-  test::expect_resume_exact(cpu, test::chromatic_scattering_scene(8, 8, 64));
-}
-
-TEST(CpuAccumulation, ResumeRefusesAnotherBackendsState) {
-  CpuRenderer cpu(1);
-  Scene s = test::constant_background_scene(4, 4, 8, {1, 1, 1});
-  AccumulationState wrong{"vulkan", 4, 4, 4, std::vector<uint8_t>(4 * 4 * sizeof(gpu::AccumTexel))};
-  RenderControl c;
-  c.resume = &wrong;
-  EXPECT_THROW(cpu.render(s, test::settings_for(s), c), std::invalid_argument);
 }
 
 // ------------------------------------------------------------ 64-bit totals ----
