@@ -1,22 +1,21 @@
-// `pyrolume render` interrupted, checkpointed and resumed on the CPU backend,
-// as a user runs it (real signals, real files); limits that are bad input.
+// `pyrolume render` on the CPU backend: the interrupt/checkpoint/resume cases
+// both backends share run from tests/support/CliCheckpointSuite.h
+// (CliCheckpoint.*/cpu); here, a mismatched resume refused and limits that
+// are bad input.
 #include <gtest/gtest.h>
 
 #include "render/Limits.h"
-#include "support/AccumulationChecks.h"
+#include "support/CliCheckpointSuite.h"
 #include "util/Error.h"
 
 namespace pyrolume {
+
+namespace test {
+INSTANTIATE_BACKEND_SUITE(CliCheckpoint, "cpu");
+}  // namespace test
+
 namespace {
 using namespace pyrolume::test;
-
-TEST(CliCheckpointCpu, SigintSavesThenResumeCompletesIdentically) { expect_cli_interrupt_then_resume("cpu"); }
-
-TEST(CliCheckpointCpu, SigtermSavesAndExits143) { expect_cli_sigterm_saves("cpu"); }
-
-TEST(CliCheckpointCpu, SigtermEndsAPassThroughAPathologicallyDenseMedium) {
-  expect_sigterm_ends_a_pathological_pass("cpu");
-}
 
 TEST(CliCheckpointCpu, MismatchedResumeIsRefused) {
   auto dir = temp_dir("cli-mismatch");

@@ -1,26 +1,24 @@
-// `pyrolume render` on the Vulkan backend interrupted, checkpointed and
-// resumed as a user runs it (real signals, real files), and the device-failure
-// path: a lost device or exhausted device memory mid-render (injected with
-// PYROLUME_TEST_FAIL_PASS, since lavapipe cannot lose a device) saves the
-// accumulation so far, says which failure it was and exits 1.
+// `pyrolume render` on the Vulkan backend: the interrupt/checkpoint/resume
+// cases both backends share run from tests/support/CliCheckpointSuite.h
+// (CliCheckpoint.*/vulkan); here, the device-failure path: a lost device or
+// exhausted device memory mid-render (injected with PYROLUME_TEST_FAIL_PASS,
+// since lavapipe cannot lose a device) saves the accumulation so far, says
+// which failure it was and exits 1.
 #include <cstdlib>
 
 #include <gtest/gtest.h>
 
-#include "support/AccumulationChecks.h"
+#include "support/CliCheckpointSuite.h"
 #include "support/VdbScenes.h"
 
 namespace pyrolume {
+
+namespace test {
+INSTANTIATE_BACKEND_SUITE(CliCheckpoint, "vulkan");
+}  // namespace test
+
 namespace {
 using namespace pyrolume::test;
-
-TEST(CliCheckpointVulkan, SigintSavesThenResumeCompletesIdentically) { expect_cli_interrupt_then_resume("vulkan"); }
-
-TEST(CliCheckpointVulkan, SigtermSavesAndExits143) { expect_cli_sigterm_saves("vulkan"); }
-
-TEST(CliCheckpointVulkan, SigtermEndsAPassThroughAPathologicallyDenseMedium) {
-  expect_sigterm_ends_a_pathological_pass("vulkan");
-}
 
 // Runs the CLI with PYROLUME_TEST_FAIL_PASS=fault set.
 CliResult run_with_fault(const std::string& fault, const std::string& args) {
