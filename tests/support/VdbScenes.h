@@ -487,4 +487,12 @@ struct ConstantBoxSetup {
   }
 };
 
+// Media that transmit everything: a grid with no active voxels and an
+// all-zero grid (σa = σs = 1), written into `dir` (both transmittance tests).
+inline void add_empty_and_zero_grids(Scene& s, const std::filesystem::path& dir) {
+  s.media.push_back(vdb_medium("empty", write_empty_vdb(dir / "empty.vdb"), {1, 1, 1}, {1, 1, 1}));
+  s.media.push_back(vdb_medium("zero", write_constant_box_vdb(dir / "zero.vdb", {0.1, {}}, {{-3, -3, -3}, {3, 3, 3}}, 0.0f),
+                               {1, 1, 1}, {1, 1, 1}));
+}
+
 }  // namespace pyrolume::test

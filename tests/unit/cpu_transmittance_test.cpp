@@ -203,10 +203,7 @@ TEST_F(Transmittance, HomogeneousAndGridMediaAdd) {
 
 TEST_F(Transmittance, EmptyAndZeroGridsAndMissesTransmitEverything) {
   Scene s = test::vdb_base_scene(8, 8, 1);
-  s.media.push_back(test::vdb_medium("empty", test::write_empty_vdb(dir / "empty.vdb"), {1, 1, 1}, {1, 1, 1}));
-  s.media.push_back(test::vdb_medium(
-      "zero", test::write_constant_box_vdb(dir / "zero.vdb", {0.1, {}}, {{-3, -3, -3}, {3, 3, 3}}, 0.0f), {1, 1, 1},
-      {1, 1, 1}));
+  test::add_empty_and_zero_grids(s, dir);
   const MediaData md = cpu::prepare_media(s);
   Pcg32 rng(1, 2);
   for (int i = 0; i < 100; ++i) {

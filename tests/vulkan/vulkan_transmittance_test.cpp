@@ -166,10 +166,7 @@ TEST_F(VulkanTransmittance, RussianRouletteKeepsRatioTrackingUnbiased) {
 // An empty grid, an all-zero grid, and rays that miss a grid transmit exactly 1.
 TEST_F(VulkanTransmittance, EmptyAndZeroGridsAndMissesTransmitEverything) {
   Scene s = test::vdb_base_scene(16, 16, 8);
-  s.media.push_back(test::vdb_medium("empty", test::write_empty_vdb(dir / "empty.vdb"), {1, 1, 1}, {1, 1, 1}));
-  s.media.push_back(test::vdb_medium(
-      "zero", test::write_constant_box_vdb(dir / "zero.vdb", {0.1, {}}, {{-3, -3, -3}, {3, 3, 3}}, 0.0f), {1, 1, 1},
-      {1, 1, 1}));
+  test::add_empty_and_zero_grids(s, dir);
   s.media.push_back(test::vdb_medium(
       "aside", test::write_constant_box_vdb(dir / "aside.vdb", {0.1, {30.0, 0, 0}}, {{-3, -3, -3}, {3, 3, 3}}, 1.0f),
       {1, 1, 1}, {1, 1, 1}));
