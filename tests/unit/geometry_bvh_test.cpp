@@ -16,6 +16,7 @@
 #include "geometry/Surfaces.h"
 #include "geometry/Triangle.h"
 #include "shared/geometry_types.h"
+#include "support/RandomDirections.h"
 
 using namespace pyrolume;
 using namespace pyrolume::geometry;
@@ -24,13 +25,7 @@ namespace {
 
 const std::filesystem::path kTerrain = std::filesystem::path(PYROLUME_SOURCE_DIR) / "assets/terrain/mountain.obj";
 
-glm::dvec3 random_unit(std::mt19937_64& rng) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  glm::dvec3 d;
-  do d = glm::dvec3(n(rng), n(rng), n(rng));
-  while (glm::length(d) < 1e-6);
-  return glm::normalize(d);
-}
+using test::random_unit;
 
 // `count` triangles in [−1, 1]³ with sizes from tiny to large, some
 // degenerate (zero area), some sharing vertices.

@@ -19,6 +19,7 @@
 #include "render/vulkan/Pipeline.h"
 #include "render/vulkan/Spirv.h"
 #include "shared/geometry_types.h"
+#include "support/RandomDirections.h"
 
 using namespace pyrolume;
 using namespace pyrolume::geometry;
@@ -40,13 +41,7 @@ struct TestResult {
 };
 static_assert(sizeof(TestResult) == 80);
 
-glm::dvec3 random_unit(std::mt19937_64& rng) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  glm::dvec3 d;
-  do d = glm::dvec3(n(rng), n(rng), n(rng));
-  while (glm::length(d) < 1e-6);
-  return glm::normalize(d);
-}
+using test::random_unit;
 
 // The terrain, a soup of random triangles floating above it, a sphere, a
 // finite rectangle and an infinite ground plane below everything.
