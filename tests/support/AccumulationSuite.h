@@ -21,7 +21,7 @@ namespace pyrolume::test {
 
 class AccumulationFixture : public BackendFixture {
  protected:
-  explicit AccumulationFixture(const std::string& backend) : BackendFixture(backend) {}
+  using BackendFixture::BackendFixture;
 };
 
 using Accumulation = BackendSuite<AccumulationFixture>;

@@ -19,7 +19,7 @@ namespace pyrolume::test {
 
 class AnalyticFixture : public BackendFixture {
  protected:
-  explicit AnalyticFixture(const std::string& backend) : BackendFixture(backend) {}
+  using BackendFixture::BackendFixture;
 
   // The render against single_collision_exact, informative to SE_bias 0.25 %.
   void expect_single_collision_closed_form(const Scene& s) {

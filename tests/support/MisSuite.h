@@ -23,7 +23,7 @@ namespace pyrolume::test {
 
 class MisFixture : public BackendFixture {
  protected:
-  explicit MisFixture(const std::string& backend) : BackendFixture(backend) {}
+  using BackendFixture::BackendFixture;
 
   // render(), and the strategy the scene asks for is the one used.
   RenderResult render_as_written(const Scene& s) {

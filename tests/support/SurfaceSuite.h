@@ -138,7 +138,7 @@ inline Scene concave_furnace_scene(const std::filesystem::path& obj, int max_dep
 
 class SurfaceFixture : public BackendFixture {
  protected:
-  explicit SurfaceFixture(const std::string& backend) : BackendFixture(backend) {}
+  using BackendFixture::BackendFixture;
 
   // How far a pixel mean that is exact in closed form may be from `value`.
   double exact_tol(double value) const { return per_backend(1e-12, kFloatTol * (1 + std::abs(value))); }
