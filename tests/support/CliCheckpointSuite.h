@@ -4,7 +4,7 @@
 // (the checks are AccumulationChecks.h's), instantiated for "cpu" by
 // tests/unit/cli_checkpoint_test.cpp and for "vulkan" by
 // tests/vulkan/cli_checkpoint_vulkan_test.cpp (BackendSuite.h explains the
-// naming: CliCheckpoint.Name/cpu, CliCheckpoint.Name/vulkan).
+// naming: CliCheckpoint.Name/"cpu", CliCheckpoint.Name/"vulkan").
 #include <string>
 
 #include <gtest/gtest.h>

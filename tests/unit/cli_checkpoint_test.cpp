@@ -1,6 +1,6 @@
 // `pyrolume render` on the CPU backend: the interrupt/checkpoint/resume cases
 // both backends share run from tests/support/CliCheckpointSuite.h
-// (CliCheckpoint.*/cpu); here, a mismatched resume refused and limits that
+// (CliCheckpoint.*/"cpu"); here, a mismatched resume refused and limits that
 // are bad input.
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // (exact constant radiance at 65 536 spp, non-finite samples counted and
 // recorded as 0, bit-identical resume from an interruption or a checkpoint,
 // another backend's state refused) run from tests/support/AccumulationSuite.h
-// (Accumulation.*/cpu); here, the equilibrium medium exact at 65 536 spp, the
+// (Accumulation.*/"cpu"); here, the equilibrium medium exact at 65 536 spp, the
 // checkpoint file format and the 64-bit sample arithmetic.
 #include <gtest/gtest.h>
 

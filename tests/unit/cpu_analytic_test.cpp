@@ -1,5 +1,5 @@
 // CPU reference vs closed forms (issue 2: analytic tests): the cases both
-// backends share run from tests/support/AnalyticSuite.h (Analytic.*/cpu);
+// backends share run from tests/support/AnalyticSuite.h (Analytic.*/"cpu");
 // here, the CPU-only ones, plus determinism, progressive control and
 // robustness of the reference.
 #include <algorithm>

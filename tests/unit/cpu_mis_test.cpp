@@ -1,5 +1,5 @@
 // Next-event estimation and MIS in the CPU reference (docs/mis.md): the cases
-// both backends share run from tests/support/MisSuite.h (Mis.*/cpu); here,
+// both backends share run from tests/support/MisSuite.h (Mis.*/"cpu"); here,
 // the CPU-only ones: MIS and BSDF/phase sampling only converge to the same
 // image with a scattering emitter, a scattering furnace stays 1 with the sky
 // as a light, and the light choice and strategy rules.

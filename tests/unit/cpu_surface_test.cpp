@@ -1,5 +1,5 @@
 // CPU reference with surfaces (issue 6, BSDF/phase sampling only): the cases
-// both backends share run from tests/support/SurfaceSuite.h (Surface.*/cpu);
+// both backends share run from tests/support/SurfaceSuite.h (Surface.*/"cpu");
 // here, the CPU-only ones: the cosine-hemisphere sampler, a surface clipping
 // the medium behind it against a closed form, a surface lit by an emissive
 // medium (both estimators agree) and determinism across thread counts.

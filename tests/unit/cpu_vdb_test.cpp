@@ -1,5 +1,5 @@
 // CPU reference with grid (vdb) media: the cases both backends share run from
-// tests/support/VdbSuite.h (Vdb.*/cpu); here, the CPU-only ones (estimators
+// tests/support/VdbSuite.h (Vdb.*/"cpu"); here, the CPU-only ones (estimators
 // against each other on scattering scenes, a white furnace at 1e-12, the NaN
 // warning of the prepared media, the 5 nm blackbody sum). Every VDB is written
 // by the test (tests/support/VdbScenes.h).
@@ -97,7 +97,7 @@ TEST_F(CpuVdb, ScatteringCheckerboardWhiteFurnace) {
 }
 
 // NaN voxels are 0 in the CPU's prepared media (the loader warns, and the
-// largest density ignores them); Vdb.NanVoxelsRenderLikeZeros/cpu renders them.
+// largest density ignores them); Vdb.NanVoxelsRenderLikeZeros/"cpu" renders them.
 TEST_F(CpuVdb, NanVoxelsAreZero) {
   const auto [a, b] = nan_and_zero_scenes();
   const cpu::MediaData md = cpu::prepare_media(a);

@@ -1,6 +1,6 @@
 // `pyrolume render` on the Vulkan backend: the interrupt/checkpoint/resume
 // cases both backends share run from tests/support/CliCheckpointSuite.h
-// (CliCheckpoint.*/vulkan); here, the device-failure path: a lost device or
+// (CliCheckpoint.*/"vulkan"); here, the device-failure path: a lost device or
 // exhausted device memory mid-render (injected with PYROLUME_TEST_FAIL_PASS,
 // since lavapipe cannot lose a device) saves the accumulation so far, says
 // which failure it was and exits 1.

@@ -3,7 +3,7 @@
 // at 65 536 spp, mean and Σ L²; non-finite samples counted and recorded as 0;
 // a resumed render, state uploaded back to the device, bit-identical to an
 // uninterrupted one; another backend's state refused) run from
-// tests/support/AccumulationSuite.h (Accumulation.*/vulkan); here, the
+// tests/support/AccumulationSuite.h (Accumulation.*/"vulkan"); here, the
 // readback applying the compensation.
 #include <cstring>
 

@@ -1,7 +1,7 @@
 // The Vulkan backend against closed forms and against the CPU reference
 // (issue 2 tests), with validation layers on: any validation message fails.
 // The closed-form cases both backends share run from
-// tests/support/AnalyticSuite.h (Analytic.*/vulkan); here, the GPU-only ones.
+// tests/support/AnalyticSuite.h (Analytic.*/"vulkan"); here, the GPU-only ones.
 #include <gtest/gtest.h>
 
 #include "render/Backend.h"

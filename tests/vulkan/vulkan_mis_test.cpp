@@ -1,7 +1,7 @@
 // Next-event estimation and MIS on the Vulkan backend (docs/mis.md), validation
 // layers on. The cases both backends share (strategies agreeing, furnaces
 // with the sky as a light, the variance MIS saves on the lit plane) run from
-// tests/support/MisSuite.h (Mis.*/vulkan); here, GPU against the CPU
+// tests/support/MisSuite.h (Mis.*/"vulkan"); here, GPU against the CPU
 // reference with MIS (scattering fire over a plane under a sky, an emissive
 // scattering grid, chromatic σ for the spectral MIS pdfs, several light
 // samples, guided and ratio-tracked continuations, the automatic choice).

@@ -1,7 +1,7 @@
 // The Vulkan backend with surfaces and the environment map (issue 6, BSDF and
 // phase sampling only), validation layers on (any message fails). The cases
 // both backends share run from tests/support/SurfaceSuite.h
-// (Surface.*/vulkan); here, the GPU-only ones:
+// (Surface.*/"vulkan"); here, the GPU-only ones:
 //  - every byte through the R8G8B8A8_SRGB sampler against the IEC curve;
 //  - GPU vs the CPU reference (z-tests with the bias formula of docs/testing.md) on a
 //    small terrain_explosion and on an emissive scattering medium above a

@@ -1,6 +1,6 @@
 // The Vulkan backend with grid (vdb) media (issue 5 on the GPU, and issue 4's
 // mismatched-lattice test): the cases both backends share run from
-// tests/support/VdbSuite.h (Vdb.*/vulkan); here, the GPU-only ones: the
+// tests/support/VdbSuite.h (Vdb.*/"vulkan"); here, the GPU-only ones: the
 // majorant grid, the estimators against each other, against the CPU
 // reference, and the schedules that must not change the image (early event
 // exit, wavefront, temperature in the density texture). Every VDB is written
