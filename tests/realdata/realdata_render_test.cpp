@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "render/Backend.h"
+#include "backends/Backends.h"
 #include "render/cpu/CpuRenderer.h"
 #include "support/AnalyticScenes.h"
 #include "support/Stats.h"

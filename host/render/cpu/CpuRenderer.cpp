@@ -718,7 +718,8 @@ AccumulationState save_state(const RenderResult& res, const CpuCounters& c) {
 
 void load_state(const AccumulationState& st, RenderResult& res, CpuCounters& c) {
   const size_t n = res.sum.size() * sizeof(double);
-  if (st.backend != "cpu" || st.width != res.width || st.height != res.height || st.data.size() != 2 * n + sizeof c)
+  if (st.backend != "cpu" || st.width != res.width || st.height != res.height ||
+      st.data.size() != CpuRenderer::accumulation_bytes(res.width, res.height))
     throw std::invalid_argument("cpu reference: the resumed accumulation is not a " + std::to_string(res.width) + "x" +
                                 std::to_string(res.height) + " cpu one");
   std::memcpy(res.sum.data(), st.data.data(), n);
@@ -728,6 +729,10 @@ void load_state(const AccumulationState& st, RenderResult& res, CpuCounters& c) 
 }
 
 }  // namespace
+
+uint64_t CpuRenderer::accumulation_bytes(int width, int height) {
+  return uint64_t(width) * uint64_t(height) * 6 * sizeof(double) + sizeof(CpuCounters);
+}
 
 CpuRenderer::CpuRenderer(int threads) {
   if (threads <= 0) threads = int(std::thread::hardware_concurrency());
