@@ -5,7 +5,7 @@
 #include <cstdio>
 
 #include "color/Blackbody.h"
-#include "shared/gpu_types.h"
+#include "color/EmissionModel.h"
 #include "util/Error.h"
 
 namespace pyrolume {
@@ -34,10 +34,10 @@ double brightest_blackbody(const Emission& e, double hottest_k) {
 void check_emitted_radiance(const std::string& file, const std::string& at, double scale, double brightest,
                             const std::string& what) {
   const double radiance = scale * brightest;
-  if (!(radiance <= double(gpu::MAX_EMITTED_RADIANCE)))
+  if (!(radiance <= double(kMaxEmittedRadiance)))
     throw input_error(file, at + ".emission.scale",
                       "emission.scale " + sci(scale) + " × " + what + " (" + sci(brightest) + ") gives radiance " +
-                          sci(radiance) + ", beyond " + sci(gpu::MAX_EMITTED_RADIANCE) +
+                          sci(radiance) + ", beyond " + sci(kMaxEmittedRadiance) +
                           ", the most a render can sum in float without overflowing; lower emission.scale");
 }
 

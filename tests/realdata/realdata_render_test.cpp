@@ -12,6 +12,7 @@
 
 #include "backends/Backends.h"
 #include "render/cpu/CpuRenderer.h"
+#include "scene/MediumVolume.h"
 #include "support/AnalyticScenes.h"
 #include "support/Stats.h"
 #include "support/TestSupport.h"

@@ -14,6 +14,7 @@
 #include "light/EnvironmentMap.h"
 #include "light/LightSelection.h"
 #include "render/cpu/CpuRenderer.h"
+#include "scene/MediumVolume.h"
 #include "support/MisScenes.h"
 #include "support/Stats.h"
 

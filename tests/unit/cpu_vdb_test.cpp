@@ -14,6 +14,7 @@
 #include "render/cpu/CpuRenderer.h"
 #include "render/cpu/Intersect.h"
 #include "render/cpu/Media.h"
+#include "scene/MediumVolume.h"
 #include "support/AnalyticScenes.h"
 #include "support/Stats.h"
 #include "support/TestSupport.h"

@@ -16,6 +16,7 @@
 #include "render/Backend.h"
 #include "render/cpu/CpuRenderer.h"
 #include "render/cpu/Intersect.h"
+#include "scene/MediumVolume.h"
 #include "support/VulkanFixture.h"
 #include "support/AnalyticScenes.h"
 #include "support/Stats.h"

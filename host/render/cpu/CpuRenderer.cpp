@@ -27,7 +27,6 @@
 #include "render/cpu/Rng.h"
 #include "render/cpu/Sampling.h"
 #include "render/cpu/Transmittance.h"
-#include "shared/gpu_types.h"
 
 namespace pyrolume {
 namespace cpu {
@@ -857,7 +856,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
                 L[c] = walk_channel(walk_scene, c, scene.camera.position, dir, rng, cnt, scratch, max_depth);
               // NaN, Inf and beyond MAX_SAMPLE_RADIANCE (where float sums of
               // squares could overflow): recorded as 0, counted in nonfinite_samples.
-              const double kMaxL = gpu::MAX_SAMPLE_RADIANCE;
+              const double kMaxL = kMaxSampleRadiance;
               if (!(std::abs(L.x) <= kMaxL && std::abs(L.y) <= kMaxL && std::abs(L.z) <= kMaxL)) {
                 ++cnt.nonfinite;
                 L = glm::dvec3(0.0);

@@ -6,6 +6,7 @@
 
 #include "color/Blackbody.h"
 #include "render/cpu/Intersect.h"
+#include "scene/MediumVolume.h"
 
 namespace pyrolume::cpu {
 
