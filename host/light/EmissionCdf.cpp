@@ -10,16 +10,13 @@
 
 #include "color/Blackbody.h"
 #include "color/ColorSpace.h"
+#include "color/EmissionModel.h"
 #include "light/PiecewiseConstant.h"
 #include "scene/MediumVolume.h"
 
 namespace pyrolume {
 
 namespace {
-
-// The GPU's blackbody LUT range (host/render/cpu/Media.h kBlackbodyMinK/MaxK).
-constexpr double kBlackbodyMinK = 100.0;
-constexpr double kBlackbodyMaxK = 1.0e6;
 
 glm::dmat4 translation(const glm::dvec3& t) {
   glm::dmat4 m(1.0);
@@ -74,13 +71,13 @@ EmissionCdf EmissionCdf::build(const DenseGrid& density, const DenseGrid* temper
   // R16F grids hold at most 65536 distinct values).
   auto E_of_value = [&](float value) -> double {
     const double T = (double(value) - p.temperature.offset) * p.temperature.scale;
-    if (!(T > p.temperature.cutoff_k) || !(T >= kBlackbodyMinK)) return 0.0;  // NaN too
-    const glm::dvec3 Le = p.emission.scale * color::blackbody_rgb_5nm(std::min(T, kBlackbodyMaxK), p.emission.blackbody,
-                                                                       p.emission.observer, p.emission.adapt_to_k);
+    if (!temperature_emits(T, p.temperature.cutoff_k)) return 0.0;  // NaN too
+    const glm::dvec3 Le = temperature_Le(T, p.temperature.cutoff_k, p.emission.scale, p.emission.blackbody,
+                                         p.emission.observer, p.emission.adapt_to_k);
     return color::srgb_luminance(p.sigma_a * Le);
   };
-  const bool temperature_emits = p.emits_temperature && temperature && !temperature->empty();
-  if (!(p.emits_rgb || temperature_emits)) return e;
+  const bool grid_emits = p.emits_temperature && temperature && !temperature->empty();
+  if (!(p.emits_rgb || grid_emits)) return e;
   std::vector<float> E_t;
   double E_outside = 0.0;  // E at the temperature texture's outside (value 0)
   if (!p.emits_rgb) {

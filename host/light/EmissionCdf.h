@@ -19,7 +19,7 @@
 //           leaves the temperature texture, whose outside reads 0),
 //   E(T)  = Y(σa ⊙ Le(T)): sRGB luminance, σa = sigma_a · density_scale,
 //           Le = emission.scale · blackbody_rgb_5nm(T) with the CPU reference's
-//           rules (0 at or below cutoff_k and below 100 K, T clamped to 1e6 K);
+//           rules (color/EmissionModel.h temperature_Le);
 //           T = (value − offset) · scale. Constant-rgb emission: E = Y(σa ⊙ Le_rgb).
 // The emission at x, σa·ρ(x)·Le(T(x)), is > 0 only if ρ(x) > 0 and
 // T(x) > cutoff; trilinear values are convex combinations of the corners, so
