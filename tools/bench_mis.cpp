@@ -37,8 +37,8 @@
 
 #include <unistd.h>
 
+#include "backends/Backends.h"
 #include "image/ImageIo.h"
-#include "render/Backend.h"
 #include "render/SceneSetup.h"
 #include "scene/Scene.h"
 

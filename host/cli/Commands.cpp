@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "backends/Backends.h"
 #include "cli/OutputCheck.h"
 #include "cli/Sequence.h"
 #include "color/Blackbody.h"
@@ -15,12 +16,9 @@
 #include "image/Compare.h"
 #include "image/DisplayTransform.h"
 #include "image/ImageIo.h"
-#include "image/RenderImage.h"
-#include "render/Backend.h"
 #include "render/Checkpoint.h"
+#include "render/RenderImage.h"
 #include "render/SceneSetup.h"
-#include "render/vulkan/Devices.h"
-#include "render/vulkan/VulkanRenderer.h"
 #include "scene/Scene.h"
 #include "util/Error.h"
 #include "util/Progress.h"
@@ -193,8 +191,8 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
   const auto t0 = std::chrono::steady_clock::now();
   BackendOptions options;
   options.device_index = args.device;
+  options.frame_reuse = true;
   auto backend = make_backend(args.backend, options);
-  if (auto* vulkan = dynamic_cast<VulkanRenderer*>(backend.get())) vulkan->set_frame_reuse(true);
 
   // Auto exposure comes from the first frame rendered and holds for the rest (no flicker).
   DisplayExposure exposure(parse_exposure(args.exposure));
@@ -447,9 +445,7 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
 }
 
 int run_devices(int device) {
-  auto list = vk::list_devices();
-  int chosen = vk::choose_device(list, device);
-  std::cout << vk::format_device_list(list, chosen);
+  std::cout << device_list(device);
   return 0;
 }
 

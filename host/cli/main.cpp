@@ -14,7 +14,6 @@
 #include "cli/Commands.h"
 #include "preview/Preview.h"
 #include "render/Render.h"
-#include "render/vulkan/Devices.h"
 #include "util/Error.h"
 
 namespace {
@@ -139,7 +138,7 @@ int main(int argc, char** argv) {
   } catch (const InputError& e) {
     std::cerr << "pyrolume: " << e.what() << "\n";
     return 2;
-  } catch (const vk::NoDeviceError& e) {
+  } catch (const NoDeviceError& e) {
     std::cerr << "pyrolume: " << e.what() << "\n";
     return 2;
   } catch (const std::bad_alloc&) {

@@ -7,7 +7,7 @@
 
 #include <glm/glm.hpp>
 
-#include "scene/Scene.h"
+#include "color/BlackbodyMode.h"
 
 namespace pyrolume::color {
 

@@ -16,7 +16,8 @@
 
 #include <glm/glm.hpp>
 
-#include "scene/Scene.h"
+#include "color/BlackbodyMode.h"
+#include "color/EmissionModel.h"
 
 namespace pyrolume::color {
 
@@ -32,12 +33,12 @@ struct BlackbodyLutParams {
 
 class BlackbodyLut {
  public:
-  // Defaults: ln-uniform over 100 K .. 1e6 K. The low end matches the scene's
-  // default temperature.cutoff_k; the size is what the 0.1 % bound needs at
+  // Defaults: ln-uniform over the emission range (color/EmissionModel.h,
+  // 100 K .. 1e6 K); the size is what the 0.1 % bound needs at
   // 500 K in the peak and physical modes, where radiance changes by a factor
   // e^(hc/(lambda k T)) ≈ e^45 per unit of ln T (Wien tail).
-  static constexpr double kDefaultMinK = 100.0;
-  static constexpr double kDefaultMaxK = 1.0e6;
+  static constexpr double kDefaultMinK = kEmissionMinK;
+  static constexpr double kDefaultMaxK = kEmissionMaxK;
   static constexpr uint32_t kDefaultSize = 8192;
 
   // Throws std::invalid_argument for a bad observer/adapt_to_k, size < 2 or a

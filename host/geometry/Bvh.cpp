@@ -8,7 +8,6 @@
 #include <string>
 #include <tuple>
 
-#include "shared/geometry_types.h"
 
 namespace pyrolume::geometry {
 namespace {
@@ -45,9 +44,9 @@ double node_area(const BvhNode& n) {
 class Builder {
  public:
   Builder(const std::vector<Triangle>& tris, const BvhOptions& opt) : opt_(opt) {
-    if (opt_.max_leaf_size < 1 || opt_.max_leaf_size > gpu::BVH_MAX_LEAF_TRIANGLES)
+    if (opt_.max_leaf_size < 1 || opt_.max_leaf_size > kBvhMaxLeafTriangles)
       throw std::invalid_argument("BvhOptions::max_leaf_size must be 1.." +
-                                  std::to_string(gpu::BVH_MAX_LEAF_TRIANGLES));
+                                  std::to_string(kBvhMaxLeafTriangles));
     if (opt_.bins < 2) throw std::invalid_argument("BvhOptions::bins must be at least 2");
     info_.resize(tris.size());
     index_.resize(tris.size());
@@ -193,7 +192,7 @@ class Builder {
     return std::clamp(b, 0, opt_.bins - 1);
   }
 
-  static constexpr uint32_t kMaxDepth = gpu::BVH_STACK_SIZE - 1;
+  static constexpr uint32_t kMaxDepth = kBvhStackSize - 1;
   BvhOptions opt_;
   std::vector<PrimInfo> info_;
   std::vector<uint32_t> index_;
@@ -230,7 +229,7 @@ bool traverse(const Bvh& bvh, const Ray& ray, double t_max, SurfaceHit* hit) {
   const TriangleRay tr(ray);
   const glm::dvec3 inv = safe_inverse(ray.direction);
   const bool neg[3] = {ray.direction.x < 0.0, ray.direction.y < 0.0, ray.direction.z < 0.0};
-  std::array<uint32_t, gpu::BVH_STACK_SIZE> stack;
+  std::array<uint32_t, kBvhStackSize> stack;
   uint32_t sp = 0, node = 0;
   double t_closest = t_max;
   uint32_t found = UINT32_MAX;

@@ -3,7 +3,7 @@
 // fast Construction of SAH-based Bounding Volume Hierarchies"), flattened in
 // depth-first order, and a plain stack traversal for the CPU reference (the
 // GPU reads the same tree with its leaves folded into their parents:
-// pack_gpu_nodes in Surfaces.h, shaders/bvh.glsl).
+// pack_gpu_nodes in render/vulkan/SurfacePacking.h, shaders/bvh.glsl).
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <vector>
@@ -12,6 +12,11 @@
 #include "geometry/Triangle.h"
 
 namespace pyrolume::geometry {
+
+// The GPU traversal's fixed stack and leaf size (shaders/shared/geometry_types.h
+// BVH_STACK_SIZE, BVH_MAX_LEAF_TRIANGLES; SurfacePacking.cpp asserts they agree).
+inline constexpr uint32_t kBvhStackSize = 32;
+inline constexpr uint32_t kBvhMaxLeafTriangles = 4;
 
 struct BvhNode {
   static constexpr uint32_t kLeaf = 3;  // `axis` of a leaf
@@ -30,18 +35,18 @@ enum class BvhSplit {
 struct BvhOptions {
   BvhSplit split = BvhSplit::Sah;
   int bins = 16;               // SAH bins per axis
-  uint32_t max_leaf_size = 4;  // ≤ BVH_MAX_LEAF_TRIANGLES
+  uint32_t max_leaf_size = 4;  // ≤ kBvhMaxLeafTriangles
 };
 
 struct Bvh {
   std::vector<BvhNode> nodes;       // nodes[0] is the root; never empty
   std::vector<Triangle> triangles;  // reordered so every leaf owns a contiguous range
-  uint32_t depth = 0;               // deepest leaf (root = 0); < BVH_STACK_SIZE
+  uint32_t depth = 0;               // deepest leaf (root = 0); < kBvhStackSize
 };
 
 // Builds over `triangles` (moved in, reordered; Triangle::source keeps each
 // one's original index). Zero triangles give a single empty leaf. Leaves hold
-// at most max_leaf_size triangles; the depth never exceeds BVH_STACK_SIZE − 1
+// at most max_leaf_size triangles; the depth never exceeds kBvhStackSize − 1
 // (deeper subtrees switch to median splits), so the GPU's fixed stack suffices.
 Bvh build_bvh(std::vector<Triangle> triangles, const BvhOptions& options = {});
 

@@ -6,6 +6,7 @@
 
 #include "geometry/Mesh.h"
 #include "geometry/Triangle.h"
+#include "scene/MediumVolume.h"
 #include "util/Error.h"
 #include "volume/VdbLoader.h"
 

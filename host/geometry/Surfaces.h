@@ -1,7 +1,8 @@
 #pragma once
 // Everything a scene's surfaces need: the BVH over its triangles, analytic
 // shapes, Lambertian materials and their albedo textures; closest-hit and
-// shadow queries over all of them; and the GPU packing (geometry_types.h).
+// shadow queries over all of them. Their GPU layout is
+// render/vulkan/SurfacePacking.h.
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <vector>
@@ -10,7 +11,6 @@
 #include "geometry/Ray.h"
 #include "geometry/Shape.h"
 #include "geometry/Texture.h"
-#include "shared/geometry_types.h"
 
 namespace pyrolume::geometry {
 
@@ -35,24 +35,5 @@ bool intersect(const Surfaces& surfaces, const Ray& ray, double t_max, SurfaceHi
 bool occluded(const Surfaces& surfaces, const Ray& ray, double t_max);
 // The hit material's albedo at the hit's uv.
 glm::dvec3 albedo_at(const Surfaces& surfaces, const SurfaceHit& hit);
-
-// The buffers of shaders/bvh.glsl, each at least one element long (Vulkan has
-// no empty buffers): an empty BVH is a root with two empty leaves plus one dummy
-// triangle; no shapes gives one dummy shape (SURFACE_SHAPE_COUNT = 0 keeps the
-// shader from reading it); no materials gives one grey material.
-struct GpuSurfaces {
-  std::vector<gpu::GpuBvhNode> nodes;
-  std::vector<gpu::GpuTriangle> triangles;
-  std::vector<gpu::GpuTriangleAttributes> attributes;
-  std::vector<gpu::GpuSurfaceShape> shapes;
-  std::vector<gpu::GpuMaterial> materials;
-  uint32_t shape_count = 0;     // the real number of shapes (SURFACE_SHAPE_COUNT)
-  uint32_t triangle_count = 0;  // the real number of triangles
-};
-
-GpuSurfaces pack_gpu_surfaces(const Surfaces& surfaces);
-// The parts on their own (the test shader uses them without materials).
-std::vector<gpu::GpuBvhNode> pack_gpu_nodes(const Bvh& bvh);
-gpu::GpuSurfaceShape pack_gpu_shape(const SurfaceShape& shape);
 
 }  // namespace pyrolume::geometry

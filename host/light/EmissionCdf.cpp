@@ -10,15 +10,13 @@
 
 #include "color/Blackbody.h"
 #include "color/ColorSpace.h"
+#include "color/EmissionModel.h"
 #include "light/PiecewiseConstant.h"
+#include "scene/MediumVolume.h"
 
 namespace pyrolume {
 
 namespace {
-
-// The GPU's blackbody LUT range (host/render/cpu/Media.h kBlackbodyMinK/MaxK).
-constexpr double kBlackbodyMinK = 100.0;
-constexpr double kBlackbodyMaxK = 1.0e6;
 
 glm::dmat4 translation(const glm::dvec3& t) {
   glm::dmat4 m(1.0);
@@ -73,13 +71,13 @@ EmissionCdf EmissionCdf::build(const DenseGrid& density, const DenseGrid* temper
   // R16F grids hold at most 65536 distinct values).
   auto E_of_value = [&](float value) -> double {
     const double T = (double(value) - p.temperature.offset) * p.temperature.scale;
-    if (!(T > p.temperature.cutoff_k) || !(T >= kBlackbodyMinK)) return 0.0;  // NaN too
-    const glm::dvec3 Le = p.emission.scale * color::blackbody_rgb_5nm(std::min(T, kBlackbodyMaxK), p.emission.blackbody,
-                                                                       p.emission.observer, p.emission.adapt_to_k);
+    if (!temperature_emits(T, p.temperature.cutoff_k)) return 0.0;  // NaN too
+    const glm::dvec3 Le = temperature_Le(T, p.temperature.cutoff_k, p.emission.scale, p.emission.blackbody,
+                                         p.emission.observer, p.emission.adapt_to_k);
     return color::srgb_luminance(p.sigma_a * Le);
   };
-  const bool temperature_emits = p.emits_temperature && temperature && !temperature->empty();
-  if (!(p.emits_rgb || temperature_emits)) return e;
+  const bool grid_emits = p.emits_temperature && temperature && !temperature->empty();
+  if (!(p.emits_rgb || grid_emits)) return e;
   std::vector<float> E_t;
   double E_outside = 0.0;  // E at the temperature texture's outside (value 0)
   if (!p.emits_rgb) {
@@ -445,48 +443,10 @@ EmissionCdf EmissionCdf::clustered(int k) const {
   return e;
 }
 
-std::vector<gpu::GpuEmissionCluster> EmissionCdf::gpu_clusters() const {
-  auto to_gpu = [](const Cluster& c) {
-    gpu::GpuEmissionCluster g{};
-    g.sphere = gpu::vec4(float(c.centre.x), float(c.centre.y), float(c.centre.z), float(c.radius2));
-    g.power = gpu::vec4(float(c.power), 0.0f, 0.0f, 0.0f);
-    g.entries = gpu::uvec4(c.first, c.count, 0u, 0u);
-    return g;
-  };
-  // The grid of clusters (looked up by cell), then copies of the nonempty
-  // ones (the loops over clusters skip the empty ones without reading them).
-  std::vector<gpu::GpuEmissionCluster> out;
-  out.reserve(clusters_.size() + nonempty_clusters());
-  for (const Cluster& c : clusters_) out.push_back(to_gpu(c));
-  for (const Cluster& c : clusters_)
-    if (c.count > 0) out.push_back(to_gpu(c));
-  return out;
-}
-
 size_t EmissionCdf::nonempty_clusters() const {
   size_t n = 0;
   for (const Cluster& c : clusters_) n += c.count > 0 ? 1 : 0;
   return n;
-}
-
-gpu::GpuEmissionCdf EmissionCdf::gpu_header(uint32_t entry_offset, uint32_t pmf_offset, uint32_t cluster_offset) const {
-  if (!empty() && !is_clustered()) throw std::logic_error("EmissionCdf::gpu_header: the GPU needs a clustered() distribution");
-  gpu::GpuEmissionCdf g{};
-  auto row = [](const glm::dmat4& m, int r) {
-    return gpu::vec4(float(m[0][r]), float(m[1][r]), float(m[2][r]), float(m[3][r]));
-  };
-  g.world_to_cell_row0 = row(world_to_cell_, 0);
-  g.world_to_cell_row1 = row(world_to_cell_, 1);
-  g.world_to_cell_row2 = row(world_to_cell_, 2);
-  g.cell_to_world_row0 = row(cell_to_world_, 0);
-  g.cell_to_world_row1 = row(cell_to_world_, 1);
-  g.cell_to_world_row2 = row(cell_to_world_, 2);
-  g.cells = gpu::uvec4(uint32_t(cells_.x), uint32_t(cells_.y), uint32_t(cells_.z), uint32_t(cdf_.size()));
-  g.offsets = gpu::uvec4(entry_offset, pmf_offset, cluster_offset, uint32_t(nonempty_clusters()));
-  g.clusters = gpu::uvec4(uint32_t(cluster_dims_.x), uint32_t(cluster_dims_.y), uint32_t(cluster_dims_.z),
-                          uint32_t(cluster_k_));
-  g.measure = gpu::vec4(float(cell_volume_), cell_volume_ > 0.0 ? float(1.0 / cell_volume_) : 0.0f, float(power_), 0.0f);
-  return g;
 }
 
 }  // namespace pyrolume

@@ -19,7 +19,7 @@
 //           leaves the temperature texture, whose outside reads 0),
 //   E(T)  = Y(σa ⊙ Le(T)): sRGB luminance, σa = sigma_a · density_scale,
 //           Le = emission.scale · blackbody_rgb_5nm(T) with the CPU reference's
-//           rules (0 at or below cutoff_k and below 100 K, T clamped to 1e6 K);
+//           rules (color/EmissionModel.h temperature_Le);
 //           T = (value − offset) · scale. Constant-rgb emission: E = Y(σa ⊙ Le_rgb).
 // The emission at x, σa·ρ(x)·Le(T(x)), is > 0 only if ρ(x) > 0 and
 // T(x) > cutoff; trilinear values are convex combinations of the corners, so
@@ -34,7 +34,6 @@
 #include <glm/glm.hpp>
 
 #include "scene/Scene.h"
-#include "shared/light_types.h"
 #include "volume/DenseGrid.h"
 #include "volume/StoredVolume.h"
 
@@ -144,18 +143,23 @@ class EmissionCdf {
   }
   double direction_pdf(const glm::dvec3& o, double norm, const glm::dvec3& w) const;
 
-  // ---- what the GPU reads (shaders/shared/light_types.h, shaders/lights.glsl) ----
-  // The GPU samples only from a receiver: a clustered() distribution (or an
-  // empty one); gpu_header throws std::logic_error for any other.
-  const std::vector<float>& gpu_cdf() const { return local_cdf_; }    // inclusive within each cluster
-  const std::vector<uint32_t>& gpu_cells() const { return entries_; }  // grouped by cluster
-  const std::vector<float>& gpu_pmf() const { return local_pmf_; }    // one per cell, within its cluster
-  std::vector<gpu::GpuEmissionCluster> gpu_clusters() const;  // one per cluster, then the nonempty ones again
-  size_t nonempty_clusters() const;                            // clusters with cells of weight > 0
-  // entry_offset / pmf_offset / cluster_offset: where this medium's arrays
-  // start when several media share the buffers.
-  gpu::GpuEmissionCdf gpu_header(uint32_t entry_offset = 0, uint32_t pmf_offset = 0,
-                                 uint32_t cluster_offset = 0) const;
+  // ---- the clustered layout (render/vulkan/LightPacking.h packs it) ----
+  const std::vector<float>& cluster_cdf() const { return local_cdf_; }  // per entry, inclusive within its cluster
+  const std::vector<uint32_t>& entry_cells() const { return entries_; }  // grouped by cluster
+  const std::vector<float>& cluster_pmf() const { return local_pmf_; }  // one per cell, within its cluster
+  // A cluster of k³ cells (clustered()).
+  struct Cluster {
+    glm::dvec3 centre{0.0};   // world-space bounding sphere of its cells of weight > 0
+    double radius2 = 0.0;
+    double power = 0.0;       // Φ_s: Σ of its cells' weights / Σ of all (0: empty)
+    uint32_t first = 0, count = 0;  // its entries
+  };
+  const std::vector<Cluster>& clusters() const { return clusters_; }  // dense over the cluster grid
+  glm::ivec3 cluster_dims() const { return cluster_dims_; }
+  int cluster_cells_per_axis() const { return cluster_k_; }           // k
+  size_t nonempty_clusters() const;                                   // clusters with cells of weight > 0
+  const glm::dmat4& cell_to_world_matrix() const { return cell_to_world_; }
+  const glm::dmat4& world_to_cell_matrix() const { return world_to_cell_; }
 
  private:
   // The float CDF over entries_ (weights w, one per entry) and the per-cell pmf.
@@ -183,12 +187,6 @@ class EmissionCdf {
   std::vector<uint32_t> entries_; // per entry
 
   // clustered(): entries_ are grouped by cluster (then ascending).
-  struct Cluster {
-    glm::dvec3 centre{0.0};   // world-space bounding sphere of its cells of weight > 0
-    double radius2 = 0.0;
-    double power = 0.0;       // Φ_s: Σ of its cells' weights / Σ of all (0: empty)
-    uint32_t first = 0, count = 0;  // its entries
-  };
   int cluster_k_ = 0;              // cells per cluster per axis
   glm::ivec3 cluster_dims_{0};
   std::vector<Cluster> clusters_;  // dense over the cluster grid, linear like cells

@@ -6,8 +6,8 @@
 #include <stdexcept>
 
 #include "color/ColorSpace.h"
+#include "color/EmissionModel.h"
 #include "image/ImageIo.h"
-#include "shared/gpu_types.h"
 #include "light/PiecewiseConstant.h"
 #include "util/Error.h"
 
@@ -32,7 +32,7 @@ EnvironmentMap EnvironmentMap::load(const std::filesystem::path& file, double sc
   Image img = read_image(file);  // names the file in its InputError
   if (img.width < 1 || img.height < 1) throw input_error(file.string(), "", "environment map has no pixels");
   // NaN and Inf texels are refused (from_image would read them as no light,
-  // silently); radiance beyond gpu::MAX_EMITTED_RADIANCE would overflow the
+  // silently); radiance beyond kMaxEmittedRadiance would overflow the
   // renderers' float sums (docs/robustness.md "Finite by construction").
   size_t nonfinite = 0;
   float brightest = 0.0f;
@@ -43,10 +43,10 @@ EnvironmentMap EnvironmentMap::load(const std::filesystem::path& file, double sc
   if (nonfinite > 0)
     throw input_error(file.string(), "",
                       std::to_string(nonfinite) + " texel values are NaN or infinite; an environment map must be finite");
-  if (double(brightest) * scale > double(gpu::MAX_EMITTED_RADIANCE)) {
+  if (double(brightest) * scale > double(kMaxEmittedRadiance)) {
     char why[160];
     std::snprintf(why, sizeof why, "texels up to %.3g times environment.scale %.3g exceed %.3g, the most a render "
-                  "can sum in float without overflowing", double(brightest), scale, double(gpu::MAX_EMITTED_RADIANCE));
+                  "can sum in float without overflowing", double(brightest), scale, double(kMaxEmittedRadiance));
     throw input_error(file.string(), "", why);
   }
   try {
@@ -202,24 +202,6 @@ EnvSample EnvironmentMap::sample(const glm::dvec2& u2) const {
   s.pdf = pdf_uv_texel(i, j) / (2.0 * kPi * kPi * sin_theta);
   s.radiance = scale_ * lookup_uv(uv);
   return s;
-}
-
-std::vector<float> EnvironmentMap::gpu_texels() const {
-  std::vector<float> t(size_t(width_) * height_ * 4);
-  for (size_t k = 0; k < size_t(width_) * height_; ++k) {
-    t[k * 4 + 0] = rgb_[k * 3 + 0];
-    t[k * 4 + 1] = rgb_[k * 3 + 1];
-    t[k * 4 + 2] = rgb_[k * 3 + 2];
-    t[k * 4 + 3] = pdf_uv_[k];
-  }
-  return t;
-}
-
-gpu::GpuEnvironment EnvironmentMap::gpu_header() const {
-  gpu::GpuEnvironment g{};
-  g.transform = gpu::vec4(float(cos_rot_), float(sin_rot_), float(scale_), float(power_));
-  g.size = gpu::uvec4(uint32_t(width_), uint32_t(height_), has_distribution() ? 1u : 0u, zenith_y_ ? 1u : 0u);
-  return g;
 }
 
 }  // namespace pyrolume

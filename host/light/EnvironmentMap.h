@@ -24,7 +24,6 @@
 #include <glm/glm.hpp>
 
 #include "image/Image.h"
-#include "shared/light_types.h"
 
 namespace pyrolume {
 
@@ -88,21 +87,22 @@ class EnvironmentMap {
   double pdf_uv_texel(int i, int j) const { return double(pdf_uv_[size_t(j) * width_ + i]); }
   double pdf_uv(const glm::dvec2& uv) const;
 
-  // ---- what the GPU reads (shaders/shared/light_types.h, shaders/lights.glsl) ----
-  // texels(): W·H × (r, g, b, p_uv), row 0 = top, no scale.
-  // cdf(): (H + 1) marginal CDF values over rows, then for each row j its
-  // (W + 1) conditional CDF values at offset (H + 1) + j·(W + 1). Each starts at 0
-  // and ends at exactly 1 (a row of weight 0 holds a uniform CDF; it is never chosen).
-  std::vector<float> gpu_texels() const;
-  const std::vector<float>& gpu_cdf() const { return cdf_; }
-  gpu::GpuEnvironment gpu_header() const;
-
- private:
-  void build_distribution();
+  // The sampling CDFs: (H + 1) marginal CDF values over rows, then for each
+  // row j its (W + 1) conditional CDF values at offset (H + 1) + j·(W + 1).
+  // Each starts at 0 and ends at exactly 1 (a row of weight 0 holds a uniform
+  // CDF; it is never chosen). The GPU layout is render/vulkan/LightPacking.h.
+  const std::vector<float>& cdf() const { return cdf_; }
+  // Texel (i, j) as stored (no scale), and the rotation about the zenith.
   glm::dvec3 texel(int i, int j) const {
     const size_t k = (size_t(j) * width_ + i) * 3;
     return {rgb_[k], rgb_[k + 1], rgb_[k + 2]};
   }
+  double cos_rotation() const { return cos_rot_; }
+  double sin_rotation() const { return sin_rot_; }
+  bool zenith_y() const { return zenith_y_; }
+
+ private:
+  void build_distribution();
 
   std::string name_;
   int width_ = 0, height_ = 0;
@@ -111,7 +111,7 @@ class EnvironmentMap {
   bool zenith_y_ = false;
   std::vector<float> rgb_;      // W·H·3, row 0 = top
   std::vector<float> pdf_uv_;   // W·H
-  std::vector<float> cdf_;      // see gpu_cdf()
+  std::vector<float> cdf_;      // see cdf()
   double total_weight_ = 0.0;
   double power_ = 0.0;
   size_t sanitized_ = 0;

@@ -1,7 +1,8 @@
 #pragma once
 // The backend interface: the Vulkan renderer and the CPU reference render the
-// same Scene into the same RenderResult.
-#include <memory>
+// same Scene into the same RenderResult. The factory that picks one by name
+// is backends/Backends.h.
+#include <cstdint>
 #include <string>
 
 #include "render/Render.h"
@@ -19,13 +20,14 @@ class Backend {
   virtual uint64_t validation_messages() const { return 0; }
 };
 
+// What backends/Backends.h make_backend passes on; a backend ignores what it
+// has no use for.
 struct BackendOptions {
   int device_index = -1;    // -1: PYROLUME_DEVICE or automatic choice
   bool validation = false;  // also on when PYROLUME_VALIDATION=1
+  // Sequences (docs/animation.md): keep what the last render built for the
+  // next frame of the same scene (Vulkan: VulkanRenderer::set_frame_reuse).
+  bool frame_reuse = false;
 };
-
-// "vulkan" or "cpu"; throws InputError for an unknown name, and a clear error
-// pointing at --backend cpu when no Vulkan device exists.
-std::unique_ptr<Backend> make_backend(const std::string& name, const BackendOptions& options = {});
 
 }  // namespace pyrolume

@@ -9,7 +9,6 @@
 #include <nlohmann/json.hpp>
 
 #include "image/AtomicFile.h"
-#include "shared/gpu_types.h"
 #include "util/Error.h"
 #include "util/InputFile.h"
 #include "util/Json.h"
@@ -31,16 +30,6 @@ uint64_t fnv1a(const void* data, size_t n, uint64_t h = 0xcbf29ce484222325ull) {
     h *= 0x100000001b3ull;
   }
   return h;
-}
-
-// The payload size each backend's layout has (render/cpu/CpuRenderer.cpp
-// save_state, render/vulkan/RenderSession::save_state): a checkpoint whose
-// size disagrees is refused here, with its file name, not deep in a backend.
-uint64_t payload_bytes(const std::string& backend, int width, int height) {
-  const uint64_t pixels = uint64_t(width) * uint64_t(height);
-  if (backend == "cpu") return pixels * 6 * sizeof(double) + 3 * sizeof(uint64_t);
-  if (backend == "vulkan") return pixels * sizeof(gpu::AccumTexel);
-  return 0;
 }
 
 // FNV-1a 64 of the magic line and the JSON line, each with its '\n': where a
@@ -96,7 +85,9 @@ void write_checkpoint(const fs::path& file, const CheckpointIdentity& id, int sp
   });
 }
 
-Checkpoint read_checkpoint(const fs::path& file) {
+// A checkpoint whose payload size disagrees with its backend's layout
+// (payload_bytes) is refused here, with its file name, not deep in a backend.
+Checkpoint read_checkpoint(const fs::path& file, const PayloadBytes& payload_bytes) {
   const std::string name = file.string();
   std::error_code ec;
   const fs::file_status status = fs::status(file, ec);

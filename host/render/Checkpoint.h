@@ -12,6 +12,7 @@
 // order: a checkpoint resumes on the machine type that wrote it.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include "render/Render.h"
@@ -48,10 +49,14 @@ uint64_t scene_fingerprint(const std::filesystem::path& scene_file);
 void write_checkpoint(const std::filesystem::path& file, const CheckpointIdentity& identity, int spp_target,
                       const AccumulationState& state);
 
+// The payload size a backend's layout has for a width×height render, 0 for a
+// backend it does not know (backends/Backends.h accumulation_bytes).
+using PayloadBytes = std::function<uint64_t(const std::string& backend, int width, int height)>;
+
 // Missing, truncated, corrupt or foreign files throw InputError naming the file
-// and the reason; the header's size is checked against the file's before the
-// payload is allocated.
-Checkpoint read_checkpoint(const std::filesystem::path& file);
+// and the reason; the header's size is checked against payload_bytes and the
+// file's before the payload is allocated.
+Checkpoint read_checkpoint(const std::filesystem::path& file, const PayloadBytes& payload_bytes);
 
 // Throws InputError "FILE: KEY: REASON" naming the first identity field that
 // differs (scene, backend, width, height, seed, frame), or when the checkpoint

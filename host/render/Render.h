@@ -18,6 +18,12 @@ struct Scene;
 // (pixels × spp, up to 2^28 · 2^24) need 64-bit arithmetic: total_samples().
 inline constexpr int kMaxSpp = 1 << 24;
 
+// A sample whose radiance exceeds this in any channel (or is NaN or infinite)
+// is counted as non-finite and adds nothing: beyond it float sums of 2^24
+// samples could overflow (shaders/shared/gpu_types.h MAX_SAMPLE_RADIANCE, the
+// GPU's copy, asserted equal in render/vulkan/GpuScene.cpp).
+inline constexpr float kMaxSampleRadiance = 1e15f;
+
 // Camera samples of a width×height render at spp samples per pixel, in 64-bit
 // (int products overflow at 2^31: 4096² pixels × 128 spp already does).
 inline uint64_t total_samples(int width, int height, int spp) {

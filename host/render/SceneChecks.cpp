@@ -5,7 +5,7 @@
 #include <cstdio>
 
 #include "color/Blackbody.h"
-#include "shared/gpu_types.h"
+#include "color/EmissionModel.h"
 #include "util/Error.h"
 
 namespace pyrolume {
@@ -25,19 +25,19 @@ double max3(const glm::dvec3& v) { return std::max({v.x, v.y, v.z}); }
 // grow with T, "chromaticity" and "peak" are normalised curves, so the
 // range is sampled every 2 % of temperature, its top included.
 double brightest_blackbody(const Emission& e, double hottest_k) {
-  hottest_k = std::min(hottest_k, 1e6);
+  hottest_k = std::min(hottest_k, kEmissionMaxK);
   double best = 0.0;
-  for (double T = 100.0; T < hottest_k; T *= 1.02) best = std::max(best, max3(color::blackbody_rgb(T, e.blackbody, e.observer, e.adapt_to_k)));
+  for (double T = kEmissionMinK; T < hottest_k; T *= 1.02) best = std::max(best, max3(color::blackbody_rgb(T, e.blackbody, e.observer, e.adapt_to_k)));
   return std::max(best, max3(color::blackbody_rgb(hottest_k, e.blackbody, e.observer, e.adapt_to_k)));
 }
 
 void check_emitted_radiance(const std::string& file, const std::string& at, double scale, double brightest,
                             const std::string& what) {
   const double radiance = scale * brightest;
-  if (!(radiance <= double(gpu::MAX_EMITTED_RADIANCE)))
+  if (!(radiance <= double(kMaxEmittedRadiance)))
     throw input_error(file, at + ".emission.scale",
                       "emission.scale " + sci(scale) + " × " + what + " (" + sci(brightest) + ") gives radiance " +
-                          sci(radiance) + ", beyond " + sci(gpu::MAX_EMITTED_RADIANCE) +
+                          sci(radiance) + ", beyond " + sci(kMaxEmittedRadiance) +
                           ", the most a render can sum in float without overflowing; lower emission.scale");
 }
 
@@ -76,7 +76,7 @@ void check_loaded_medium(const Scene& scene, size_t medium, const StoredVolume& 
   if (!(hottest_k > map.cutoff_k)) return;  // nothing glows (the loader warns)
   char what[160];
   std::snprintf(what, sizeof what, "the brightest %s blackbody colour up to the grid's hottest voxel, %.4g K",
-                color::to_string(e.blackbody), std::min(hottest_k, 1e6));
+                color::to_string(e.blackbody), std::min(hottest_k, kEmissionMaxK));
   check_emitted_radiance(scene.file.string(), "media[" + std::to_string(medium) + "]", e.scale,
                          brightest_blackbody(e, hottest_k), what);
 }

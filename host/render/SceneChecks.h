@@ -14,14 +14,14 @@ namespace pyrolume {
 
 // Every medium's emission: emission.scale times the brightest colour it can
 // take (its rgb or its temperature_k's blackbody colour; a grid's, once it is
-// loaded, in check_loaded_medium) must stay within gpu::MAX_EMITTED_RADIANCE;
+// loaded, in check_loaded_medium) must stay within kMaxEmittedRadiance (color/EmissionModel.h);
 // σa and σs (times density_scale) within kMaxSigma.
 void check_scene_ranges(const Scene& scene);
 
 // What a grid medium must satisfy once loaded: its majorant optical depth
 // (check_majorant_depth), and emission.scale times the brightest blackbody
 // colour between 100 K and its hottest voxel's temperature within
-// gpu::MAX_EMITTED_RADIANCE.
+// kMaxEmittedRadiance.
 void check_loaded_medium(const Scene& scene, size_t medium, const StoredVolume& volume);
 
 // The largest extinction coefficient accepted, per scene unit: far beyond any

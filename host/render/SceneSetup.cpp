@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "geometry/Mesh.h"
+#include "scene/MediumVolume.h"
 #include "util/Error.h"
 #include "volume/SourceConventions.h"
 #include "volume/VdbInfo.h"

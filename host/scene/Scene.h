@@ -10,6 +10,9 @@
 
 #include <glm/glm.hpp>
 
+#include "color/BlackbodyMode.h"
+#include "volume/VolumeOptions.h"
+
 namespace pyrolume {
 
 // A keyframed parameter: {"keys": [[frame, value], ...]} in the scene JSON
@@ -101,10 +104,6 @@ struct Bounds {
   glm::dvec3 min{0.0}, max{0.0};
 };
 
-// Seed: "chromaticity" in scene files (colour only); StefanBoltzmann: the
-// default, brightness ∝ T⁴ (docs/blackbody.md).
-enum class BlackbodyMode { Seed, Peak, Physical, StefanBoltzmann };
-
 struct Emission {
   // Exactly one of rgb / temperature_k is set for homogeneous media; grid media
   // take their temperature from the grid (then neither is set).
@@ -119,22 +118,12 @@ struct Emission {
   bool is_grid = false;  // temperature comes from a grid
 };
 
-struct TemperatureMapping {
-  double scale = 1.0;   // T = (value - offset) * scale, kelvin
-  double offset = 0.0;
-  double cutoff_k = 100.0;  // no emission at or below
-};
-
 // Which keys of a vdb medium the file wrote: a source convention
 // (host/volume/SourceConventions) fills in only the others.
 struct ExplicitKeys {
   bool temperature_scale = false, temperature_offset = false, temperature_cutoff = false;
   bool emission = false;  // an "emission" block
 };
-
-// The simulator that wrote a vdb file (docs/sources.md): it decides the grids
-// read, the temperature mapping and the up axis. Auto: detected from the file.
-enum class VolumeSource { Auto, Blender, Houdini, EmberGen, Kelvin };
 
 struct Transform {
   glm::dvec3 translate{0.0};
@@ -202,8 +191,6 @@ struct Light {
   // by next-event estimation; the others can also be hit by rays.
   bool is_delta() const { return type == Type::Point || type == Type::Spot || (type == Type::Distant && angle_deg == 0.0); }
 };
-
-enum class UpAxis { Y, Z };
 
 struct Scene {
   std::filesystem::path file;  // the JSON it came from (for messages)

@@ -22,4 +22,10 @@ inline InputError input_error(const std::string& file, const std::string& key, c
   return InputError(msg);
 }
 
+// No device to render on (no driver, no GPU): one line that points to another
+// backend (exit status 2). The Vulkan backend throws vk::NoDeviceError.
+struct NoDeviceError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 }  // namespace pyrolume

@@ -166,15 +166,6 @@ void fit_temperature_mapping(SourceConvention& c, const std::string& file) {
   c.mapping_text = s.str();
 }
 
-void apply_source_convention(Medium& m, const SourceConvention& c) {
-  if (m.density_grid.empty()) m.density_grid = c.density_grid;
-  if (m.temperature_grid.empty()) m.temperature_grid = c.temperature_grid;
-  if (!m.given.temperature_scale) m.temperature.scale = c.mapping.scale;
-  if (!m.given.temperature_offset) m.temperature.offset = c.mapping.offset;
-  if (!m.given.temperature_cutoff) m.temperature.cutoff_k = c.mapping.cutoff_k;
-  if (c.temperature_grid.empty() && !m.given.emission) m.emission.is_grid = false;
-}
-
 std::string scene_snippet(const std::string& file, const SourceConvention& c) {
   std::ostringstream s;
   s << "{\"media\": [{\"type\": \"vdb\", \"file\": \"" << file << "\"}]}\n"

@@ -7,8 +7,8 @@
 #include <optional>
 #include <string>
 
-#include "scene/Scene.h"
 #include "volume/VdbInfo.h"
+#include "volume/VolumeOptions.h"
 
 namespace pyrolume {
 
@@ -46,12 +46,6 @@ SourceConvention source_convention(const VolumeFileInfo& info, VolumeSource requ
 // A grid whose values are all <= 0 keeps scale 1 (nothing glows; the loader's
 // warning says so).
 void fit_temperature_mapping(SourceConvention& c, const std::string& file);
-
-// Sets what the scene file left unset on a vdb medium: the grids, the
-// temperature mapping (each of scale, offset, cutoff_k only when not written),
-// and, when the convention finds no temperature grid and the file wrote no
-// emission block, no emission.
-void apply_source_convention(Medium& m, const SourceConvention& c);
 
 // A scene that renders the file with its defaults (for `pyrolume info`).
 std::string scene_snippet(const std::string& file, const SourceConvention& c);

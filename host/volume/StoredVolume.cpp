@@ -8,10 +8,6 @@
 
 namespace pyrolume {
 
-bool needs_temperature_grid(const Medium& m) {
-  return m.type == Medium::Type::Vdb && m.emission.is_grid && m.emission.scale > 0.0;
-}
-
 void round_to_format(StoredGrid& g) {
   g.half_bits.clear();
   if (g.format != TextureFormat::R16F) return;
@@ -38,9 +34,9 @@ StoredGrid store(DenseGrid grid, TextureFormat wanted) {
 }
 }  // namespace
 
-StoredVolume load_stored_volume(const Medium& m, const DenseLimits& limits) {
-  VolumeGrids grids = load_volume(m, needs_temperature_grid(m), limits);
-  TextureFormat wanted = m.texture_format == "r32f" ? TextureFormat::R32F : TextureFormat::R16F;
+StoredVolume load_stored_volume(const VolumeOptions& m, const DenseLimits& limits) {
+  VolumeGrids grids = load_volume(m, limits);
+  const TextureFormat wanted = m.texture_format;
   StoredVolume v;
   v.density = store(std::move(grids.density), wanted);
   if (grids.temperature) v.temperature = store(std::move(*grids.temperature), wanted);

@@ -8,12 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "scene/Scene.h"
 #include "volume/DenseGrid.h"
+#include "volume/VolumeOptions.h"
 
 namespace pyrolume {
-
-enum class TextureFormat { R16F, R32F };
 
 struct StoredGrid {
   DenseGrid grid;                // values as stored (already rounded when R16F)
@@ -27,13 +25,10 @@ struct StoredVolume {
   std::vector<std::string> warnings;
 };
 
-// Whether a medium's emission needs its temperature grid.
-bool needs_temperature_grid(const Medium& m);
-
-// Loads the medium's grids (VdbLoader) and rounds them to their texture format:
-// the medium's `texture_format` ("r16f" default, "r32f"), promoted to R32F when a
-// stored value exceeds what R16F holds (|v| > 6e4).
-StoredVolume load_stored_volume(const Medium& m, const DenseLimits& limits = {});
+// Loads the grids (VdbLoader) and rounds them to their texture format:
+// options.texture_format, promoted to R32F when a stored value exceeds what
+// R16F holds (|v| > 6e4). A Medium's: scene/MediumVolume.h.
+StoredVolume load_stored_volume(const VolumeOptions& options, const DenseLimits& limits = {});
 
 // Rounds every value to the nearest half and fills half_bits.
 void round_to_format(StoredGrid& g);

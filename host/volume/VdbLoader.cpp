@@ -35,16 +35,6 @@
 
 namespace pyrolume {
 
-glm::dmat4 medium_transform_matrix(const Transform& t) {
-  glm::dmat4 M(1.0);
-  M = glm::translate(M, t.translate);
-  M = glm::rotate(M, glm::radians(t.rotate_deg.z), glm::dvec3(0, 0, 1));
-  M = glm::rotate(M, glm::radians(t.rotate_deg.y), glm::dvec3(0, 1, 0));
-  M = glm::rotate(M, glm::radians(t.rotate_deg.x), glm::dvec3(1, 0, 0));
-  M = glm::scale(M, t.scale);
-  return M;  // = T * Rz * Ry * Rx * S
-}
-
 namespace {
 
 enum class Role { Density, Temperature };
@@ -96,7 +86,7 @@ struct GridChoice {
   std::optional<GridEntry> temperature;
 };
 
-GridChoice choose_grids(const std::vector<GridEntry>& entries, const Medium& m, bool need_temperature,
+GridChoice choose_grids(const std::vector<GridEntry>& entries, const VolumeOptions& m, bool need_temperature,
                         const std::string& file, std::vector<std::string>& warnings) {
   GridChoice c;
   const std::string dname = m.density_grid.empty() ? kDefaultDensityGrid : m.density_grid;
@@ -291,14 +281,14 @@ void warn_empty(const std::string& file, Role role, const std::string& grid, std
 // ---- OpenVDB ----
 
 template <class GridT>
-DenseGrid dense_from_openvdb(const GridT& grid, const Medium& m, Role role, const std::string& file,
+DenseGrid dense_from_openvdb(const GridT& grid, const VolumeOptions& m, Role role, const std::string& file,
                              std::vector<std::string>& warnings, const DenseLimits& limits) {
   DenseGrid out;
   out.name = grid.getName();
   const glm::dmat4 grid_to_world = openvdb_index_to_world(grid.transform(), file, out.name);
   const openvdb::CoordBBox bbox = grid.evalActiveVoxelBoundingBox();
   if (grid.activeVoxelCount() == 0 || bbox.empty()) {
-    out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world;
+    out.index_to_world = m.transform * grid_to_world;
     out.world_to_index = glm::inverse(out.index_to_world);
     check_index_maps(out, file, role);
     warn_empty(file, role, out.name, warnings);
@@ -321,7 +311,7 @@ DenseGrid dense_from_openvdb(const GridT& grid, const Medium& m, Role role, cons
   }
   b.finish();
   report_counts(b, file, role, out.name, warnings);
-  out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world * b.index_map();
+  out.index_to_world = m.transform * grid_to_world * b.index_map();
   out.world_to_index = glm::inverse(out.index_to_world);
   check_index_maps(out, file, role);
   return out;
@@ -349,7 +339,7 @@ std::vector<GridEntry> openvdb_grid_entries(openvdb::io::File& f) {
   return entries;
 }
 
-VolumeGrids load_openvdb(const Medium& m, bool need_temperature, const DenseLimits& limits) {
+VolumeGrids load_openvdb(const VolumeOptions& m, bool need_temperature, const DenseLimits& limits) {
   ensure_openvdb_initialized();
   const std::string file = m.file.string();
   validate_openvdb_file(m.file);  // OpenVDB trusts the lengths and offsets it reads
@@ -388,14 +378,14 @@ VolumeGrids load_openvdb(const Medium& m, bool need_temperature, const DenseLimi
 // ---- NanoVDB ----
 
 template <class BuildT>
-DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Medium& m, Role role,
+DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const VolumeOptions& m, Role role,
                              const std::string& file, std::vector<std::string>& warnings, const DenseLimits& limits) {
   DenseGrid out;
   out.name = grid.gridName();
   const glm::dmat4 grid_to_world = nanovdb_index_to_world(grid);
   const auto& bbox = grid.indexBBox();  // bbox of the active values
   if (grid.activeVoxelCount() == 0 || bbox.empty()) {
-    out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world;
+    out.index_to_world = m.transform * grid_to_world;
     out.world_to_index = glm::inverse(out.index_to_world);
     check_index_maps(out, file, role);
     warn_empty(file, role, out.name, warnings);
@@ -413,13 +403,13 @@ DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Medium
       }
   b.finish();
   report_counts(b, file, role, out.name, warnings);
-  out.index_to_world = medium_transform_matrix(m.transform) * grid_to_world * b.index_map();
+  out.index_to_world = m.transform * grid_to_world * b.index_map();
   out.world_to_index = glm::inverse(out.index_to_world);
   check_index_maps(out, file, role);
   return out;
 }
 
-VolumeGrids load_nanovdb(const Medium& m, bool need_temperature, const DenseLimits& limits) {
+VolumeGrids load_nanovdb(const VolumeOptions& m, bool need_temperature, const DenseLimits& limits) {
   const std::string file = m.file.string();
   VolumeGrids out;
   std::vector<nanovdb::io::GridMetaData> metas;
@@ -461,11 +451,11 @@ VolumeGrids load_nanovdb(const Medium& m, bool need_temperature, const DenseLimi
 
 void set_max_dense_texels(uint64_t texels) { max_dense_texels = std::min(texels, uint64_t(1) << 32); }
 
-VolumeGrids load_volume(const Medium& m, bool need_temperature, const DenseLimits& limits) {
+VolumeGrids load_volume(const VolumeOptions& m, const DenseLimits& limits) {
   const std::string file = m.file.string();
   if (m.downsample < 1) throw input_error(file, "downsample", "must be >= 1");
-  return detect_volume_format(m.file) == VolumeFormat::NanoVdb ? load_nanovdb(m, need_temperature, limits)
-                                                               : load_openvdb(m, need_temperature, limits);
+  return detect_volume_format(m.file) == VolumeFormat::NanoVdb ? load_nanovdb(m, m.need_temperature, limits)
+                                                               : load_openvdb(m, m.need_temperature, limits);
 }
 
 std::string cold_temperature_warning(const DenseGrid& t, const TemperatureMapping& map) {

@@ -5,8 +5,8 @@
 
 #include <glm/glm.hpp>
 
-#include "scene/Scene.h"
 #include "volume/DenseGrid.h"
+#include "volume/VolumeOptions.h"
 
 namespace pyrolume {
 
@@ -14,15 +14,16 @@ namespace pyrolume {
 inline constexpr const char* kDefaultTemperatureGrids[] = {"temperature", "heat", "flame"};
 inline constexpr const char* kDefaultDensityGrid = "density";
 
-// Reads only the density grid (and, when need_temperature, the temperature
-// grid) named by the medium, each into its own DenseGrid with its own
-// index->world map, the medium transform composed on top.
+// Reads only the density grid (and, when options.need_temperature, the
+// temperature grid) named in options, each into its own DenseGrid with its own
+// index->world map, options.transform composed on top. A Medium's:
+// scene/MediumVolume.h.
 // Throws InputError (file, grid, reason) for a missing/unreadable file, a
 // missing grid (the message lists the grids present) or a non-scalar grid.
 // Recoverable oddities (empty grid, NaN/Inf, negative density) come back as
 // VolumeGrids::warnings. A grid past `limits` throws InputError (file, grid,
 // the limit, the "downsample" that would fit) before its dense array exists.
-VolumeGrids load_volume(const Medium& m, bool need_temperature, const DenseLimits& limits = {});
+VolumeGrids load_volume(const VolumeOptions& options, const DenseLimits& limits = {});
 
 // "" when the temperature grid's hottest value maps above the cutoff;
 // otherwise the warning (naming the grid, the hottest temperature and a
@@ -35,9 +36,5 @@ std::string cold_temperature_warning(const DenseGrid& temperature, const Tempera
 // tests lower it: a few bytes of active tiles can describe a legitimately huge
 // volume, and allocating it teaches them nothing.
 void set_max_dense_texels(uint64_t texels);
-
-// The medium's `transform` as a matrix: T * Rz * Ry * Rx * S, i.e. scale first,
-// then rotate about X, Y, Z (degrees, right-handed), then translate.
-glm::dmat4 medium_transform_matrix(const Transform& t);
 
 }  // namespace pyrolume

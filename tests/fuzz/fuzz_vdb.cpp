@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "fuzz/FuzzSupport.h"
+#include "scene/MediumVolume.h"
 #include "volume/VdbInfo.h"
 #include "volume/VdbLoader.h"
 

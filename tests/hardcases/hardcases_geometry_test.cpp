@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "hardcases/HardCaseFixture.h"
+#include "scene/MediumVolume.h"
 #include "volume/VdbLoader.h"
 
 namespace pyrolume {

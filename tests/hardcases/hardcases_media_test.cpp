@@ -13,6 +13,7 @@
 
 #include "color/Blackbody.h"
 #include "hardcases/HardCaseFixture.h"
+#include "scene/MediumVolume.h"
 #include "volume/VdbLoader.h"
 
 namespace pyrolume {

@@ -10,8 +10,9 @@
 
 #include <gtest/gtest.h>
 
-#include "render/Backend.h"
+#include "backends/Backends.h"
 #include "render/cpu/CpuRenderer.h"
+#include "scene/MediumVolume.h"
 #include "support/AnalyticScenes.h"
 #include "support/Stats.h"
 #include "support/TestSupport.h"

@@ -12,6 +12,7 @@
 #include <iostream>
 #include <string>
 
+#include "scene/MediumVolume.h"
 #include "support/TestSupport.h"
 #include "volume/VdbLoader.h"
 

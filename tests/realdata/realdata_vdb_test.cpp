@@ -12,6 +12,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
 
+#include "scene/MediumVolume.h"
 #include "support/TestSupport.h"
 #include "util/Error.h"
 #include "volume/VdbInfo.h"

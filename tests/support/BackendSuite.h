@@ -26,7 +26,7 @@
 
 #include <gtest/gtest.h>
 
-#include "render/Backend.h"
+#include "backends/Backends.h"
 #include "render/cpu/CpuRenderer.h"
 #include "support/AnalyticScenes.h"
 

@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "render/Backend.h"
+#include "backends/Backends.h"
 #include "support/AnalyticScenes.h"
 
 namespace pyrolume::test {

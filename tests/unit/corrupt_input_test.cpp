@@ -27,6 +27,7 @@
 #include "geometry/Mesh.h"
 #include "image/ImageIo.h"
 #include "light/EnvironmentMap.h"
+#include "scene/MediumVolume.h"
 #include "support/TestSupport.h"
 #include "util/Error.h"
 #include "volume/VdbInfo.h"

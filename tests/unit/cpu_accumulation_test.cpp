@@ -6,6 +6,7 @@
 // checkpoint file format and the 64-bit sample arithmetic.
 #include <gtest/gtest.h>
 
+#include "backends/Backends.h"
 #include "render/Checkpoint.h"
 #include "render/cpu/CpuRenderer.h"
 #include "render/cpu/Rng.h"

@@ -15,6 +15,7 @@
 #include "light/LightSelection.h"
 #include "render/cpu/CpuRenderer.h"
 #include "support/MisSuite.h"
+#include "scene/MediumVolume.h"
 #include "support/Stats.h"
 
 namespace pyrolume {

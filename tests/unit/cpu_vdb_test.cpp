@@ -13,6 +13,7 @@
 #include "color/Blackbody.h"
 #include "render/cpu/CpuRenderer.h"
 #include "render/cpu/Media.h"
+#include "scene/MediumVolume.h"
 #include "support/Stats.h"
 #include "support/VdbSuite.h"
 

@@ -15,6 +15,7 @@
 #include "geometry/Shape.h"
 #include "geometry/Surfaces.h"
 #include "geometry/Triangle.h"
+#include "render/vulkan/SurfacePacking.h"
 #include "shared/geometry_types.h"
 #include "support/RandomDirections.h"
 

@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "image/RenderImage.h"
+#include "render/RenderImage.h"
 
 using namespace pyrolume;
 

@@ -15,6 +15,7 @@
 #include "light/EnvironmentMap.h"
 #include "light/LightSelection.h"
 #include "render/cpu/CpuRenderer.h"
+#include "scene/MediumVolume.h"
 #include "scene/Scene.h"
 #include "support/MisScenes.h"
 #include "util/Error.h"

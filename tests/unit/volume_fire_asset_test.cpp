@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include "scene/MediumVolume.h"
 #include "scene/Scene.h"
 #include "volume/VdbLoader.h"
 

@@ -3,6 +3,7 @@
 // and the downsample that would fit.
 #include <gtest/gtest.h>
 
+#include "scene/MediumVolume.h"
 #include "support/VdbScenes.h"
 #include "util/Error.h"
 #include "volume/VdbLoader.h"

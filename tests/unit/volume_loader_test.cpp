@@ -11,6 +11,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
 
+#include "scene/MediumVolume.h"
 #include "support/TestSupport.h"
 #include "support/VdbScenes.h"
 #include "util/Error.h"

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "scene/MediumVolume.h"
 #include "scene/Scene.h"
 #include "support/TestSupport.h"
 #include "volume/MajorantGrid.h"

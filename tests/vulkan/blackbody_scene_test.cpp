@@ -2,7 +2,7 @@
 // blackbody emission at 1000–10 000 K agrees per pixel and in total.
 #include <gtest/gtest.h>
 
-#include "render/Backend.h"
+#include "backends/Backends.h"
 #include "render/cpu/CpuRenderer.h"
 #include "scene/Scene.h"
 #include "support/Stats.h"

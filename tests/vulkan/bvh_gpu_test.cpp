@@ -18,6 +18,7 @@
 #include "render/vulkan/Memory.h"
 #include "render/vulkan/Pipeline.h"
 #include "render/vulkan/Spirv.h"
+#include "render/vulkan/SurfacePacking.h"
 #include "shared/geometry_types.h"
 #include "support/RandomDirections.h"
 

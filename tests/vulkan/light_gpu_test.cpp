@@ -13,9 +13,11 @@
 #include "light/EmissionCdf.h"
 #include "light/EnvironmentMap.h"
 #include "render/vulkan/Context.h"
+#include "render/vulkan/LightPacking.h"
 #include "render/vulkan/Memory.h"
 #include "render/vulkan/Pipeline.h"
 #include "render/vulkan/Spirv.h"
+#include "scene/MediumVolume.h"
 #include "scene/Scene.h"
 #include "shared/light_types.h"
 #include "volume/StoredVolume.h"
@@ -95,16 +97,16 @@ Buffer storage(Context& ctx, const void* data, size_t bytes, const char* name) {
 }
 
 void run_queries(Context& ctx, const EnvironmentMap& env, const EmissionCdf& cdf, std::vector<Query>& queries) {
-  LightBlock block{env.gpu_header(), cdf.gpu_header()};
+  LightBlock block{pack_gpu_environment_header(env), pack_gpu_emission_header(cdf)};
   Buffer ubo(ctx, sizeof block, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, MemoryKind::HostVisible, "light block");
   ubo.upload(ctx, &block, sizeof block);
-  const std::vector<float> texels = env.gpu_texels();
+  const std::vector<float> texels = pack_gpu_environment_texels(env);
   Buffer env_texels = storage(ctx, texels.data(), texels.size() * 4, "env_texels");
-  Buffer env_cdf = storage(ctx, env.gpu_cdf().data(), env.gpu_cdf().size() * 4, "env_cdf");
-  Buffer em_cdf = storage(ctx, cdf.gpu_cdf().data(), cdf.gpu_cdf().size() * 4, "emission_cdf");
-  Buffer em_cells = storage(ctx, cdf.gpu_cells().data(), cdf.gpu_cells().size() * 4, "emission_cells");
-  Buffer em_pmf = storage(ctx, cdf.gpu_pmf().data(), cdf.gpu_pmf().size() * 4, "emission_pmf");
-  const std::vector<gpu::GpuEmissionCluster> clusters = cdf.gpu_clusters();
+  Buffer env_cdf = storage(ctx, env.cdf().data(), env.cdf().size() * 4, "env_cdf");
+  Buffer em_cdf = storage(ctx, cdf.cluster_cdf().data(), cdf.cluster_cdf().size() * 4, "emission_cdf");
+  Buffer em_cells = storage(ctx, cdf.entry_cells().data(), cdf.entry_cells().size() * 4, "emission_cells");
+  Buffer em_pmf = storage(ctx, cdf.cluster_pmf().data(), cdf.cluster_pmf().size() * 4, "emission_pmf");
+  const std::vector<gpu::GpuEmissionCluster> clusters = pack_gpu_emission_clusters(cdf);
   Buffer em_clusters = storage(ctx, clusters.data(), clusters.size() * sizeof clusters[0], "emission_clusters");
   Buffer qbuf(ctx, queries.size() * sizeof(Query), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::Readback, "queries");
   std::memcpy(qbuf.map(), queries.data(), queries.size() * sizeof(Query));

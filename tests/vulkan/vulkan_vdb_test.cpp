@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "render/cpu/CpuRenderer.h"
+#include "scene/MediumVolume.h"
 #include "support/Stats.h"
 #include "support/VdbSuite.h"
 #include "render/vulkan/GpuScene.h"

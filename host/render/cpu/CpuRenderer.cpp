@@ -27,7 +27,6 @@
 #include "render/cpu/Rng.h"
 #include "render/cpu/Sampling.h"
 #include "render/cpu/Transmittance.h"
-#include "shared/gpu_types.h"
 
 namespace pyrolume {
 namespace cpu {
@@ -718,7 +717,8 @@ AccumulationState save_state(const RenderResult& res, const CpuCounters& c) {
 
 void load_state(const AccumulationState& st, RenderResult& res, CpuCounters& c) {
   const size_t n = res.sum.size() * sizeof(double);
-  if (st.backend != "cpu" || st.width != res.width || st.height != res.height || st.data.size() != 2 * n + sizeof c)
+  if (st.backend != "cpu" || st.width != res.width || st.height != res.height ||
+      st.data.size() != CpuRenderer::accumulation_bytes(res.width, res.height))
     throw std::invalid_argument("cpu reference: the resumed accumulation is not a " + std::to_string(res.width) + "x" +
                                 std::to_string(res.height) + " cpu one");
   std::memcpy(res.sum.data(), st.data.data(), n);
@@ -728,6 +728,10 @@ void load_state(const AccumulationState& st, RenderResult& res, CpuCounters& c) 
 }
 
 }  // namespace
+
+uint64_t CpuRenderer::accumulation_bytes(int width, int height) {
+  return uint64_t(width) * uint64_t(height) * 6 * sizeof(double) + sizeof(CpuCounters);
+}
 
 CpuRenderer::CpuRenderer(int threads) {
   if (threads <= 0) threads = int(std::thread::hardware_concurrency());
@@ -852,7 +856,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
                 L[c] = walk_channel(walk_scene, c, scene.camera.position, dir, rng, cnt, scratch, max_depth);
               // NaN, Inf and beyond MAX_SAMPLE_RADIANCE (where float sums of
               // squares could overflow): recorded as 0, counted in nonfinite_samples.
-              const double kMaxL = gpu::MAX_SAMPLE_RADIANCE;
+              const double kMaxL = kMaxSampleRadiance;
               if (!(std::abs(L.x) <= kMaxL && std::abs(L.y) <= kMaxL && std::abs(L.z) <= kMaxL)) {
                 ++cnt.nonfinite;
                 L = glm::dvec3(0.0);

@@ -5,7 +5,9 @@
 #include <limits>
 
 #include "color/Blackbody.h"
+#include "color/EmissionModel.h"
 #include "render/cpu/Intersect.h"
+#include "scene/MediumVolume.h"
 
 namespace pyrolume::cpu {
 
@@ -133,10 +135,8 @@ double grid_temperature(const MediumData& m, const glm::dvec3& p) {
 }
 
 glm::dvec3 grid_Le_of_temperature(const MediumData& m, double T) {
-  if (!(T > m.temperature.cutoff_k) || !(T >= kBlackbodyMinK)) return glm::dvec3(0.0);  // NaN too
-  T = std::min(T, kBlackbodyMaxK);
-  return m.emission.scale *
-         color::blackbody_rgb_5nm(T, m.emission.blackbody, m.emission.observer, m.emission.adapt_to_k);
+  return temperature_Le(T, m.temperature.cutoff_k, m.emission.scale, m.emission.blackbody, m.emission.observer,
+                        m.emission.adapt_to_k);
 }
 
 glm::dvec3 LeCache::get(const MediumData& m, int medium, double T_k) {

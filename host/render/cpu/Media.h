@@ -25,11 +25,6 @@
 
 namespace pyrolume::cpu {
 
-// The GPU's blackbody LUT covers [kMinK, kMaxK]: 0 below (and for NaN), the
-// last texel above. The reference does the same with a direct evaluation.
-inline constexpr double kBlackbodyMinK = 100.0;
-inline constexpr double kBlackbodyMaxK = 1.0e6;
-
 struct MediumData {
   Medium::Type type = Medium::Type::Homogeneous;
   std::string name;
@@ -103,9 +98,8 @@ double grid_density(const MediumData& m, const glm::dvec3& p);
 // Temperature in kelvin at p: (value − offset) · scale (value 0 outside the grid).
 double grid_temperature(const MediumData& m, const glm::dvec3& p);
 
-// Le of a vdb medium at temperature T, what the GPU LUT returns: 0 at or below
-// cutoff_k, below kBlackbodyMinK and for NaN; T clamped to kBlackbodyMaxK.
-// Planck evaluated directly (color::blackbody_rgb_5nm), times emission.scale.
+// Le of a vdb medium at temperature T, what the GPU LUT returns: the emission
+// rule of color/EmissionModel.h (temperature_Le), Planck evaluated directly.
 glm::dvec3 grid_Le_of_temperature(const MediumData& m, double T);
 
 // One-entry memo of grid_Le_of_temperature per medium (exact: same T, same Le).

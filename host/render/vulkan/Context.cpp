@@ -92,7 +92,7 @@ Context::Context(const Options& options) {
   // --- instance ---
   uint32_t loader_version = VK_API_VERSION_1_0;
   if (vkEnumerateInstanceVersion(&loader_version) != VK_SUCCESS || loader_version < VK_API_VERSION_1_1)
-    throw NoDeviceError("the Vulkan loader is older than 1.1");
+    throw no_device_error("the Vulkan loader is older than 1.1");
   const uint32_t api = std::min<uint32_t>(VK_API_VERSION_1_3, loader_version);
 
   std::vector<const char*> layers;
@@ -158,7 +158,7 @@ Context::Context(const Options& options) {
   VkInstance raw_instance = VK_NULL_HANDLE;
   VkResult r = vkCreateInstance(&ici, nullptr, &raw_instance);
   if (r == VK_ERROR_INCOMPATIBLE_DRIVER || r == VK_ERROR_INITIALIZATION_FAILED)
-    throw NoDeviceError(std::string("vkCreateInstance: ") + vk_result_name(r));
+    throw no_device_error(std::string("vkCreateInstance: ") + vk_result_name(r));
   VK_CHECK(r);
   instance_ = UniqueInstance(raw_instance, {});
 

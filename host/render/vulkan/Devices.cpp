@@ -12,10 +12,10 @@
 
 namespace pyrolume::vk {
 
-NoDeviceError::NoDeviceError(const std::string& detail)
-    : VulkanError("no Vulkan device available (" + detail +
-                      "); install a Vulkan driver (e.g. mesa-vulkan-drivers) or use --backend cpu",
-                  VK_ERROR_INCOMPATIBLE_DRIVER) {}
+NoDeviceError no_device_error(const std::string& detail) {
+  return NoDeviceError("no Vulkan device available (" + detail +
+                       "); install a Vulkan driver (e.g. mesa-vulkan-drivers) or use --backend cpu");
+}
 
 const char* device_type_name(VkPhysicalDeviceType type) {
   switch (type) {
@@ -62,14 +62,14 @@ std::vector<DeviceInfo> list_devices(VkInstance instance) {
   if (count) VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, devices.data()));
   std::vector<DeviceInfo> infos;
   for (uint32_t i = 0; i < count; ++i) infos.push_back(describe_device(devices[i], i));
-  if (infos.empty()) throw NoDeviceError("the Vulkan loader found no physical device");
+  if (infos.empty()) throw no_device_error("the Vulkan loader found no physical device");
   return infos;
 }
 
 std::vector<DeviceInfo> list_devices() {
   uint32_t loader_version = VK_API_VERSION_1_0;
   if (vkEnumerateInstanceVersion(&loader_version) != VK_SUCCESS || loader_version < VK_API_VERSION_1_1)
-    throw NoDeviceError("the Vulkan loader is older than 1.1");
+    throw no_device_error("the Vulkan loader is older than 1.1");
   VkApplicationInfo app{.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "pyrolume devices";
   app.apiVersion = loader_version >= VK_API_VERSION_1_3 ? VK_API_VERSION_1_3 : loader_version;
@@ -90,7 +90,7 @@ std::vector<DeviceInfo> list_devices() {
   VkInstance raw = VK_NULL_HANDLE;
   VkResult r = vkCreateInstance(&ci, nullptr, &raw);
   if (r == VK_ERROR_INCOMPATIBLE_DRIVER || r == VK_ERROR_INITIALIZATION_FAILED)
-    throw NoDeviceError(std::string("vkCreateInstance: ") + vk_result_name(r));
+    throw no_device_error(std::string("vkCreateInstance: ") + vk_result_name(r));
   VK_CHECK(r);
   UniqueInstance instance(raw, {});
   return list_devices(instance.get());
@@ -131,7 +131,7 @@ std::string range_text(size_t n) {
 }  // namespace
 
 int choose_device(const std::vector<DeviceInfo>& devices, int requested) {
-  if (devices.empty()) throw NoDeviceError("the Vulkan loader found no physical device");
+  if (devices.empty()) throw no_device_error("the Vulkan loader found no physical device");
   if (requested >= 0) {
     if (size_t(requested) >= devices.size())
       throw InputError("--device " + std::to_string(requested) + ": no such device; " + range_text(devices.size()));

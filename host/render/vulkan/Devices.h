@@ -7,13 +7,13 @@
 #include <vector>
 
 #include "render/vulkan/VkCheck.h"
+#include "util/Error.h"
 
 namespace pyrolume::vk {
 
-// No Vulkan driver or no device: the message is one line that points to --backend cpu.
-struct NoDeviceError : VulkanError {
-  explicit NoDeviceError(const std::string& detail);
-};
+// No Vulkan driver or no device: NoDeviceError (util/Error.h) whose message
+// is one line that points to --backend cpu.
+NoDeviceError no_device_error(const std::string& detail);
 
 struct DeviceInfo {
   uint32_t index = 0;  // position in vkEnumeratePhysicalDevices

@@ -3,11 +3,17 @@
 #include <cmath>
 
 #include "color/Blackbody.h"
+#include "color/EmissionModel.h"
 #include "light/AnalyticLights.h"
+#include "scene/MediumVolume.h"
 #include "util/Error.h"
 #include "volume/MajorantGrid.h"
 
 namespace pyrolume {
+
+// The host's radiance limits are the shaders' (shaders/shared/gpu_types.h).
+static_assert(kMaxSampleRadiance == gpu::MAX_SAMPLE_RADIANCE);
+static_assert(kMaxEmittedRadiance == gpu::MAX_EMITTED_RADIANCE);
 namespace {
 gpu::vec4 v4(glm::dvec3 v, double w) { return gpu::vec4(float(v.x), float(v.y), float(v.z), float(w)); }
 double max3(glm::dvec3 v) { return std::max(v.x, std::max(v.y, v.z)); }

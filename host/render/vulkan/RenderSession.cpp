@@ -10,7 +10,10 @@
 #include "light/EnvironmentMap.h"
 #include "render/Limits.h"
 #include "render/SceneChecks.h"
+#include "render/vulkan/LightPacking.h"
 #include "render/vulkan/Spirv.h"
+#include "render/vulkan/SurfacePacking.h"
+#include "scene/MediumVolume.h"
 #include "util/Error.h"
 
 namespace pyrolume {
@@ -394,9 +397,9 @@ void RenderSession::create_environment(const Scene& scene) {
     EnvironmentMap env = EnvironmentMap::load(scene.environment->file, scene.environment->scale,
                                               scene.environment->rotation_deg,
                                               scene.up_axis.value_or(UpAxis::Z) == UpAxis::Y);
-    texels = env.gpu_texels();
-    cdf = env.gpu_cdf();
-    header = env.gpu_header();
+    texels = pack_gpu_environment_texels(env);
+    cdf = env.cdf();
+    header = pack_gpu_environment_header(env);
     environment_ = std::move(env);
   }
   env_texels_ = storage_buffer(ctx_, texels, "environment");
@@ -430,13 +433,14 @@ RenderSession::EmissionLights RenderSession::build_emission_lights(
     const size_t i = g.grid_sources[slot].medium;
     if (!by_medium[i] || !(out.selection.p_medium[i] > 0.0)) continue;
     const EmissionCdf& c = *by_medium[i];
-    gpu::GpuEmissionCdf h = c.gpu_header(uint32_t(out.cdf.size()), uint32_t(out.pmf.size()), uint32_t(out.clusters.size()));
+    gpu::GpuEmissionCdf h = pack_gpu_emission_header(c, uint32_t(out.cdf.size()), uint32_t(out.pmf.size()),
+                                                     uint32_t(out.clusters.size()));
     h.measure.w = float(out.selection.p_medium[i]);
     out.headers[slot] = h;
-    out.cdf.insert(out.cdf.end(), c.gpu_cdf().begin(), c.gpu_cdf().end());
-    out.cells.insert(out.cells.end(), c.gpu_cells().begin(), c.gpu_cells().end());
-    out.pmf.insert(out.pmf.end(), c.gpu_pmf().begin(), c.gpu_pmf().end());
-    const std::vector<gpu::GpuEmissionCluster> clusters = c.gpu_clusters();
+    out.cdf.insert(out.cdf.end(), c.cluster_cdf().begin(), c.cluster_cdf().end());
+    out.cells.insert(out.cells.end(), c.entry_cells().begin(), c.entry_cells().end());
+    out.pmf.insert(out.pmf.end(), c.cluster_pmf().begin(), c.cluster_pmf().end());
+    const std::vector<gpu::GpuEmissionCluster> clusters = pack_gpu_emission_clusters(c);
     out.clusters.insert(out.clusters.end(), clusters.begin(), clusters.end());
   }
   return out;

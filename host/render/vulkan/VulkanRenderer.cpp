@@ -22,6 +22,7 @@ VulkanRenderer::VulkanRenderer(const BackendOptions& options) {
   o.validation = options.validation;
   context_ = std::make_unique<vk::Context>(o);
   context_seconds_ = since(t0);
+  frame_reuse_ = options.frame_reuse;
 }
 
 VulkanRenderer::~VulkanRenderer() = default;
@@ -33,6 +34,10 @@ uint64_t VulkanRenderer::validation_messages() const { return context_->validati
 void VulkanRenderer::set_frame_reuse(bool on) {
   frame_reuse_ = on;
   if (!on) kept_.reset();
+}
+
+uint64_t VulkanRenderer::accumulation_bytes(int width, int height) {
+  return uint64_t(width) * uint64_t(height) * sizeof(gpu::AccumTexel);
 }
 
 int VulkanRenderer::spp_per_pass(int width, int height, int spp, int rays_per_vertex) {
@@ -137,7 +142,7 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
     }
     if (saved.data.empty()) {  // failed before anything was saved: 0 spp
       saved = AccumulationState{"vulkan", settings.width, settings.height, 0, {}};
-      saved.data.assign(size_t(settings.width) * size_t(settings.height) * sizeof(gpu::AccumTexel), 0);
+      saved.data.assign(accumulation_bytes(settings.width, settings.height), 0);
     }
     RenderResult partial = result;
     RenderSession::result_from_state(saved, partial);

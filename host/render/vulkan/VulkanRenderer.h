@@ -22,6 +22,10 @@ class VulkanRenderer : public Backend {
   RenderResult render(const Scene& scene, const RenderSettings& settings, const RenderControl& control) override;
   uint64_t validation_messages() const override;
 
+  // Bytes of its AccumulationState for a width×height render: one
+  // gpu::AccumTexel per pixel (RenderSession::save_state).
+  static uint64_t accumulation_bytes(int width, int height);
+
   // Samples per pixel per dispatch: a fixed function of the image size, so the
   // pass schedule (and with it the float summation order) never depends on
   // timing and reruns are bit-identical.
@@ -33,6 +37,7 @@ class VulkanRenderer : public Backend {
   // grids, majorants and LUTs into it: the pipeline, BVH and environment are
   // built once per sequence. Off by default: a renderer that renders
   // unrelated scenes (tests, bench) must not hold on to one.
+  // BackendOptions::frame_reuse sets it at construction.
   void set_frame_reuse(bool on);
   // Renders that reused the kept session (tests, stats).
   int reused_frames() const { return reused_frames_; }

@@ -1,4 +1,4 @@
-#include "image/RenderImage.h"
+#include "render/RenderImage.h"
 
 #include <algorithm>
 #include <limits>

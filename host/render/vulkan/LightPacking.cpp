@@ -1,0 +1,72 @@
+#include "render/vulkan/LightPacking.h"
+
+#include <stdexcept>
+
+namespace pyrolume {
+
+std::vector<gpu::GpuEmissionCluster> pack_gpu_emission_clusters(const EmissionCdf& cdf) {
+  auto to_gpu = [](const EmissionCdf::Cluster& c) {
+    gpu::GpuEmissionCluster g{};
+    g.sphere = gpu::vec4(float(c.centre.x), float(c.centre.y), float(c.centre.z), float(c.radius2));
+    g.power = gpu::vec4(float(c.power), 0.0f, 0.0f, 0.0f);
+    g.entries = gpu::uvec4(c.first, c.count, 0u, 0u);
+    return g;
+  };
+  // The grid of clusters (looked up by cell), then copies of the nonempty
+  // ones (the loops over clusters skip the empty ones without reading them).
+  std::vector<gpu::GpuEmissionCluster> out;
+  out.reserve(cdf.clusters().size() + cdf.nonempty_clusters());
+  for (const EmissionCdf::Cluster& c : cdf.clusters()) out.push_back(to_gpu(c));
+  for (const EmissionCdf::Cluster& c : cdf.clusters())
+    if (c.count > 0) out.push_back(to_gpu(c));
+  return out;
+}
+
+gpu::GpuEmissionCdf pack_gpu_emission_header(const EmissionCdf& cdf, uint32_t entry_offset, uint32_t pmf_offset,
+                                             uint32_t cluster_offset) {
+  if (!cdf.empty() && !cdf.is_clustered())
+    throw std::logic_error("pack_gpu_emission_header: the GPU needs a clustered() distribution");
+  gpu::GpuEmissionCdf g{};
+  auto row = [](const glm::dmat4& m, int r) {
+    return gpu::vec4(float(m[0][r]), float(m[1][r]), float(m[2][r]), float(m[3][r]));
+  };
+  const glm::dmat4& world_to_cell = cdf.world_to_cell_matrix();
+  const glm::dmat4& cell_to_world = cdf.cell_to_world_matrix();
+  g.world_to_cell_row0 = row(world_to_cell, 0);
+  g.world_to_cell_row1 = row(world_to_cell, 1);
+  g.world_to_cell_row2 = row(world_to_cell, 2);
+  g.cell_to_world_row0 = row(cell_to_world, 0);
+  g.cell_to_world_row1 = row(cell_to_world, 1);
+  g.cell_to_world_row2 = row(cell_to_world, 2);
+  const glm::ivec3 cells = cdf.cells(), dims = cdf.cluster_dims();
+  g.cells = gpu::uvec4(uint32_t(cells.x), uint32_t(cells.y), uint32_t(cells.z), uint32_t(cdf.entry_count()));
+  g.offsets = gpu::uvec4(entry_offset, pmf_offset, cluster_offset, uint32_t(cdf.nonempty_clusters()));
+  g.clusters = gpu::uvec4(uint32_t(dims.x), uint32_t(dims.y), uint32_t(dims.z), uint32_t(cdf.cluster_cells_per_axis()));
+  const double volume = cdf.cell_volume();
+  g.measure = gpu::vec4(float(volume), volume > 0.0 ? float(1.0 / volume) : 0.0f, float(cdf.power()), 0.0f);
+  return g;
+}
+
+gpu::GpuEnvironment pack_gpu_environment_header(const EnvironmentMap& env) {
+  gpu::GpuEnvironment g{};
+  g.transform = gpu::vec4(float(env.cos_rotation()), float(env.sin_rotation()), float(env.scale()), float(env.power()));
+  g.size = gpu::uvec4(uint32_t(env.width()), uint32_t(env.height()), env.has_distribution() ? 1u : 0u,
+                      env.zenith_y() ? 1u : 0u);
+  return g;
+}
+
+std::vector<float> pack_gpu_environment_texels(const EnvironmentMap& env) {
+  std::vector<float> t(size_t(env.width()) * env.height() * 4);
+  size_t k = 0;
+  for (int j = 0; j < env.height(); ++j)
+    for (int i = 0; i < env.width(); ++i, ++k) {
+      const glm::dvec3 rgb = env.texel(i, j);
+      t[k * 4 + 0] = float(rgb.x);
+      t[k * 4 + 1] = float(rgb.y);
+      t[k * 4 + 2] = float(rgb.z);
+      t[k * 4 + 3] = float(env.pdf_uv_texel(i, j));
+    }
+  return t;
+}
+
+}  // namespace pyrolume

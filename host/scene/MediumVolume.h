@@ -1,0 +1,35 @@
+#pragma once
+// A vdb Medium of the scene model as the volume loaders take it
+// (volume/VolumeOptions.h), and what a grid file's source convention sets on it.
+#include <glm/glm.hpp>
+
+#include "scene/Scene.h"
+#include "volume/SourceConventions.h"
+#include "volume/StoredVolume.h"
+#include "volume/VdbLoader.h"
+
+namespace pyrolume {
+
+// The medium's `transform` as a matrix: T * Rz * Ry * Rx * S, i.e. scale first,
+// then rotate about X, Y, Z (degrees, right-handed), then translate.
+glm::dmat4 medium_transform_matrix(const Transform& t);
+
+// Whether a medium's emission needs its temperature grid.
+bool needs_temperature_grid(const Medium& m);
+
+// The loaders' options for a vdb medium: its file, grids, transform,
+// downsample, texture_format ("r16f" default, "r32f") and temperature mapping.
+VolumeOptions volume_options(const Medium& m, bool need_temperature);
+
+// load_volume / load_stored_volume (volume/) for a medium; the stored one
+// reads the temperature grid when needs_temperature_grid(m).
+VolumeGrids load_volume(const Medium& m, bool need_temperature, const DenseLimits& limits = {});
+StoredVolume load_stored_volume(const Medium& m, const DenseLimits& limits = {});
+
+// Sets what the scene file left unset on a vdb medium: the grids, the
+// temperature mapping (each of scale, offset, cutoff_k only when not written),
+// and, when the convention finds no temperature grid and the file wrote no
+// emission block, no emission.
+void apply_source_convention(Medium& m, const SourceConvention& c);
+
+}  // namespace pyrolume

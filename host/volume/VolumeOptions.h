@@ -1,0 +1,39 @@
+#pragma once
+// What the volume loaders take: a grid file, the grids to read, where they
+// sit and how they are stored. The scene model (scene/Scene.h) names these
+// types; scene/MediumVolume.h makes a VolumeOptions from a Medium.
+#include <filesystem>
+#include <string>
+
+#include <glm/glm.hpp>
+
+namespace pyrolume {
+
+struct TemperatureMapping {
+  double scale = 1.0;   // T = (value - offset) * scale, kelvin
+  double offset = 0.0;
+  double cutoff_k = 100.0;  // no emission at or below
+};
+
+// The simulator that wrote a vdb file (docs/sources.md): it decides the grids
+// read, the temperature mapping and the up axis. Auto: detected from the file.
+enum class VolumeSource { Auto, Blender, Houdini, EmberGen, Kelvin };
+
+// Which world axis is up (a file's convention, or the scene's).
+enum class UpAxis { Y, Z };
+
+// The texture format grids are stored in (volume/StoredVolume.h).
+enum class TextureFormat { R16F, R32F };
+
+struct VolumeOptions {
+  std::filesystem::path file;
+  std::string density_grid;      // empty: default "density"
+  std::string temperature_grid;  // empty: first of temperature, heat, flame
+  bool need_temperature = false; // read the temperature grid too
+  glm::dmat4 transform{1.0};     // composed on top of each grid's index->world map
+  int downsample = 1;
+  TextureFormat texture_format = TextureFormat::R16F;  // R32F is also used when values exceed R16F
+  TemperatureMapping temperature;  // for the warning when nothing glows
+};
+
+}  // namespace pyrolume
