@@ -27,7 +27,7 @@ void light_norms(vec3 o, out vec4 norm) {
     for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
       if (!is_grid(media[i])) continue;
       const uint slot = media[i].grid_slot;
-      if (emission_lights[slot].measure.w > 0.0) norm[slot] = emission_receiver_norm(emission_lights[slot], o);
+      if (emission_lights[slot].pick_probability > 0.0) norm[slot] = emission_receiver_norm(emission_lights[slot], o);
     }
 }
 
@@ -42,17 +42,17 @@ float light_direction_pdf(vec3 o, vec4 norm, vec3 d) {
     for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
       if (!is_grid(media[i])) continue;
       GpuEmissionCdf e = emission_lights[media[i].grid_slot];
-      if (e.measure.w > 0.0) p += e.measure.w * emission_direction_pdf(e, o, norm[media[i].grid_slot], d);
+      if (e.pick_probability > 0.0) p += e.pick_probability * emission_direction_pdf(e, o, norm[media[i].grid_slot], d);
     }
   for (uint i = 0u; i < LIGHT_COUNT; ++i)
-    if (analytic_lights[i].value.w > 0.0) p += analytic_lights[i].value.w * analytic_light_pdf(analytic_lights[i], o, d);
+    if (analytic_lights[i].pick_probability > 0.0) p += analytic_lights[i].pick_probability * analytic_light_pdf(analytic_lights[i], o, d);
   return p;
 }
 
 // A light direction for next-event estimation from point o: the environment
 // map's, toward a point drawn from an emissive grid's emission CDF, or toward
 // an analytic light (the light chosen by frame.p_env, each grid's
-// measure.w and each analytic light's value.w). false: none. A delta light
+// pick_probability and each analytic light's). false: none. A delta light
 // sets delta_light to its index and delta_w to what it delivers along dir per
 // unit of f, over its probability; otherwise delta_light = LIGHT_COUNT.
 bool sample_light_direction(vec3 o, vec4 norm, inout uint rng, out vec3 dir, out vec3 delta_w, out uint delta_light) {
@@ -75,7 +75,7 @@ bool sample_light_direction(vec3 o, vec4 norm, inout uint rng, out vec3 dir, out
   if (HAS_GRIDS && HAS_EMISSION)
     for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
       if (!is_grid(media[i])) continue;
-      float p = emission_lights[media[i].grid_slot].measure.w;
+      float p = emission_lights[media[i].grid_slot].pick_probability;
       if (!(p > 0.0) || found) continue;
       pick = i;
       if (u < p) found = true; else u -= p;
@@ -84,7 +84,7 @@ bool sample_light_direction(vec3 o, vec4 norm, inout uint rng, out vec3 dir, out
     // Past the grids: the analytic light whose probability covers u (the last one when rounding leaves u past them).
     uint light = LIGHT_COUNT;
     for (uint i = 0u; i < LIGHT_COUNT; ++i) {
-      const float p = analytic_lights[i].value.w;
+      const float p = analytic_lights[i].pick_probability;
       if (!(p > 0.0) || found) continue;
       light = i;
       if (u < p) found = true; else u -= p;
@@ -93,9 +93,9 @@ bool sample_light_direction(vec3 o, vec4 norm, inout uint rng, out vec3 dir, out
       const GpuLight l = analytic_lights[light];
       vec3 delta_value;
       if (!analytic_light_sample(l, o, u2, dir, delta_value)) return false;
-      if (light_is_delta(l.kind.x)) {
+      if (light_is_delta(l.kind)) {
         delta_light = light;
-        delta_w = delta_value / l.value.w;
+        delta_w = delta_value / l.pick_probability;
       }
       return true;
     }

@@ -10,8 +10,8 @@ const int RAY_READY = -1, RAY_ENDED = 0, PATH_ENDED = 1;
 void lights_on_ray(inout PathState p) {
   float t = p.has_hit ? p.hit.t : INF;
   uint light = intersect_sphere_lights(p.o, p.d, t);
-  if (p.delta_light < LIGHT_COUNT && analytic_lights[p.delta_light].kind.x != LIGHT_DISTANT) {
-    const float r = length(analytic_lights[p.delta_light].position.xyz - p.o);
+  if (p.delta_light < LIGHT_COUNT && analytic_lights[p.delta_light].kind != LIGHT_DISTANT) {
+    const float r = length(analytic_lights[p.delta_light].position - p.o);
     if (r < t) {
       t = r;
       light = p.delta_light;

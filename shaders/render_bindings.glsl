@@ -72,7 +72,7 @@ layout(std430, set = 0, binding = BINDING_EMISSION_CLUSTERS) readonly buffer Emi
   GpuEmissionCluster emission_clusters[];
 };
 layout(std140, set = 0, binding = BINDING_EMISSION_HEADERS) uniform EmissionHeaderBlock {
-  GpuEmissionCdf emission_lights[MAX_GRIDS];  // by grid slot; measure.w: probability of picking it
+  GpuEmissionCdf emission_lights[MAX_GRIDS];  // by grid slot
 };
 #include "lights.glsl"
 layout(std430, set = 0, binding = BINDING_LIGHTS) readonly buffer AnalyticLightBlock { GpuLight analytic_lights[]; };

@@ -448,9 +448,11 @@ EmissionCdf EmissionCdf::clustered(int k) const {
 std::vector<gpu::GpuEmissionCluster> EmissionCdf::gpu_clusters() const {
   auto to_gpu = [](const Cluster& c) {
     gpu::GpuEmissionCluster g{};
-    g.sphere = gpu::vec4(float(c.centre.x), float(c.centre.y), float(c.centre.z), float(c.radius2));
-    g.power = gpu::vec4(float(c.power), 0.0f, 0.0f, 0.0f);
-    g.entries = gpu::uvec4(c.first, c.count, 0u, 0u);
+    g.center = gpu::vec3(float(c.centre.x), float(c.centre.y), float(c.centre.z));
+    g.radius_sq = float(c.radius2);
+    g.power = float(c.power);
+    g.first_entry = c.first;
+    g.entry_count = c.count;
     return g;
   };
   // The grid of clusters (looked up by cell), then copies of the nonempty
@@ -481,11 +483,17 @@ gpu::GpuEmissionCdf EmissionCdf::gpu_header(uint32_t entry_offset, uint32_t pmf_
   g.cell_to_world_row0 = row(cell_to_world_, 0);
   g.cell_to_world_row1 = row(cell_to_world_, 1);
   g.cell_to_world_row2 = row(cell_to_world_, 2);
-  g.cells = gpu::uvec4(uint32_t(cells_.x), uint32_t(cells_.y), uint32_t(cells_.z), uint32_t(cdf_.size()));
-  g.offsets = gpu::uvec4(entry_offset, pmf_offset, cluster_offset, uint32_t(nonempty_clusters()));
-  g.clusters = gpu::uvec4(uint32_t(cluster_dims_.x), uint32_t(cluster_dims_.y), uint32_t(cluster_dims_.z),
-                          uint32_t(cluster_k_));
-  g.measure = gpu::vec4(float(cell_volume_), cell_volume_ > 0.0 ? float(1.0 / cell_volume_) : 0.0f, float(power_), 0.0f);
+  g.cells = gpu::uvec3(uint32_t(cells_.x), uint32_t(cells_.y), uint32_t(cells_.z));
+  g.entry_count = uint32_t(cdf_.size());
+  g.first_entry = entry_offset;
+  g.first_cell = pmf_offset;
+  g.first_cluster = cluster_offset;
+  g.nonempty_clusters = uint32_t(nonempty_clusters());
+  g.clusters = gpu::uvec3(uint32_t(cluster_dims_.x), uint32_t(cluster_dims_.y), uint32_t(cluster_dims_.z));
+  g.cluster_k = uint32_t(cluster_k_);
+  g.cell_volume = float(cell_volume_);
+  g.inv_cell_volume = cell_volume_ > 0.0 ? float(1.0 / cell_volume_) : 0.0f;
+  g.power = float(power_);
   return g;
 }
 

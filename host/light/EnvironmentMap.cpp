@@ -217,8 +217,14 @@ std::vector<float> EnvironmentMap::gpu_texels() const {
 
 gpu::GpuEnvironment EnvironmentMap::gpu_header() const {
   gpu::GpuEnvironment g{};
-  g.transform = gpu::vec4(float(cos_rot_), float(sin_rot_), float(scale_), float(power_));
-  g.size = gpu::uvec4(uint32_t(width_), uint32_t(height_), has_distribution() ? 1u : 0u, zenith_y_ ? 1u : 0u);
+  g.cos_rotation = float(cos_rot_);
+  g.sin_rotation = float(sin_rot_);
+  g.scale = float(scale_);
+  g.power = float(power_);
+  g.width = uint32_t(width_);
+  g.height = uint32_t(height_);
+  g.can_sample = has_distribution() ? 1u : 0u;
+  g.zenith_y = zenith_y_ ? 1u : 0u;
   return g;
 }
 

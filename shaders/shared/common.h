@@ -16,6 +16,8 @@ using uvec4 = glm::uvec4;
 using uint = uint32_t;
 }  // namespace pyrolume::gpu
 #define PYRO_CONST constexpr
+// A shared struct's field sits where std140/std430 put it.
+#define PYRO_OFFSET(S, field, at) static_assert(offsetof(S, field) == (at))
 #else
 #define PYRO_CONST const
 #endif

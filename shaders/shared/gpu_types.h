@@ -229,7 +229,6 @@ struct AccumTexel {
 
 #ifdef __cplusplus
 // Every field where std140/std430 put it (a vec3 ends 4 bytes before the next 16).
-#define PYRO_OFFSET(S, field, at) static_assert(offsetof(S, field) == (at))
 static_assert(sizeof(GpuMedium) == 96);
 PYRO_OFFSET(GpuMedium, shape, 12); PYRO_OFFSET(GpuMedium, sigma_s, 16); PYRO_OFFSET(GpuMedium, g, 28);
 PYRO_OFFSET(GpuMedium, emission, 32); PYRO_OFFSET(GpuMedium, emission_mode, 44); PYRO_OFFSET(GpuMedium, center, 48);
@@ -272,7 +271,6 @@ static_assert(sizeof(AccumTexel) == 64);
 PYRO_OFFSET(AccumTexel, events, 12); PYRO_OFFSET(AccumTexel, sum_c, 16); PYRO_OFFSET(AccumTexel, events_c, 28);
 PYRO_OFFSET(AccumTexel, sum_sq, 32); PYRO_OFFSET(AccumTexel, lookups, 44); PYRO_OFFSET(AccumTexel, sum_sq_c, 48);
 PYRO_OFFSET(AccumTexel, nonfinite, 60);
-#undef PYRO_OFFSET
 }  // namespace pyrolume::gpu
 #endif
 #endif

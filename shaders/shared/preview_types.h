@@ -28,9 +28,10 @@ struct DisplayConstants {
 
 #ifdef __cplusplus
 static_assert(sizeof(DisplayConstants) == 64);
-static_assert(offsetof(DisplayConstants, rect) == 16 && offsetof(DisplayConstants, border) == 32);
-static_assert(offsetof(DisplayConstants, radiance_scale) == 44 && offsetof(DisplayConstants, swap_red_blue) == 48);
-static_assert(offsetof(DisplayConstants, view) == 52 && offsetof(DisplayConstants, unused1) == 60);
+PYRO_OFFSET(DisplayConstants, rect, 16); PYRO_OFFSET(DisplayConstants, border, 32);
+PYRO_OFFSET(DisplayConstants, radiance_scale, 44); PYRO_OFFSET(DisplayConstants, swap_red_blue, 48);
+PYRO_OFFSET(DisplayConstants, view, 52); PYRO_OFFSET(DisplayConstants, unused0, 56);
+PYRO_OFFSET(DisplayConstants, unused1, 60);
 }  // namespace pyrolume::gpu
 #endif
 #endif

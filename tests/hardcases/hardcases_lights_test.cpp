@@ -67,7 +67,7 @@ TEST(HardLights, EmissionCdfWithZeroTotalIsSafe) {
     EXPECT_EQ(cdf.entry_count(), 0u) << c.what;
     EXPECT_EQ(cdf.power(), 0.0) << c.what;
     EXPECT_TRUE(cdf.gpu_cdf().empty()) << c.what;
-    EXPECT_EQ(cdf.gpu_header().cells.w, 0u) << c.what;
+    EXPECT_EQ(cdf.gpu_header().entry_count, 0u) << c.what;
     for (double u : kEdgeU)
       for (double u3 : {0.0, 0.5, std::nextafter(1.0, 0.0)}) {
         const EmissionSample s = cdf.sample(u, glm::dvec3(u3));
@@ -132,7 +132,7 @@ TEST(HardLights, EnvironmentMapAllZeroIsSafe) {
   const EnvironmentMap env = EnvironmentMap::from_image(make_image(16, 8), 3.0, 30.0);
   EXPECT_FALSE(env.has_distribution());
   EXPECT_EQ(env.power(), 0.0);
-  EXPECT_EQ(env.gpu_header().size.z, 0u);
+  EXPECT_EQ(env.gpu_header().can_sample, 0u);
   for (double u : kEdgeU)
     for (double v : kEdgeU) {
       const EnvSample s = env.sample({u, v});

@@ -304,7 +304,7 @@ TEST(EmissionCdf, NoEmissionGivesNoDistribution) {
     EXPECT_EQ(cdf.power(), 0.0) << what;
     EXPECT_EQ(cdf.sample(0.5, {0.5, 0.5, 0.5}).pdf, 0.0) << what;
     EXPECT_EQ(cdf.pdf(glm::dvec3(1.0, -0.5, 2.0)), 0.0) << what;
-    EXPECT_EQ(cdf.gpu_header().cells.w, 0u) << what;
+    EXPECT_EQ(cdf.gpu_header().entry_count, 0u) << what;
   };
   DenseGrid zero = d;
   std::fill(zero.values.begin(), zero.values.end(), 0.0f);

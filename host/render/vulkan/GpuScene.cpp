@@ -9,7 +9,6 @@
 
 namespace pyrolume {
 namespace {
-gpu::vec4 v4(glm::dvec3 v, double w) { return gpu::vec4(float(v.x), float(v.y), float(v.z), float(w)); }
 gpu::vec3 v3(glm::dvec3 v) { return gpu::vec3(float(v.x), float(v.y), float(v.z)); }
 double max3(glm::dvec3 v) { return std::max(v.x, std::max(v.y, v.z)); }
 
@@ -208,29 +207,33 @@ std::vector<gpu::GpuLight> pack_gpu_lights(const Scene& scene, const LightSelect
     const Light& l = scene.lights[i];
     gpu::GpuLight g{};
     const glm::dvec3 value = l.type == Light::Type::Distant && !l.is_delta() ? disc_radiance(l) : light_value(l);
-    g.value = glm::vec4(glm::vec3(value), float(i < selection.p_light.size() ? selection.p_light[i] : 0.0));
-    g.direction = glm::vec4(glm::vec3(l.direction), 0.0f);
+    g.value = gpu::vec3(value);
+    g.pick_probability = float(i < selection.p_light.size() ? selection.p_light[i] : 0.0);
+    g.direction = gpu::vec3(l.direction);
     switch (l.type) {
       case Light::Type::Point:
-        g.kind.x = gpu::LIGHT_POINT;
-        g.position = glm::vec4(glm::vec3(l.position), 0.0f);
+        g.kind = gpu::LIGHT_POINT;
+        g.position = gpu::vec3(l.position);
         break;
       case Light::Type::Spot: {
-        g.kind.x = gpu::LIGHT_SPOT;
-        g.position = glm::vec4(glm::vec3(l.position), 0.0f);
+        g.kind = gpu::LIGHT_SPOT;
+        g.position = gpu::vec3(l.position);
         const SpotCone c = spot_cone(l);
-        g.cone = glm::vec4(float(c.cos_end), float(c.cos_start), 0.0f, 0.0f);
+        g.cos_cone = float(c.cos_end);
+        g.cos_falloff = float(c.cos_start);
         break;
       }
       case Light::Type::Distant: {
-        g.kind.x = l.is_delta() ? gpu::LIGHT_DISTANT : gpu::LIGHT_DISC;
+        g.kind = l.is_delta() ? gpu::LIGHT_DISTANT : gpu::LIGHT_DISC;
         const double s = std::sin(disc_half_angle(l));
-        g.cone = glm::vec4(0.0f, 0.0f, float(disc_one_minus_cos(l)), float(s * s));
+        g.one_minus_cos = float(disc_one_minus_cos(l));
+        g.sin2 = float(s * s);
         break;
       }
       case Light::Type::Sphere:
-        g.kind.x = gpu::LIGHT_SPHERE;
-        g.position = glm::vec4(glm::vec3(l.center), float(l.radius));
+        g.kind = gpu::LIGHT_SPHERE;
+        g.position = gpu::vec3(l.center);
+        g.radius = float(l.radius);
         break;
     }
     out.push_back(g);

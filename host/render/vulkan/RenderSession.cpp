@@ -431,7 +431,7 @@ RenderSession::EmissionLights RenderSession::build_emission_lights(
     if (!by_medium[i] || !(out.selection.p_medium[i] > 0.0)) continue;
     const EmissionCdf& c = *by_medium[i];
     gpu::GpuEmissionCdf h = c.gpu_header(uint32_t(out.cdf.size()), uint32_t(out.pmf.size()), uint32_t(out.clusters.size()));
-    h.measure.w = float(out.selection.p_medium[i]);
+    h.pick_probability = float(out.selection.p_medium[i]);
     out.headers[slot] = h;
     out.cdf.insert(out.cdf.end(), c.gpu_cdf().begin(), c.gpu_cdf().end());
     out.cells.insert(out.cells.end(), c.gpu_cells().begin(), c.gpu_cells().end());
