@@ -25,6 +25,11 @@ struct PathState {
   // f · MIS weight / p_light), then the path goes on with the continuation
   // sampled at the vertex (next_*), one ray segment (free flights up to its
   // event) per path_step like any other ray (docs/rendering.md: divergence).
+  // The path's phase, as flags (one uint was slower: docs/benchmarks.md "The
+  // path's phase as one value"): a camera or continuation ray (!light_ray);
+  // a light ray (light_ray, continuation_ray < 2); the ratio-tracked
+  // continuation's first segment (light_ray, continuation_ray 2); the
+  // vertex's next light ray still to draw (light_pending).
   bool light_ray;
   float light_T;  // a light ray's ratio-tracking transmittance (max channel) since its last roulette
   // Ratio-tracked continuation (docs/mis.md): 1 while the surface vertex's
@@ -67,7 +72,7 @@ vec3 escaped_radiance(vec3 d) {
 // toward a delta distant light has reached it.
 void escape(inout PathState p) {
   if (LIGHT_COUNT > 0u && p.delta_light < LIGHT_COUNT) {
-    if (analytic_lights[p.delta_light].kind.x == LIGHT_DISTANT) p.L += p.w;
+    if (analytic_lights[p.delta_light].kind == LIGHT_DISTANT) p.L += p.w;
     return;
   }
   if (!p.skip_segment) p.L += unidirectional_weight(p.pdf_dir, p.p_light) * p.w * escaped_radiance(p.d);
