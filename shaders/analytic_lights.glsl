@@ -27,8 +27,8 @@ vec3 sample_cone(vec3 axis, float omc, vec2 u) {
 // 1 − cos θmax of the cone that sphere light l subtends from o: sin²θmax =
 // r²/d², 1 − cos = sin² / (1 + cos). 0 from inside (no sample).
 float sphere_light_omc(GpuLight l, vec3 o) {
-  const vec3 v = l.position.xyz - o;
-  const float d2 = dot(v, v), r2 = l.position.w * l.position.w;
+  const vec3 v = l.position - o;
+  const float d2 = dot(v, v), r2 = l.radius * l.radius;
   if (!(d2 > r2)) return 0.0;
   const float s2 = r2 / d2;
   return s2 / (1.0 + sqrt(1.0 - s2));
@@ -37,19 +37,19 @@ float sphere_light_omc(GpuLight l, vec3 o) {
 // Whether unit direction d lies in disc light l's cone: |d × axis|² ≤ sin²θ,
 // which keeps its precision for small discs where cos does not.
 bool in_disc(GpuLight l, vec3 d) {
-  const vec3 c = cross(d, l.direction.xyz);
-  return dot(d, l.direction.xyz) > 0.0 && dot(c, c) <= l.cone.w;
+  const vec3 c = cross(d, l.direction);
+  return dot(d, l.direction) > 0.0 && dot(c, c) <= l.sin2;
 }
 
 // The solid-angle pdf with which light l, once picked, draws unit direction d
 // from o: uniform over the disc's or the sphere's cone; 0 outside it and for
 // delta lights.
 float analytic_light_pdf(GpuLight l, vec3 o, vec3 d) {
-  if (l.kind.x == LIGHT_DISC) return in_disc(l, d) ? 1.0 / (2.0 * PI * l.cone.z) : 0.0;
-  if (l.kind.x == LIGHT_SPHERE) {
-    const vec3 v = l.position.xyz - o, c = cross(v, d);
+  if (l.kind == LIGHT_DISC) return in_disc(l, d) ? 1.0 / (2.0 * PI * l.one_minus_cos) : 0.0;
+  if (l.kind == LIGHT_SPHERE) {
+    const vec3 v = l.position - o, c = cross(v, d);
     const float omc = sphere_light_omc(l, o);
-    const bool hits = dot(v, d) > 0.0 && dot(c, c) <= l.position.w * l.position.w;
+    const bool hits = dot(v, d) > 0.0 && dot(c, c) <= l.radius * l.radius;
     return omc > 0.0 && hits ? 1.0 / (2.0 * PI * omc) : 0.0;
   }
   return 0.0;
@@ -58,9 +58,9 @@ float analytic_light_pdf(GpuLight l, vec3 o, vec3 d) {
 // pbrt-v4's spot falloff: smoothstep from the cone's edge (cone.x) to where
 // the falloff starts (cone.y); a hard edge when they are equal.
 float spot_falloff(GpuLight l, float cos_a) {
-  if (cos_a >= l.cone.y) return 1.0;
-  if (cos_a < l.cone.x) return 0.0;
-  return smoothstep(l.cone.x, l.cone.y, cos_a);
+  if (cos_a >= l.cos_falloff) return 1.0;
+  if (cos_a < l.cos_cone) return 0.0;
+  return smoothstep(l.cos_cone, l.cos_falloff, cos_a);
 }
 
 // A direction from o toward light l (false: none). Delta lights also give
@@ -69,28 +69,28 @@ float spot_falloff(GpuLight l, float cos_a) {
 bool analytic_light_sample(GpuLight l, vec3 o, vec2 u, out vec3 dir, out vec3 delta_value) {
   dir = vec3(0.0, 0.0, 1.0);
   delta_value = vec3(0.0);
-  const uint kind = l.kind.x;
+  const uint kind = l.kind;
   if (kind == LIGHT_POINT || kind == LIGHT_SPOT) {
-    const vec3 v = l.position.xyz - o;
+    const vec3 v = l.position - o;
     const float d2 = dot(v, v);
     if (!(d2 > 0.0)) return false;
     dir = v * inversesqrt(d2);
-    const float falloff = kind == LIGHT_SPOT ? spot_falloff(l, dot(-dir, l.direction.xyz)) : 1.0;
-    delta_value = l.value.rgb * (falloff / d2);
+    const float falloff = kind == LIGHT_SPOT ? spot_falloff(l, dot(-dir, l.direction)) : 1.0;
+    delta_value = l.value * (falloff / d2);
     return falloff > 0.0;
   }
   if (kind == LIGHT_DISTANT) {
-    dir = l.direction.xyz;
-    delta_value = l.value.rgb;
+    dir = l.direction;
+    delta_value = l.value;
     return true;
   }
   if (kind == LIGHT_DISC) {
-    dir = sample_cone(l.direction.xyz, l.cone.z, u);
+    dir = sample_cone(l.direction, l.one_minus_cos, u);
     return true;
   }
   const float omc = sphere_light_omc(l, o);
   if (!(omc > 0.0)) return false;
-  dir = sample_cone(normalize(l.position.xyz - o), omc, u);
+  dir = sample_cone(normalize(l.position - o), omc, u);
   return true;
 }
 
@@ -98,7 +98,7 @@ bool analytic_light_sample(GpuLight l, vec3 o, vec2 u, out vec3 dir, out vec3 de
 vec3 disc_lights_radiance(vec3 d) {
   vec3 L = vec3(0.0);
   for (uint i = 0u; i < LIGHT_COUNT; ++i)
-    if (analytic_lights[i].kind.x == LIGHT_DISC && in_disc(analytic_lights[i], d)) L += analytic_lights[i].value.rgb;
+    if (analytic_lights[i].kind == LIGHT_DISC && in_disc(analytic_lights[i], d)) L += analytic_lights[i].value;
   return L;
 }
 
@@ -108,9 +108,9 @@ vec3 disc_lights_radiance(vec3 d) {
 uint intersect_sphere_lights(vec3 o, vec3 d, inout float t_max) {
   uint found = LIGHT_COUNT;
   for (uint i = 0u; i < LIGHT_COUNT; ++i) {
-    if (analytic_lights[i].kind.x != LIGHT_SPHERE) continue;
+    if (analytic_lights[i].kind != LIGHT_SPHERE) continue;
     vec2 t;
-    if (intersect_sphere(o, d, analytic_lights[i].position.xyz, analytic_lights[i].position.w, t) && t.x < t_max) {
+    if (intersect_sphere(o, d, analytic_lights[i].position, analytic_lights[i].radius, t) && t.x < t_max) {
       t_max = t.x;
       found = i;
     }
@@ -121,6 +121,6 @@ uint intersect_sphere_lights(vec3 o, vec3 d, inout float t_max) {
 // The radiance that a ray along d sees where it meets sphere light l at x:
 // its radiance from outside, none from inside (it emits outward only).
 vec3 sphere_light_radiance(GpuLight l, vec3 x, vec3 d) {
-  return dot(d, x - l.position.xyz) < 0.0 ? l.value.rgb : vec3(0.0);
+  return dot(d, x - l.position) < 0.0 ? l.value : vec3(0.0);
 }
 #endif

@@ -107,7 +107,7 @@ vec3 bvh_safe_inverse(vec3 d) {
 // lies beyond the closest hit found since is skipped. llvmpipe runs every
 // iteration for the whole SIMD group, so iterations are what cost: this
 // visits half the nodes of a one-box-per-node traversal. No return inside
-// the loop (docs/mis.md: llvmpipe lost returns from inside loops).
+// the loop (docs/rendering.md "llvmpipe workarounds").
 bool bvh_traverse(vec3 o, vec3 d, float t_max, bool any_hit, inout SurfaceHit hit) {
   TriangleRay r = make_triangle_ray(o, d);
   vec3 inv_d = bvh_safe_inverse(d);

@@ -10,7 +10,7 @@
 #extension GL_GOOGLE_include_directive : require
 
 #include "shared/gpu_types.h"
-#include "preview_shared.glsl"
+#include "shared/preview_types.h"
 #include "shared/view_transform.h"
 
 layout(local_size_x = PREVIEW_WORKGROUP_SIZE, local_size_y = PREVIEW_WORKGROUP_SIZE) in;
@@ -21,18 +21,18 @@ layout(push_constant) uniform DisplayBlockConstants { DisplayConstants dc; };
 
 void main() {
   uvec2 p = gl_GlobalInvocationID.xy;
-  uvec2 target = dc.size.zw;
+  uvec2 target = dc.image_and_target.zw;
   if (p.x >= target.x || p.y >= target.y) return;
 
-  vec3 srgb = dc.tone.yzw;
+  vec3 srgb = dc.border;
   uvec2 local = p - dc.rect.xy;  // wraps to huge values left of / above the rect
   if (local.x < dc.rect.z && local.y < dc.rect.w) {
     // Nearest texel: the preview shows samples, not a resampled image.
-    uvec2 src = min(local * dc.size.xy / dc.rect.zw, dc.size.xy - 1u);
-    vec3 L = accum[src.y * dc.size.x + src.x].sum.rgb * dc.tone.x;
-    srgb = view_display(L, dc.flags.y);
+    uvec2 src = min(local * dc.image_and_target.xy / dc.rect.zw, dc.image_and_target.xy - 1u);
+    vec3 L = accum[src.y * dc.image_and_target.x + src.x].sum * dc.radiance_scale;
+    srgb = view_display(L, dc.view);
   }
   uvec3 b = uvec3(round(srgb * 255.0));
-  if (dc.flags.x != 0u) b = b.bgr;
+  if (dc.swap_red_blue != 0u) b = b.bgr;
   display_texels[p.y * target.x + p.x] = b.x | (b.y << 8) | (b.z << 16) | (255u << 24);
 }

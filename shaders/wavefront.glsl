@@ -26,7 +26,7 @@ layout(constant_id = SPEC_WAVEFRONT_STAGE) const uint WAVEFRONT_STAGE = WAVEFRON
 layout(set = 0, binding = BINDING_PATHS, rgba32ui) uniform uimageBuffer path_vec;
 layout(std430, set = 0, binding = BINDING_QUEUES) buffer QueueBlock {
   WavefrontQueues queues;
-  uint queue_slots[];  // track queues 0 and 1, the event queue, the begin queue: queues.sizes.x slots each
+  uint queue_slots[];  // track queues 0 and 1, the event queue, the begin queue: queues.capacity slots each
 };
 
 const uint PATH_STRIDE = WAVEFRONT_PATH_WORDS + MEDIA_N * WAVEFRONT_PATH_WORDS_PER_MEDIUM;
@@ -142,15 +142,15 @@ void path_io(bool store, bool everything, uint slot, inout PathState p, inout Sl
 // Append slot to queue q (0, 1: track queues; EVENT_QUEUE; BEGIN_QUEUE).
 void enqueue(uint q, uint slot) {
   uint j;
-  if (q == 0u) j = atomicAdd(queues.counts.x, 1u);
-  else if (q == 1u) j = atomicAdd(queues.counts.y, 1u);
-  else if (q == EVENT_QUEUE) j = atomicAdd(queues.counts.z, 1u);
-  else j = atomicAdd(queues.sizes.y, 1u);
-  queue_slots[q * queues.sizes.x + j] = slot;
+  if (q == 0u) j = atomicAdd(queues.track_count0, 1u);
+  else if (q == 1u) j = atomicAdd(queues.track_count1, 1u);
+  else if (q == EVENT_QUEUE) j = atomicAdd(queues.event_count, 1u);
+  else j = atomicAdd(queues.begin_count, 1u);
+  queue_slots[q * queues.capacity + j] = slot;
 }
 
 uvec2 slot_pixel(uint slot) {
-  const uint width = frame.image.x;
+  const uint width = frame.width;
   return uvec2(slot % width, slot / width + pass_constants.row_begin);
 }
 
@@ -180,7 +180,7 @@ bool settle(uvec2 pixel, inout PathState p, inout SlotState s, inout vec2 span[M
 
 void finish_slot(uint slot, SlotState s) {
   const uvec2 pixel = slot_pixel(slot);
-  add_pass(pixel.y * frame.image.x + pixel.x, s.sum, s.sum_c, s.sq, s.sq_c, s.stats, s.nonfinite);
+  add_pass(pixel.y * frame.width + pixel.x, s.sum, s.sum_c, s.sq, s.sq_c, s.stats, s.nonfinite);
 }
 
 void wavefront_main() {
@@ -191,33 +191,33 @@ void wavefront_main() {
   if (WAVEFRONT_STAGE == WAVEFRONT_SIZE_TRACK) {
     // The track queue filled last becomes the one read; the other and the
     // event queue start empty.
-    const uint read = queues.counts.w ^ 1u;
-    queues.counts.w = read;
-    const uint n = read == 0u ? queues.counts.x : queues.counts.y;
+    const uint read = queues.track_read ^ 1u;
+    queues.track_read = read;
+    const uint n = read == 0u ? queues.track_count0 : queues.track_count1;
     queues.track_dispatch = uvec4((n + WAVEFRONT_GROUP - 1u) / WAVEFRONT_GROUP, 1u, 1u, 0u);
-    if (read == 0u) queues.counts.y = 0u;
-    else queues.counts.x = 0u;
-    queues.counts.z = 0u;
-    queues.sizes.y = 0u;
+    if (read == 0u) queues.track_count1 = 0u;
+    else queues.track_count0 = 0u;
+    queues.event_count = 0u;
+    queues.begin_count = 0u;
     return;
   }
   if (WAVEFRONT_STAGE == WAVEFRONT_SIZE_EVENT) {
-    queues.event_dispatch = uvec4((queues.counts.z + WAVEFRONT_GROUP - 1u) / WAVEFRONT_GROUP, 1u, 1u, 0u);
+    queues.event_dispatch = uvec4((queues.event_count + WAVEFRONT_GROUP - 1u) / WAVEFRONT_GROUP, 1u, 1u, 0u);
     return;
   }
   if (WAVEFRONT_STAGE == WAVEFRONT_SIZE_BEGIN) {
-    queues.begin_dispatch = uvec4((queues.sizes.y + WAVEFRONT_GROUP - 1u) / WAVEFRONT_GROUP, 1u, 1u, 0u);
+    queues.begin_dispatch = uvec4((queues.begin_count + WAVEFRONT_GROUP - 1u) / WAVEFRONT_GROUP, 1u, 1u, 0u);
     return;
   }
   PathState p;
   SlotState s;
   vec2 span[MEDIA_N];
   float rho[MEDIA_N], temperature_value[MEDIA_N];
-  const uint read = queues.counts.w, fill = read ^ 1u;
+  const uint read = queues.track_read, fill = read ^ 1u;
   if (WAVEFRONT_STAGE == WAVEFRONT_START) {
     const uvec2 pixel = gl_GlobalInvocationID.xy + uvec2(0u, pass_constants.row_begin);
-    if (pixel.x >= frame.image.x || pixel.y >= min(frame.image.y, pass_constants.row_end)) return;
-    const uint slot = (pixel.y - pass_constants.row_begin) * frame.image.x + pixel.x;
+    if (pixel.x >= frame.width || pixel.y >= min(frame.height, pass_constants.row_end)) return;
+    const uint slot = (pixel.y - pass_constants.row_begin) * frame.width + pixel.x;
     s.k = pass_constants.sample_offset;
     s.sum = s.sum_c = s.sq = s.sq_c = vec3(0.0);
     s.nonfinite = 0.0;
@@ -236,8 +236,8 @@ void wavefront_main() {
   }
   const uint j = gl_WorkGroupID.x * WAVEFRONT_GROUP + gl_LocalInvocationIndex;
   if (WAVEFRONT_STAGE == WAVEFRONT_TRACK) {
-    if (j >= (read == 0u ? queues.counts.x : queues.counts.y)) return;
-    const uint slot = queue_slots[read * queues.sizes.x + j];
+    if (j >= (read == 0u ? queues.track_count0 : queues.track_count1)) return;
+    const uint slot = queue_slots[read * queues.capacity + j];
     path_io(false, false, slot, p, s, span, rho, temperature_value);
     if (s.pending == 0u) s.event = path_track(p, span, s.rng, s.stats, s.c, rho, temperature_value);
     path_io(true, false, slot, p, s, span, rho, temperature_value);
@@ -246,8 +246,8 @@ void wavefront_main() {
     return;
   }
   if (WAVEFRONT_STAGE == WAVEFRONT_EVENT) {
-    if (j >= queues.counts.z) return;
-    const uint slot = queue_slots[EVENT_QUEUE * queues.sizes.x + j];
+    if (j >= queues.event_count) return;
+    const uint slot = queue_slots[EVENT_QUEUE * queues.capacity + j];
     path_io(false, true, slot, p, s, span, rho, temperature_value);
     const bool ended = s.pending != 0u ? s.pending == 2u
                                        : path_event(p, span, s.event, s.c, rho, temperature_value, s.rng, s.stats);
@@ -265,8 +265,8 @@ void wavefront_main() {
     enqueue(fill, slot);
   }
   if (WAVEFRONT_STAGE == WAVEFRONT_BEGIN) {
-    if (j >= queues.sizes.y) return;
-    const uint slot = queue_slots[BEGIN_QUEUE * queues.sizes.x + j];
+    if (j >= queues.begin_count) return;
+    const uint slot = queue_slots[BEGIN_QUEUE * queues.capacity + j];
     path_io(false, true, slot, p, s, span, rho, temperature_value);
     if (!settle(slot_pixel(slot), p, s, span, s.pending == 2u)) {
       finish_slot(slot, s);

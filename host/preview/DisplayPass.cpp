@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "preview_shared.glsl"
+#include "shared/preview_types.h"
 #include "shared/view_transform.h"
 #include "render/vulkan/Spirv.h"
 
@@ -39,12 +39,13 @@ void DisplayPass::resize(VkExtent2D target, bool bgra) {
 
 void DisplayPass::record(VkCommandBuffer cmd, int spp, double exposure_stops, ViewTransform view, VkImage image) {
   gpu::DisplayConstants dc{};
-  dc.size = gpu::uvec4(image_w_, image_h_, target_.width, target_.height);
+  dc.image_and_target = gpu::uvec4(image_w_, image_h_, target_.width, target_.height);
   dc.rect = gpu::uvec4(rect_.x, rect_.y, rect_.width, rect_.height);
   const float border = 0.08f;  // dark grey bars, so the image's own black edges stay visible
-  dc.tone = gpu::vec4(spp > 0 ? float(std::exp2(exposure_stops) / spp) : 0.0f, border, border, border);
-  dc.flags = gpu::uvec4(bgra_ ? 1u : 0u, view == ViewTransform::Standard ? display::VIEW_STANDARD : display::VIEW_AGX,
-                        0u, 0u);
+  dc.border = gpu::vec3(border);
+  dc.radiance_scale = spp > 0 ? float(std::exp2(exposure_stops) / spp) : 0.0f;
+  dc.swap_red_blue = bgra_ ? 1u : 0u;
+  dc.view = view == ViewTransform::Standard ? display::VIEW_STANDARD : display::VIEW_AGX;
   pipeline_.bind(cmd, set_.set());
   pipeline_.push(cmd, dc);
   const uint32_t g = gpu::PREVIEW_WORKGROUP_SIZE;

@@ -1,7 +1,8 @@
 // Structs and constants shared by the host (C++) and the shaders (GLSL): the one
 // source of truth for data that crosses the boundary. Written in the common subset
-// of both languages; only vec4/uvec4 members, so std140 and std430 agree and no
-// vec3 padding can drift. The C++ side static_asserts every size below.
+// of both languages. Members are vec4/uvec4 or a vec3 followed by a 4-byte
+// scalar, so std140, std430 and C++ place them alike; the C++ side
+// static_asserts every size and offset below.
 #ifndef PYROLUME_GPU_TYPES_H
 #define PYROLUME_GPU_TYPES_H
 
@@ -104,14 +105,21 @@ PYRO_CONST uint EMIT_CONSTANT = 1;     // grid: Le = emission.rgb (× density vi
 PYRO_CONST uint EMIT_TEMPERATURE = 2;  // grid: Le = scale × blackbody LUT(T(x))
 
 // One medium (96 bytes). Grid media multiply sigma_a and sigma_s by
-// density_scale · density(x).
+// density_scale · density(x). Each row is a vec3 and a scalar: 16 bytes in
+// std140, std430 and C++ alike (offsets asserted below).
 struct GpuMedium {
-  vec4 sigma_a;   // rgb: absorption coefficient, 1/unit; w: shape (SHAPE_*)
-  vec4 sigma_s;   // rgb: scattering coefficient, 1/unit; w: Henyey–Greenstein g
-  vec4 emission;  // homogeneous: rgb sigma_a·Le (per unit length); grid: rgb Le or blackbody scale; w: EMIT_*
-  vec4 bounds0;   // sphere: xyz centre, w radius; box: xyz min; grid: x = slot
-  vec4 bounds1;   // box: xyz max
-  vec4 reserved;
+  vec3 sigma_a;        // absorption coefficient, 1/unit
+  uint shape;          // SHAPE_*
+  vec3 sigma_s;        // scattering coefficient, 1/unit
+  float g;             // Henyey–Greenstein asymmetry
+  vec3 emission;       // homogeneous: sigma_a·Le (per unit length); grid: Le or the blackbody scale
+  uint emission_mode;  // EMIT_*
+  vec3 center;         // sphere
+  float radius;        // sphere
+  vec3 box_min;        // box
+  uint grid_slot;      // grid: its GpuGrid, textures and emission light
+  vec3 box_max;        // box
+  float unused;
 };
 
 // A grid medium's textures and majorant grid (192 bytes). "Texel coordinates"
@@ -122,32 +130,54 @@ struct GpuGrid {
   vec4 density_row0;      // u = (dot(row0, p1), dot(row1, p1), dot(row2, p1)), p1 = (p, 1)
   vec4 density_row1;
   vec4 density_row2;
-  vec4 density_dims;      // xyz: texels; w: density_scale
+  vec3 density_dims;      // texels
+  float density_scale;
   vec4 temperature_row0;  // the temperature texture's own world -> texel map
   vec4 temperature_row1;
   vec4 temperature_row2;
-  vec4 temperature_dims;  // xyz: texels; w: unused
-  vec4 temperature_map;   // T = (value - x) · y kelvin; z: cutoff_k; w: unused
-  vec4 blackbody_lut;     // s = ln(T)·x + y; z: t_min_k (no emission below); w: unused
-  uvec4 majorant_res;     // xyz: cells; w: offset of cell (0,0,0) in the majorant buffer
-  vec4 majorant_cell;     // xyz: cell size in texels; w: max channel of (sigma_a + sigma_s)·density_scale
+  vec3 temperature_dims;  // texels
+  float unused0;
+  float temperature_offset;  // T = (value − temperature_offset) · temperature_scale kelvin
+  float temperature_scale;
+  float cutoff_k;            // no emission at or below
+  float unused1;
+  float lut_scale;  // the blackbody LUT's coordinate s = ln(T)·lut_scale + lut_offset
+  float lut_offset;
+  float t_min_k;    // the LUT's lower end: no emission below
+  float unused2;
+  uvec3 majorant_res;     // cells
+  uint majorant_offset;   // cell (0,0,0)'s index in the majorant buffer
+  vec3 majorant_cell;     // cell size in texels
+  float majorant_scale;   // max channel of (sigma_a + sigma_s)·density_scale: a cell's value times this is its majorant
 };
 
 // Per-render constants (uniform buffer).
 struct FrameConstants {
-  vec4 camera_position;  // xyz; w: tan(fov_y / 2)
-  vec4 camera_forward;   // xyz unit; w: aspect = width / height
-  vec4 camera_right;     // xyz unit = normalize(cross(forward, up))
-  vec4 camera_up;        // xyz unit = cross(right, forward)
-  vec4 background;       // rgb radiance of escaping rays
-  uvec4 image;           // x width, y height, z medium count, w max_depth
-  uvec4 sampling;        // x seed, y frame, z unused, w unused
-  vec4 lights;           // x: probability that next-event estimation picks the environment
-                         // (each emissive grid's is its GpuEmissionCdf measure.w); y: probability
-                         // that a vertex's continuation comes from its own lobe (LightSelection
-                         // p_continue_own); z: next-event samples per surface vertex
-                         // (LightSelection surface_light_samples); w: 1 when a surface vertex's
-                         // continuation is collected by a ratio-tracked ray (ratio_tracked_continuation)
+  vec3 camera_position;
+  float tan_half_fov;    // tan(fov_y / 2)
+  vec3 camera_forward;   // unit
+  float aspect;          // width / height
+  vec3 camera_right;     // unit = normalize(cross(forward, up))
+  float unused0;
+  vec3 camera_up;        // unit = cross(right, forward)
+  float unused1;
+  vec3 background;       // radiance of escaping rays
+  float unused2;
+  uint width, height;
+  uint medium_count;
+  uint max_depth;
+  uint seed;
+  uint frame_index;      // the animation frame (rng_init's stream)
+  uint unused3, unused4;
+  // Next-event estimation (LightSelection): the probability that it picks the
+  // environment (each emissive grid's is its GpuEmissionCdf pick_probability);
+  // the probability that a vertex's continuation comes from its own lobe
+  // (p_continue_own); light samples per surface vertex (surface_light_samples);
+  // 1 when a surface vertex's continuation is collected by a ratio-tracked ray.
+  float p_env;
+  float p_continue_own;
+  uint surface_light_samples;
+  uint ratio_tracked_continuation;
 };
 
 // Per-pass values (push constants).
@@ -164,7 +194,8 @@ struct PassConstants {
 // with too much work per SIMD group stops early; the host redoes it in
 // smaller passes (RenderSession::run_pass).
 struct PassStatus {
-  uvec4 counts;  // x: samples not finished (summed over pixels); yzw: 0
+  uint unfinished_samples;  // summed over pixels
+  uint unused0, unused1, unused2;
 };
 
 // The wavefront's queues (buffer BINDING_QUEUES): this header, then four
@@ -174,28 +205,72 @@ struct WavefrontQueues {
   uvec4 track_dispatch;  // xyz: vkCmdDispatchIndirect's workgroups for the track stage
   uvec4 event_dispatch;  // xyz: the same for the event stage
   uvec4 begin_dispatch;  // xyz: the same for the begin stage
-  uvec4 counts;          // x, y: paths in track queue 0, 1; z: in the event queue; w: the track queue being read
-  uvec4 sizes;           // x: capacity (paths per queue); y: paths in the begin queue; zw: unused
+  uint track_count0;     // paths in track queue 0
+  uint track_count1;     // paths in track queue 1
+  uint event_count;      // paths in the event queue
+  uint track_read;       // the track queue being read (0 or 1)
+  uint capacity;         // paths per queue
+  uint begin_count;      // paths in the begin queue
+  uint unused0, unused1;
 };
 
 // Per-pixel accumulation, Kahan-compensated so float32 sums stay accurate over
 // thousands of passes (Kahan 1965; `precise` stops the compiler reassociating).
 struct AccumTexel {
-  vec4 sum;       // rgb: Σ L; w: Σ real events (absorptions + scatterings)
-  vec4 sum_c;     // compensation terms of sum
-  vec4 sum_sq;    // rgb: Σ L²; w: Σ density lookups
-  vec4 sum_sq_c;  // compensation terms of sum_sq; w: count of non-finite samples (plain sum)
+  vec3 sum;         // Σ L
+  float events;     // Σ real events (absorptions + scatterings)
+  vec3 sum_c;       // compensation terms of sum
+  float events_c;   // and of events
+  vec3 sum_sq;      // Σ L²
+  float lookups;    // Σ density lookups (plain sum)
+  vec3 sum_sq_c;    // compensation terms of sum_sq
+  float nonfinite;  // count of non-finite samples (plain sum)
 };
 
 #ifdef __cplusplus
+// Every field where std140/std430 put it (a vec3 ends 4 bytes before the next 16).
 static_assert(sizeof(GpuMedium) == 96);
+PYRO_OFFSET(GpuMedium, shape, 12); PYRO_OFFSET(GpuMedium, sigma_s, 16); PYRO_OFFSET(GpuMedium, g, 28);
+PYRO_OFFSET(GpuMedium, emission, 32); PYRO_OFFSET(GpuMedium, emission_mode, 44); PYRO_OFFSET(GpuMedium, center, 48);
+PYRO_OFFSET(GpuMedium, radius, 60); PYRO_OFFSET(GpuMedium, box_min, 64); PYRO_OFFSET(GpuMedium, grid_slot, 76);
+PYRO_OFFSET(GpuMedium, box_max, 80); PYRO_OFFSET(GpuMedium, unused, 92);
 static_assert(sizeof(GpuGrid) == 192);
+PYRO_OFFSET(GpuGrid, density_row1, 16); PYRO_OFFSET(GpuGrid, density_row2, 32);
+PYRO_OFFSET(GpuGrid, density_dims, 48); PYRO_OFFSET(GpuGrid, density_scale, 60);
+PYRO_OFFSET(GpuGrid, temperature_row0, 64); PYRO_OFFSET(GpuGrid, temperature_row1, 80);
+PYRO_OFFSET(GpuGrid, temperature_row2, 96); PYRO_OFFSET(GpuGrid, temperature_dims, 112);
+PYRO_OFFSET(GpuGrid, unused0, 124); PYRO_OFFSET(GpuGrid, temperature_offset, 128);
+PYRO_OFFSET(GpuGrid, temperature_scale, 132); PYRO_OFFSET(GpuGrid, cutoff_k, 136); PYRO_OFFSET(GpuGrid, unused1, 140);
+PYRO_OFFSET(GpuGrid, lut_scale, 144); PYRO_OFFSET(GpuGrid, lut_offset, 148); PYRO_OFFSET(GpuGrid, t_min_k, 152);
+PYRO_OFFSET(GpuGrid, unused2, 156); PYRO_OFFSET(GpuGrid, majorant_res, 160);
+PYRO_OFFSET(GpuGrid, majorant_offset, 172); PYRO_OFFSET(GpuGrid, majorant_cell, 176);
+PYRO_OFFSET(GpuGrid, majorant_scale, 188);
 static_assert(sizeof(FrameConstants) == 128);
-static_assert(offsetof(FrameConstants, image) == 80);
+PYRO_OFFSET(FrameConstants, tan_half_fov, 12); PYRO_OFFSET(FrameConstants, camera_forward, 16);
+PYRO_OFFSET(FrameConstants, aspect, 28); PYRO_OFFSET(FrameConstants, camera_right, 32);
+PYRO_OFFSET(FrameConstants, unused0, 44); PYRO_OFFSET(FrameConstants, camera_up, 48);
+PYRO_OFFSET(FrameConstants, unused1, 60); PYRO_OFFSET(FrameConstants, background, 64);
+PYRO_OFFSET(FrameConstants, unused2, 76); PYRO_OFFSET(FrameConstants, width, 80);
+PYRO_OFFSET(FrameConstants, height, 84); PYRO_OFFSET(FrameConstants, medium_count, 88);
+PYRO_OFFSET(FrameConstants, max_depth, 92); PYRO_OFFSET(FrameConstants, seed, 96);
+PYRO_OFFSET(FrameConstants, frame_index, 100); PYRO_OFFSET(FrameConstants, unused3, 104);
+PYRO_OFFSET(FrameConstants, unused4, 108); PYRO_OFFSET(FrameConstants, p_env, 112);
+PYRO_OFFSET(FrameConstants, p_continue_own, 116); PYRO_OFFSET(FrameConstants, surface_light_samples, 120);
+PYRO_OFFSET(FrameConstants, ratio_tracked_continuation, 124);
 static_assert(sizeof(PassConstants) == 16);
-static_assert(sizeof(AccumTexel) == 64);
+PYRO_OFFSET(PassConstants, spp, 4); PYRO_OFFSET(PassConstants, row_begin, 8); PYRO_OFFSET(PassConstants, row_end, 12);
 static_assert(sizeof(PassStatus) == 16);
+PYRO_OFFSET(PassStatus, unused0, 4); PYRO_OFFSET(PassStatus, unused1, 8); PYRO_OFFSET(PassStatus, unused2, 12);
 static_assert(sizeof(WavefrontQueues) == 80);
+PYRO_OFFSET(WavefrontQueues, event_dispatch, 16); PYRO_OFFSET(WavefrontQueues, begin_dispatch, 32);
+PYRO_OFFSET(WavefrontQueues, track_count0, 48); PYRO_OFFSET(WavefrontQueues, track_count1, 52);
+PYRO_OFFSET(WavefrontQueues, event_count, 56); PYRO_OFFSET(WavefrontQueues, track_read, 60);
+PYRO_OFFSET(WavefrontQueues, capacity, 64); PYRO_OFFSET(WavefrontQueues, begin_count, 68);
+PYRO_OFFSET(WavefrontQueues, unused0, 72); PYRO_OFFSET(WavefrontQueues, unused1, 76);
+static_assert(sizeof(AccumTexel) == 64);
+PYRO_OFFSET(AccumTexel, events, 12); PYRO_OFFSET(AccumTexel, sum_c, 16); PYRO_OFFSET(AccumTexel, events_c, 28);
+PYRO_OFFSET(AccumTexel, sum_sq, 32); PYRO_OFFSET(AccumTexel, lookups, 44); PYRO_OFFSET(AccumTexel, sum_sq_c, 48);
+PYRO_OFFSET(AccumTexel, nonfinite, 60);
 }  // namespace pyrolume::gpu
 #endif
 #endif

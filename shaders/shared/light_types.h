@@ -2,8 +2,9 @@
 // environment map and the emission CDF of an emissive grid medium
 // (docs/lights.md; host/light/EnvironmentMap, host/light/EmissionCdf;
 // shaders/lights.glsl). Same rules as gpu_types.h: written in the common subset
-// of both languages, only vec4/uvec4 members (std140 and std430 agree), every
-// size static_asserted. Binding numbers are the includer's (render.comp's
+// of both languages, vec4/uvec4 members or a vec3 and a 4-byte scalar per
+// 16 bytes (std140, std430 and C++ agree), every size and offset
+// static_asserted. Binding numbers are the includer's (render.comp's
 // BINDING_* live in gpu_types.h).
 #ifndef PYROLUME_LIGHT_TYPES_H
 #define PYROLUME_LIGHT_TYPES_H
@@ -23,8 +24,12 @@ namespace pyrolume::gpu {
 //   env_cdf[(H + 1) + H·(W + 1)]: marginal CDF over rows, then one conditional CDF
 //                    per row (row j at (H + 1) + j·(W + 1)); each 0 … 1.
 struct GpuEnvironment {
-  vec4 transform;  // x: cos(rotation), y: sin(rotation), z: scale, w: power ≈ ∫ Y(L) dω (scale included)
-  uvec4 size;      // x: width W, y: height H, z: 1 if it can be sampled (else pdf 0), w: 1 if the zenith is world +Y (else +Z)
+  float cos_rotation, sin_rotation;
+  float scale;      // radiance = texel rgb × scale
+  float power;      // ≈ ∫ Y(L) dω (scale included)
+  uint width, height;
+  uint can_sample;  // 1 if it can be sampled (else pdf 0)
+  uint zenith_y;    // 1 if the zenith is world +Y (else +Z)
 };
 
 // An emissive grid medium's emission CDF as seen from a receiver (160 bytes;
@@ -40,8 +45,8 @@ struct GpuEnvironment {
 //   emission_cells[entry]:    linear index x + X·(y + Y·z) of that cell (grouped by cluster)
 //   emission_pmf[cell]:       probability of EVERY cell within its cluster (0: never chosen)
 //   emission_clusters[s]:     GpuEmissionCluster, linear over the cluster grid like cells
-// Several media may share the buffers: entries [offsets.x, offsets.x + cells.w),
-// cells [offsets.y, offsets.y + X·Y·Z) and clusters [offsets.z, offsets.z + CX·CY·CZ)
+// Several media may share the buffers: entries [first_entry, first_entry + entry_count),
+// cells [first_cell, first_cell + X·Y·Z) and clusters [first_cluster, first_cluster + CX·CY·CZ)
 // belong to this medium.
 struct GpuEmissionCdf {
   vec4 world_to_cell_row0;  // c = (dot(row0, p1), dot(row1, p1), dot(row2, p1)), p1 = (p, 1)
@@ -50,20 +55,31 @@ struct GpuEmissionCdf {
   vec4 cell_to_world_row0;  // p = (dot(row0, c1), dot(row1, c1), dot(row2, c1)), c1 = (c, 1)
   vec4 cell_to_world_row1;
   vec4 cell_to_world_row2;
-  uvec4 cells;    // xyz: cells per axis (= density dims − 1); w: entry count (cells of weight > 0)
-  uvec4 offsets;  // x: first entry in emission_cdf / emission_cells; y: first cell in emission_pmf;
-                  // z: first cluster in emission_clusters (the grid of clusters, then copies
-                  // of the nonempty ones, which the loops over clusters read); w: their count
-  uvec4 clusters; // xyz: clusters per axis; w: k, cells per cluster per axis
-  vec4 measure;   // x: cell volume |det| (world units³); y: 1 / volume; z: power ∫ w dV;
-                  // w: probability that next-event estimation picks this light (render.comp)
+  uvec3 cells;           // cells per axis (= density dims − 1)
+  uint entry_count;      // cells of weight > 0
+  uint first_entry;      // in emission_cdf / emission_cells
+  uint first_cell;       // in emission_pmf
+  // In emission_clusters: the grid of clusters, then copies of the nonempty
+  // ones, which the loops over clusters read.
+  uint first_cluster;
+  uint nonempty_clusters;
+  uvec3 clusters;        // clusters per axis
+  uint cluster_k;        // cells per cluster per axis
+  float cell_volume;     // |det| (world units³)
+  float inv_cell_volume;
+  float power;           // ∫ w dV
+  float pick_probability;  // that next-event estimation picks this light
 };
 
 // One cluster of an emission CDF (48 bytes).
 struct GpuEmissionCluster {
-  vec4 sphere;     // xyz: world-space centre of the bounding sphere of its cells of weight > 0; w: radius²
-  vec4 power;      // x: its share of the emission (0: empty); yzw: 0
-  uvec4 entries;   // x: its first entry (relative to offsets.x); y: its entry count; zw: 0
+  vec3 center;       // world-space centre of the bounding sphere of its cells of weight > 0
+  float radius_sq;   // that sphere's radius²
+  float power;       // its share of the emission (0: empty)
+  uint unused0, unused1, unused2;
+  uint first_entry;  // relative to GpuEmissionCdf first_entry
+  uint entry_count;
+  uint unused3, unused4;
 };
 
 // The kinds of analytic light (the scene's `lights`; docs/lights.md
@@ -76,25 +92,48 @@ PYRO_CONST uint LIGHT_SPHERE = 4;
 
 // One analytic light (80 bytes; buffer analytic_lights[], shaders/analytic_lights.glsl).
 struct GpuLight {
-  vec4 position;   // xyz: point or spot position, sphere centre; w: sphere radius
-  vec4 direction;  // xyz unit: distant, disc: toward the light; spot: where it shines; w: 0
-  vec4 value;      // rgb: intensity (point, spot; W/sr), irradiance (distant), radiance (disc, sphere);
-                   // w: probability that next-event estimation picks this light
-  vec4 cone;       // spot: x cos of the cone's half-angle, y cos of where the falloff starts;
-                   // disc: z 1 − cos θ, w sin²θ (θ its angular radius); else 0
-  uvec4 kind;      // x: LIGHT_*; yzw: 0
+  vec3 position;   // point or spot position, sphere centre
+  float radius;    // sphere
+  vec3 direction;  // unit: distant, disc: toward the light; spot: where it shines
+  float unused0;
+  vec3 value;      // intensity (point, spot; W/sr), irradiance (distant), radiance (disc, sphere)
+  float pick_probability;  // that next-event estimation picks this light
+  float cos_cone;          // spot: cos of the cone's half-angle
+  float cos_falloff;       // spot: cos of where the falloff starts
+  float one_minus_cos;     // disc: 1 − cos θ (θ its angular radius)
+  float sin2;              // disc: sin²θ
+  uint kind;               // LIGHT_*
+  uint unused1, unused2, unused3;
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(GpuLight) == 80);
-static_assert(offsetof(GpuLight, cone) == 48);
-static_assert(offsetof(GpuLight, kind) == 64);
-static_assert(sizeof(GpuEmissionCluster) == 48);
 static_assert(sizeof(GpuEnvironment) == 32);
-static_assert(offsetof(GpuEnvironment, size) == 16);
+PYRO_OFFSET(GpuEnvironment, sin_rotation, 4); PYRO_OFFSET(GpuEnvironment, scale, 8);
+PYRO_OFFSET(GpuEnvironment, power, 12);
+PYRO_OFFSET(GpuEnvironment, width, 16); PYRO_OFFSET(GpuEnvironment, height, 20);
+PYRO_OFFSET(GpuEnvironment, can_sample, 24); PYRO_OFFSET(GpuEnvironment, zenith_y, 28);
 static_assert(sizeof(GpuEmissionCdf) == 160);
-static_assert(offsetof(GpuEmissionCdf, cells) == 96);
-static_assert(offsetof(GpuEmissionCdf, measure) == 144);
+PYRO_OFFSET(GpuEmissionCdf, world_to_cell_row1, 16); PYRO_OFFSET(GpuEmissionCdf, world_to_cell_row2, 32);
+PYRO_OFFSET(GpuEmissionCdf, cell_to_world_row0, 48); PYRO_OFFSET(GpuEmissionCdf, cell_to_world_row1, 64);
+PYRO_OFFSET(GpuEmissionCdf, cell_to_world_row2, 80); PYRO_OFFSET(GpuEmissionCdf, cells, 96);
+PYRO_OFFSET(GpuEmissionCdf, entry_count, 108); PYRO_OFFSET(GpuEmissionCdf, first_entry, 112);
+PYRO_OFFSET(GpuEmissionCdf, first_cell, 116); PYRO_OFFSET(GpuEmissionCdf, first_cluster, 120);
+PYRO_OFFSET(GpuEmissionCdf, nonempty_clusters, 124); PYRO_OFFSET(GpuEmissionCdf, clusters, 128);
+PYRO_OFFSET(GpuEmissionCdf, cluster_k, 140); PYRO_OFFSET(GpuEmissionCdf, cell_volume, 144);
+PYRO_OFFSET(GpuEmissionCdf, inv_cell_volume, 148); PYRO_OFFSET(GpuEmissionCdf, power, 152);
+PYRO_OFFSET(GpuEmissionCdf, pick_probability, 156);
+static_assert(sizeof(GpuEmissionCluster) == 48);
+PYRO_OFFSET(GpuEmissionCluster, radius_sq, 12); PYRO_OFFSET(GpuEmissionCluster, power, 16);
+PYRO_OFFSET(GpuEmissionCluster, unused0, 20); PYRO_OFFSET(GpuEmissionCluster, unused1, 24);
+PYRO_OFFSET(GpuEmissionCluster, unused2, 28); PYRO_OFFSET(GpuEmissionCluster, first_entry, 32);
+PYRO_OFFSET(GpuEmissionCluster, entry_count, 36); PYRO_OFFSET(GpuEmissionCluster, unused3, 40);
+PYRO_OFFSET(GpuEmissionCluster, unused4, 44);
+static_assert(sizeof(GpuLight) == 80);
+PYRO_OFFSET(GpuLight, radius, 12); PYRO_OFFSET(GpuLight, direction, 16); PYRO_OFFSET(GpuLight, unused0, 28);
+PYRO_OFFSET(GpuLight, value, 32); PYRO_OFFSET(GpuLight, pick_probability, 44); PYRO_OFFSET(GpuLight, cos_cone, 48);
+PYRO_OFFSET(GpuLight, cos_falloff, 52); PYRO_OFFSET(GpuLight, one_minus_cos, 56); PYRO_OFFSET(GpuLight, sin2, 60);
+PYRO_OFFSET(GpuLight, kind, 64); PYRO_OFFSET(GpuLight, unused1, 68); PYRO_OFFSET(GpuLight, unused2, 72);
+PYRO_OFFSET(GpuLight, unused3, 76);
 }  // namespace pyrolume::gpu
 #endif
 #endif

@@ -69,7 +69,7 @@ TEST(HardLights, EmissionCdfWithZeroTotalIsSafe) {
     EXPECT_EQ(cdf.entry_count(), 0u) << c.what;
     EXPECT_EQ(cdf.power(), 0.0) << c.what;
     EXPECT_TRUE(cdf.cluster_cdf().empty()) << c.what;
-    EXPECT_EQ(pack_gpu_emission_header(cdf).cells.w, 0u) << c.what;
+    EXPECT_EQ(pack_gpu_emission_header(cdf).entry_count, 0u) << c.what;
     for (double u : kEdgeU)
       for (double u3 : {0.0, 0.5, std::nextafter(1.0, 0.0)}) {
         const EmissionSample s = cdf.sample(u, glm::dvec3(u3));
@@ -134,7 +134,7 @@ TEST(HardLights, EnvironmentMapAllZeroIsSafe) {
   const EnvironmentMap env = EnvironmentMap::from_image(make_image(16, 8), 3.0, 30.0);
   EXPECT_FALSE(env.has_distribution());
   EXPECT_EQ(env.power(), 0.0);
-  EXPECT_EQ(pack_gpu_environment_header(env).size.z, 0u);
+  EXPECT_EQ(pack_gpu_environment_header(env).can_sample, 0u);
   for (double u : kEdgeU)
     for (double v : kEdgeU) {
       const EnvSample s = env.sample({u, v});

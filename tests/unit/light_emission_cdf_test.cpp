@@ -306,7 +306,7 @@ TEST(EmissionCdf, NoEmissionGivesNoDistribution) {
     EXPECT_EQ(cdf.power(), 0.0) << what;
     EXPECT_EQ(cdf.sample(0.5, {0.5, 0.5, 0.5}).pdf, 0.0) << what;
     EXPECT_EQ(cdf.pdf(glm::dvec3(1.0, -0.5, 2.0)), 0.0) << what;
-    EXPECT_EQ(pack_gpu_emission_header(cdf).cells.w, 0u) << what;
+    EXPECT_EQ(pack_gpu_emission_header(cdf).entry_count, 0u) << what;
   };
   DenseGrid zero = d;
   std::fill(zero.values.begin(), zero.values.end(), 0.0f);

@@ -325,7 +325,7 @@ TEST(EnvironmentMap, BlackMapOrZeroScaleHasNoDistribution) {
   EXPECT_FALSE(black.has_distribution());
   EXPECT_EQ(black.sample({0.3, 0.6}).pdf, 0.0);
   EXPECT_EQ(black.pdf({0, 0, 1}), 0.0);
-  EXPECT_EQ(pack_gpu_environment_header(black).size.z, 0u);
+  EXPECT_EQ(pack_gpu_environment_header(black).can_sample, 0u);
   for (float& v : img.rgb) v = 1.0f;
   EnvironmentMap off = EnvironmentMap::from_image(img, 0.0);
   EXPECT_FALSE(off.has_distribution());

@@ -28,10 +28,14 @@ namespace {
 // float sum lost 2^-30 (kept in the compensation) reads back with it.
 TEST(VulkanAccumulation, ReadbackAppliesTheKahanCompensation) {
   gpu::AccumTexel t{};
-  t.sum = gpu::vec4(1.0f, 3.0f, 100.0f, 7.0f);
-  t.sum_c = gpu::vec4(-std::ldexp(1.0f, -30), std::ldexp(1.0f, -28), 0.0f, -0.5f);
-  t.sum_sq = gpu::vec4(2.0f, 9.0f, 1e4f, 11.0f);
-  t.sum_sq_c = gpu::vec4(-std::ldexp(1.0f, -29), 0.0f, std::ldexp(1.0f, -20), 3.0f);
+  t.sum = gpu::vec3(1.0f, 3.0f, 100.0f);
+  t.events = 7.0f;
+  t.sum_c = gpu::vec3(-std::ldexp(1.0f, -30), std::ldexp(1.0f, -28), 0.0f);
+  t.events_c = -0.5f;
+  t.sum_sq = gpu::vec3(2.0f, 9.0f, 1e4f);
+  t.lookups = 11.0f;
+  t.sum_sq_c = gpu::vec3(-std::ldexp(1.0f, -29), 0.0f, std::ldexp(1.0f, -20));
+  t.nonfinite = 3.0f;
   AccumulationState st{"vulkan", 1, 1, 5, std::vector<uint8_t>(sizeof t)};
   std::memcpy(st.data.data(), &t, sizeof t);
   RenderResult r;

@@ -15,7 +15,7 @@ namespace pyrolume {
 static_assert(kMaxSampleRadiance == gpu::MAX_SAMPLE_RADIANCE);
 static_assert(kMaxEmittedRadiance == gpu::MAX_EMITTED_RADIANCE);
 namespace {
-gpu::vec4 v4(glm::dvec3 v, double w) { return gpu::vec4(float(v.x), float(v.y), float(v.z), float(w)); }
+gpu::vec3 v3(glm::dvec3 v) { return gpu::vec3(float(v.x), float(v.y), float(v.z)); }
 double max3(glm::dvec3 v) { return std::max(v.x, std::max(v.y, v.z)); }
 
 glm::dvec3 homogeneous_le(const Emission& e) {
@@ -89,18 +89,21 @@ GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<Sto
   for (size_t i = 0; i < scene.media.size(); ++i) {
     const Medium& m = scene.media[i];
     gpu::GpuMedium g{};
-    g.sigma_s = v4(m.sigma_s, m.g);
+    g.sigma_s = v3(m.sigma_s);
+    g.g = float(m.g);
     if (m.type == Medium::Type::Homogeneous) {
       bool sphere = m.bounds.kind == Bounds::Kind::Sphere;
-      g.sigma_a = v4(m.sigma_a, sphere ? gpu::SHAPE_SPHERE : gpu::SHAPE_BOX);
+      g.sigma_a = v3(m.sigma_a);
+      g.shape = sphere ? gpu::SHAPE_SPHERE : gpu::SHAPE_BOX;
       out.has_analytic = true;
       // A medium emits sigma_a·Le per unit length (docs/scene-format.md "media").
-      g.emission = v4(m.sigma_a * homogeneous_le(m.emission), 0.0);
+      g.emission = v3(m.sigma_a * homogeneous_le(m.emission));
       if (sphere) {
-        g.bounds0 = v4(m.bounds.center, m.bounds.radius);
+        g.center = v3(m.bounds.center);
+        g.radius = float(m.bounds.radius);
       } else {
-        g.bounds0 = v4(m.bounds.min, 0.0);
-        g.bounds1 = v4(m.bounds.max, 0.0);
+        g.box_min = v3(m.bounds.min);
+        g.box_max = v3(m.bounds.max);
       }
       out.has_emission = out.has_emission || max3(glm::dvec3(g.emission)) > 0.0;
     } else {
@@ -110,40 +113,46 @@ GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<Sto
         throw input_error(scene.file.string(), "media[" + std::to_string(i) + "]",
                           "at most " + std::to_string(gpu::MAX_GRIDS) + " vdb media per scene");
       const uint32_t slot = uint32_t(out.grids.size());
-      g.sigma_a = v4(m.sigma_a, gpu::SHAPE_GRID);
-      g.bounds0 = gpu::vec4(float(slot), 0.f, 0.f, 0.f);
+      g.sigma_a = v3(m.sigma_a);
+      g.shape = gpu::SHAPE_GRID;
+      g.grid_slot = slot;
 
       gpu::GpuGrid grid{};
       GpuGridSource src;
       src.medium = i;
       src.density = &v.density;
       texel_rows(v.density.grid, grid.density_row0, grid.density_row1, grid.density_row2);
-      grid.density_dims = v4(glm::dvec3(v.density.grid.dims), m.density_scale);
+      grid.density_dims = v3(glm::dvec3(v.density.grid.dims));
+      grid.density_scale = float(m.density_scale);
       if (m.emission.rgb) {
-        g.emission = v4(*m.emission.rgb * m.emission.scale, gpu::EMIT_CONSTANT);
+        g.emission = v3(*m.emission.rgb * m.emission.scale);
+        g.emission_mode = gpu::EMIT_CONSTANT;
       } else if (needs_temperature_grid(m) && v.temperature && !v.temperature->grid.empty()) {
-        g.emission = v4(glm::dvec3(m.emission.scale), gpu::EMIT_TEMPERATURE);
+        g.emission = v3(glm::dvec3(m.emission.scale));
+        g.emission_mode = gpu::EMIT_TEMPERATURE;
         src.temperature = &*v.temperature;
         texel_rows(v.temperature->grid, grid.temperature_row0, grid.temperature_row1, grid.temperature_row2);
-        grid.temperature_dims = v4(glm::dvec3(v.temperature->grid.dims), 0.0);
-        grid.temperature_map = gpu::vec4(float(m.temperature.offset), float(m.temperature.scale),
-                                         float(m.temperature.cutoff_k), 0.f);
+        grid.temperature_dims = v3(glm::dvec3(v.temperature->grid.dims));
+        grid.temperature_offset = float(m.temperature.offset);
+        grid.temperature_scale = float(m.temperature.scale);
+        grid.cutoff_k = float(m.temperature.cutoff_k);
         if (with_luts) src.blackbody.emplace(m.emission.blackbody, m.emission.observer, m.emission.adapt_to_k);
         color::BlackbodyLutParams p = src.blackbody ? src.blackbody->params() : color::BlackbodyLutParams{};
-        grid.blackbody_lut = gpu::vec4(p.log_scale, p.log_bias, p.t_min_k, 0.f);
+        set_blackbody_lut(grid, p);
       } else {
-        g.emission = gpu::vec4(0.f, 0.f, 0.f, float(gpu::EMIT_NONE));
+        g.emission_mode = gpu::EMIT_NONE;
       }
-      out.has_emission = out.has_emission || (g.emission.w != float(gpu::EMIT_NONE) && m.emission.scale > 0.0);
+      out.has_emission = out.has_emission || (g.emission_mode != gpu::EMIT_NONE && m.emission.scale > 0.0);
 
       // Majorant cells over the stored (rounded) density.
       glm::ivec3 res = scene.integrator.majorant == "global"
                            ? glm::ivec3(1)
                            : scene.integrator.majorant_grid.value_or(default_majorant_resolution(v.density.grid.dims));
       MajorantGrid mg = build_majorant_grid(v.density.grid, res);
-      grid.majorant_res = gpu::uvec4(uint32_t(mg.res.x), uint32_t(mg.res.y), uint32_t(mg.res.z),
-                                     uint32_t(out.majorants.size()));
-      grid.majorant_cell = v4(mg.cell_size, max3(m.sigma_a + m.sigma_s) * m.density_scale);
+      grid.majorant_res = gpu::uvec3(uint32_t(mg.res.x), uint32_t(mg.res.y), uint32_t(mg.res.z));
+      grid.majorant_offset = uint32_t(out.majorants.size());
+      grid.majorant_cell = v3(mg.cell_size);
+      grid.majorant_scale = float(max3(m.sigma_a + m.sigma_s) * m.density_scale);
       out.majorants.insert(out.majorants.end(), mg.max_density.begin(), mg.max_density.end());
       out.grids.push_back(grid);
       out.grid_sources.push_back(std::move(src));
@@ -166,6 +175,12 @@ GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<Sto
   return out;
 }
 
+void set_blackbody_lut(gpu::GpuGrid& grid, const color::BlackbodyLutParams& p) {
+  grid.lut_scale = p.log_scale;
+  grid.lut_offset = p.log_bias;
+  grid.t_min_k = p.t_min_k;
+}
+
 gpu::FrameConstants build_frame_constants(const Scene& scene, const RenderSettings& s, uint32_t medium_count) {
   const Camera& c = scene.camera;
   glm::dvec3 forward = glm::normalize(c.look_at - c.position);
@@ -173,13 +188,19 @@ gpu::FrameConstants build_frame_constants(const Scene& scene, const RenderSettin
   glm::dvec3 up = glm::cross(right, forward);
   double tan_half = std::tan(glm::radians(c.fov_deg) * 0.5);
   gpu::FrameConstants f{};
-  f.camera_position = v4(c.position, tan_half);
-  f.camera_forward = v4(forward, double(s.width) / double(s.height));
-  f.camera_right = v4(right, 0.0);
-  f.camera_up = v4(up, 0.0);
-  f.background = v4(scene.background, 0.0);
-  f.image = gpu::uvec4(uint32_t(s.width), uint32_t(s.height), medium_count, uint32_t(scene.integrator.max_depth));
-  f.sampling = gpu::uvec4(s.seed, s.frame, 0u, 0u);
+  f.camera_position = v3(c.position);
+  f.tan_half_fov = float(tan_half);
+  f.camera_forward = v3(forward);
+  f.aspect = float(double(s.width) / double(s.height));
+  f.camera_right = v3(right);
+  f.camera_up = v3(up);
+  f.background = v3(scene.background);
+  f.width = uint32_t(s.width);
+  f.height = uint32_t(s.height);
+  f.medium_count = medium_count;
+  f.max_depth = uint32_t(scene.integrator.max_depth);
+  f.seed = s.seed;
+  f.frame_index = s.frame;
   return f;
 }
 
@@ -192,29 +213,33 @@ std::vector<gpu::GpuLight> pack_gpu_lights(const Scene& scene, const LightSelect
     const Light& l = scene.lights[i];
     gpu::GpuLight g{};
     const glm::dvec3 value = l.type == Light::Type::Distant && !l.is_delta() ? disc_radiance(l) : light_value(l);
-    g.value = glm::vec4(glm::vec3(value), float(i < selection.p_light.size() ? selection.p_light[i] : 0.0));
-    g.direction = glm::vec4(glm::vec3(l.direction), 0.0f);
+    g.value = gpu::vec3(value);
+    g.pick_probability = float(i < selection.p_light.size() ? selection.p_light[i] : 0.0);
+    g.direction = gpu::vec3(l.direction);
     switch (l.type) {
       case Light::Type::Point:
-        g.kind.x = gpu::LIGHT_POINT;
-        g.position = glm::vec4(glm::vec3(l.position), 0.0f);
+        g.kind = gpu::LIGHT_POINT;
+        g.position = gpu::vec3(l.position);
         break;
       case Light::Type::Spot: {
-        g.kind.x = gpu::LIGHT_SPOT;
-        g.position = glm::vec4(glm::vec3(l.position), 0.0f);
+        g.kind = gpu::LIGHT_SPOT;
+        g.position = gpu::vec3(l.position);
         const SpotCone c = spot_cone(l);
-        g.cone = glm::vec4(float(c.cos_end), float(c.cos_start), 0.0f, 0.0f);
+        g.cos_cone = float(c.cos_end);
+        g.cos_falloff = float(c.cos_start);
         break;
       }
       case Light::Type::Distant: {
-        g.kind.x = l.is_delta() ? gpu::LIGHT_DISTANT : gpu::LIGHT_DISC;
+        g.kind = l.is_delta() ? gpu::LIGHT_DISTANT : gpu::LIGHT_DISC;
         const double s = std::sin(disc_half_angle(l));
-        g.cone = glm::vec4(0.0f, 0.0f, float(disc_one_minus_cos(l)), float(s * s));
+        g.one_minus_cos = float(disc_one_minus_cos(l));
+        g.sin2 = float(s * s);
         break;
       }
       case Light::Type::Sphere:
-        g.kind.x = gpu::LIGHT_SPHERE;
-        g.position = glm::vec4(glm::vec3(l.center), float(l.radius));
+        g.kind = gpu::LIGHT_SPHERE;
+        g.position = gpu::vec3(l.center);
+        g.radius = float(l.radius);
         break;
     }
     out.push_back(g);

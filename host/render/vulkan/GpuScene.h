@@ -26,7 +26,7 @@ struct GpuScene {
   std::vector<gpu::GpuMedium> media;
   std::vector<gpu::GpuGrid> grids;
   std::vector<GpuGridSource> grid_sources;  // per slot, same order as grids
-  std::vector<float> majorants;             // every grid's cells, at GpuGrid::majorant_res.w
+  std::vector<float> majorants;             // every grid's cells, at GpuGrid::majorant_offset
   bool has_grids = false, has_scattering = false, has_emission = false;
   bool has_analytic = false;  // a sphere or box medium
   // Every emitting grid's temperature goes into its density texture's second
@@ -60,6 +60,9 @@ DensityTemperatureTexels density_temperature_texels(const StoredGrid& density, c
 GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes,
                          bool with_luts = true,
                          uint64_t max_texture_bytes = std::numeric_limits<uint64_t>::max());
+// The grid's blackbody LUT coordinate map (GpuGrid lut_scale, lut_offset, t_min_k).
+void set_blackbody_lut(gpu::GpuGrid& grid, const color::BlackbodyLutParams& p);
+
 gpu::FrameConstants build_frame_constants(const Scene& scene, const RenderSettings& settings, uint32_t medium_count);
 
 }  // namespace pyrolume

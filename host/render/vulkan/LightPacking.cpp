@@ -7,9 +7,11 @@ namespace pyrolume {
 std::vector<gpu::GpuEmissionCluster> pack_gpu_emission_clusters(const EmissionCdf& cdf) {
   auto to_gpu = [](const EmissionCdf::Cluster& c) {
     gpu::GpuEmissionCluster g{};
-    g.sphere = gpu::vec4(float(c.centre.x), float(c.centre.y), float(c.centre.z), float(c.radius2));
-    g.power = gpu::vec4(float(c.power), 0.0f, 0.0f, 0.0f);
-    g.entries = gpu::uvec4(c.first, c.count, 0u, 0u);
+    g.center = gpu::vec3(float(c.centre.x), float(c.centre.y), float(c.centre.z));
+    g.radius_sq = float(c.radius2);
+    g.power = float(c.power);
+    g.first_entry = c.first;
+    g.entry_count = c.count;
     return g;
   };
   // The grid of clusters (looked up by cell), then copies of the nonempty
@@ -39,19 +41,31 @@ gpu::GpuEmissionCdf pack_gpu_emission_header(const EmissionCdf& cdf, uint32_t en
   g.cell_to_world_row1 = row(cell_to_world, 1);
   g.cell_to_world_row2 = row(cell_to_world, 2);
   const glm::ivec3 cells = cdf.cells(), dims = cdf.cluster_dims();
-  g.cells = gpu::uvec4(uint32_t(cells.x), uint32_t(cells.y), uint32_t(cells.z), uint32_t(cdf.entry_count()));
-  g.offsets = gpu::uvec4(entry_offset, pmf_offset, cluster_offset, uint32_t(cdf.nonempty_clusters()));
-  g.clusters = gpu::uvec4(uint32_t(dims.x), uint32_t(dims.y), uint32_t(dims.z), uint32_t(cdf.cluster_cells_per_axis()));
+  g.cells = gpu::uvec3(uint32_t(cells.x), uint32_t(cells.y), uint32_t(cells.z));
+  g.entry_count = uint32_t(cdf.entry_count());
+  g.first_entry = entry_offset;
+  g.first_cell = pmf_offset;
+  g.first_cluster = cluster_offset;
+  g.nonempty_clusters = uint32_t(cdf.nonempty_clusters());
+  g.clusters = gpu::uvec3(uint32_t(dims.x), uint32_t(dims.y), uint32_t(dims.z));
+  g.cluster_k = uint32_t(cdf.cluster_cells_per_axis());
   const double volume = cdf.cell_volume();
-  g.measure = gpu::vec4(float(volume), volume > 0.0 ? float(1.0 / volume) : 0.0f, float(cdf.power()), 0.0f);
+  g.cell_volume = float(volume);
+  g.inv_cell_volume = volume > 0.0 ? float(1.0 / volume) : 0.0f;
+  g.power = float(cdf.power());
   return g;
 }
 
 gpu::GpuEnvironment pack_gpu_environment_header(const EnvironmentMap& env) {
   gpu::GpuEnvironment g{};
-  g.transform = gpu::vec4(float(env.cos_rotation()), float(env.sin_rotation()), float(env.scale()), float(env.power()));
-  g.size = gpu::uvec4(uint32_t(env.width()), uint32_t(env.height()), env.has_distribution() ? 1u : 0u,
-                      env.zenith_y() ? 1u : 0u);
+  g.cos_rotation = float(env.cos_rotation());
+  g.sin_rotation = float(env.sin_rotation());
+  g.scale = float(env.scale());
+  g.power = float(env.power());
+  g.width = uint32_t(env.width());
+  g.height = uint32_t(env.height());
+  g.can_sample = env.has_distribution() ? 1u : 0u;
+  g.zenith_y = env.zenith_y() ? 1u : 0u;
   return g;
 }
 

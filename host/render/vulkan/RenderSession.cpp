@@ -245,7 +245,7 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
       }
     if (!src.blackbody) src.blackbody.emplace(e.blackbody, e.observer, e.adapt_to_k);
     const color::BlackbodyLutParams& p = src.blackbody->params();
-    gpu_scene.grids[slot].blackbody_lut = gpu::vec4(p.log_scale, p.log_bias, p.t_min_k, 0.f);
+    set_blackbody_lut(gpu_scene.grids[slot], p);
   }
   EmissionLights lights = build_emission_lights(scene, volumes, gpu_scene);
   if (spec_constants(scene, gpu_scene, settings, lights.selection) != spec_) return false;
@@ -435,7 +435,7 @@ RenderSession::EmissionLights RenderSession::build_emission_lights(
     const EmissionCdf& c = *by_medium[i];
     gpu::GpuEmissionCdf h = pack_gpu_emission_header(c, uint32_t(out.cdf.size()), uint32_t(out.pmf.size()),
                                                      uint32_t(out.clusters.size()));
-    h.measure.w = float(out.selection.p_medium[i]);
+    h.pick_probability = float(out.selection.p_medium[i]);
     out.headers[slot] = h;
     out.cdf.insert(out.cdf.end(), c.cluster_cdf().begin(), c.cluster_cdf().end());
     out.cells.insert(out.cells.end(), c.entry_cells().begin(), c.entry_cells().end());
@@ -459,13 +459,16 @@ void RenderSession::upload_emission_lights(const EmissionLights& lights) {
 void RenderSession::upload_constants(const Scene& scene) {
   GpuScene now = build_gpu_scene(scene, volumes_, /*with_luts=*/false);
   // Keep the LUT parameters of the baked textures (the mode is not editable live).
-  for (size_t i = 0; i < now.grids.size() && i < gpu_scene_.grids.size(); ++i)
-    now.grids[i].blackbody_lut = gpu_scene_.grids[i].blackbody_lut;
+  for (size_t i = 0; i < now.grids.size() && i < gpu_scene_.grids.size(); ++i) {
+    now.grids[i].lut_scale = gpu_scene_.grids[i].lut_scale;
+    now.grids[i].lut_offset = gpu_scene_.grids[i].lut_offset;
+    now.grids[i].t_min_k = gpu_scene_.grids[i].t_min_k;
+  }
   gpu::FrameConstants frame = build_frame_constants(scene, settings_, uint32_t(now.media.size()));
-  frame.lights.x = float(light_selection_.p_env);
-  frame.lights.y = float(light_selection_.p_continue_own);
-  frame.lights.z = float(light_selection_.surface_light_samples);
-  frame.lights.w = light_selection_.ratio_tracked_continuation ? 1.0f : 0.0f;
+  frame.p_env = float(light_selection_.p_env);
+  frame.p_continue_own = float(light_selection_.p_continue_own);
+  frame.surface_light_samples = uint32_t(light_selection_.surface_light_samples);
+  frame.ratio_tracked_continuation = light_selection_.ratio_tracked_continuation ? 1u : 0u;
   frame_buffer_.upload(ctx_, &frame, sizeof frame);
   if (!now.media.empty()) media_buffer_.upload(ctx_, now.media.data(), now.media.size() * sizeof(gpu::GpuMedium));
   if (!now.grids.empty()) grid_buffer_.upload(ctx_, now.grids.data(), now.grids.size() * sizeof(gpu::GpuGrid));
@@ -570,7 +573,7 @@ void RenderSession::create_wavefront(const std::vector<uint32_t>& code) {
 
 void RenderSession::record_wavefront_start(VkCommandBuffer cmd, const gpu::PassConstants& pass) {
   gpu::WavefrontQueues start{};
-  start.sizes.x = wavefront_capacity_;
+  start.capacity = wavefront_capacity_;
   vkCmdUpdateBuffer(cmd, wavefront_queues_.buffer(), 0, sizeof start, &start);
   vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
@@ -620,7 +623,7 @@ void RenderSession::record_wavefront_iterations(VkCommandBuffer cmd, int iterati
 uint32_t RenderSession::wavefront_paths_left() const {
   wavefront_queues_.invalidate();
   const gpu::WavefrontQueues* q = wavefront_queues_.data<gpu::WavefrontQueues>();
-  return (q->counts.w ^ 1u) == 0u ? q->counts.x : q->counts.y;
+  return (q->track_read ^ 1u) == 0u ? q->track_count0 : q->track_count1;
 }
 
 int RenderSession::first_band_rows(int spp) const {
@@ -716,7 +719,7 @@ bool RenderSession::run_pass(int spp, const std::atomic<bool>* cancel) {
         if (interrupted) break;
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         pass_status_.invalidate();
-        unfinished += pass_status_.data<gpu::PassStatus>()->counts.x;
+        unfinished += pass_status_.data<gpu::PassStatus>()->unfinished_samples;
         row += rows;
         // Dispatches long enough to hide their overhead, short enough that a
         // signal is answered at once and no GPU watchdog fires.
@@ -797,9 +800,9 @@ void RenderSession::result_from_state(const AccumulationState& state, RenderResu
       result.sum[i * 3 + c] = double(t.sum[c]) - double(t.sum_c[c]);
       result.sum_sq[i * 3 + c] = double(t.sum_sq[c]) - double(t.sum_sq_c[c]);
     }
-    result.events += double(t.sum.w) - double(t.sum_c.w);
-    result.density_lookups += double(t.sum_sq.w);
-    result.nonfinite_samples += uint64_t(t.sum_sq_c.w);
+    result.events += double(t.events) - double(t.events_c);
+    result.density_lookups += double(t.lookups);
+    result.nonfinite_samples += uint64_t(t.nonfinite);
   }
 }
 

@@ -1,0 +1,44 @@
+// A pass's samples into the pixel's accumulation (AccumTexel), Kahan-compensated.
+// One Kahan (1965) summation step: s − c carries the sum of the x's to about
+// twice float precision (`precise` stops the compiler reassociating). Used for
+// the samples within a pass (64 float additions lose up to ~2e-6 otherwise)
+// and for the passes in the accumulation buffer.
+void kahan_add(inout vec3 s, inout vec3 c, vec3 x) {
+  precise vec3 y = x - c;
+  precise vec3 t = s + y;
+  c = (t - s) - y;
+  s = t;
+}
+
+// One sample's radiance into the pass's sums (NaN and Inf fail the
+// comparison too: counted, and recorded as 0).
+void add_sample(vec3 L, inout vec3 pass_sum, inout vec3 pass_sum_c, inout vec3 pass_sq, inout vec3 pass_sq_c,
+                inout float nonfinite) {
+  if (!all(lessThanEqual(abs(L), vec3(MAX_SAMPLE_RADIANCE)))) {
+    nonfinite += 1.0;
+    L = vec3(0.0);
+  }
+  kahan_add(pass_sum, pass_sum_c, L);
+  kahan_add(pass_sq, pass_sq_c, L * L);
+}
+
+// A pass's sums into the pixel's accumulation, Kahan-compensated across passes.
+void add_pass(uint pixel_index, vec3 pass_sum, vec3 pass_sum_c, vec3 pass_sq, vec3 pass_sq_c, PathStats stats,
+              float nonfinite) {
+  AccumTexel a = accum[pixel_index];
+  precise vec4 y = vec4(pass_sum - pass_sum_c, stats.events) - vec4(a.sum_c, a.events_c);
+  precise vec4 s = vec4(a.sum, a.events) + y;
+  const vec4 c = (s - vec4(a.sum, a.events)) - y;
+  a.sum_c = c.xyz;
+  a.events_c = c.w;
+  a.sum = s.xyz;
+  a.events = s.w;
+  precise vec3 y2 = (pass_sq - pass_sq_c) - a.sum_sq_c;
+  precise vec3 s2 = a.sum_sq + y2;
+  a.sum_sq_c = (s2 - a.sum_sq) - y2;
+  a.sum_sq = s2;
+  a.lookups += stats.lookups;
+  a.nonfinite += nonfinite;
+  accum[pixel_index] = a;
+}
+

@@ -1,0 +1,215 @@
+// Media lookups (render.comp): density, temperature and blackbody textures,
+// the media's extent along a ray, the majorant grid's DDA, the coefficients and
+// the emission at a point.
+// Texture arrays are indexed with constants only (no dependence on
+// dynamically-uniform indexing, which lavapipe and older GPUs handle poorly).
+// With TEMPERATURE_IN_DENSITY, .y is the temperature grid's value (else 0).
+vec2 density_at(uint slot, vec3 tc) {
+  if (GRID_COUNT <= 1u) slot = 0u;
+  vec2 v;
+  switch (slot) {
+    case 0u: v = textureLod(density_tex[0], tc, 0.0).rg; break;
+    case 1u: v = textureLod(density_tex[1], tc, 0.0).rg; break;
+    case 2u: v = textureLod(density_tex[2], tc, 0.0).rg; break;
+    default: v = textureLod(density_tex[3], tc, 0.0).rg; break;
+  }
+  return TEMPERATURE_IN_DENSITY ? v : vec2(v.x, 0.0);
+}
+float temperature_at(uint slot, vec3 tc) {
+  if (GRID_COUNT <= 1u) slot = 0u;
+  switch (slot) {
+    case 0u: return textureLod(temperature_tex[0], tc, 0.0).r;
+    case 1u: return textureLod(temperature_tex[1], tc, 0.0).r;
+    case 2u: return textureLod(temperature_tex[2], tc, 0.0).r;
+    default: return textureLod(temperature_tex[3], tc, 0.0).r;
+  }
+}
+vec3 blackbody_at(uint slot, float s) {
+  if (GRID_COUNT <= 1u) slot = 0u;
+  switch (slot) {
+    case 0u: return textureLod(blackbody_tex[0], s, 0.0).rgb;
+    case 1u: return textureLod(blackbody_tex[1], s, 0.0).rgb;
+    case 2u: return textureLod(blackbody_tex[2], s, 0.0).rgb;
+    default: return textureLod(blackbody_tex[3], s, 0.0).rgb;
+  }
+}
+
+// Grid fields are read straight from the uniform block, and with at most one
+// texture the switch's other lookups compile out (docs/rendering.md "llvmpipe workarounds": no struct copies of
+// large uniforms; every branch runs).
+vec3 albedo_texture_at(uint slot, vec2 uv) {
+  if (ALBEDO_TEXTURE_COUNT <= 1u) return textureLod(albedo_tex[0], uv, 0.0).rgb;
+  switch (slot) {
+    case 0u: return textureLod(albedo_tex[0], uv, 0.0).rgb;
+    case 1u: return textureLod(albedo_tex[1], uv, 0.0).rgb;
+    case 2u: return textureLod(albedo_tex[2], uv, 0.0).rgb;
+    case 3u: return textureLod(albedo_tex[3], uv, 0.0).rgb;
+    case 4u: return textureLod(albedo_tex[4], uv, 0.0).rgb;
+    case 5u: return textureLod(albedo_tex[5], uv, 0.0).rgb;
+    case 6u: return textureLod(albedo_tex[6], uv, 0.0).rgb;
+    default: return textureLod(albedo_tex[7], uv, 0.0).rgb;
+  }
+}
+
+vec3 density_texel(uint slot, vec3 p) {
+  vec4 p1 = vec4(p, 1.0);
+  return vec3(dot(grids[slot].density_row0, p1), dot(grids[slot].density_row1, p1), dot(grids[slot].density_row2, p1));
+}
+vec3 density_texel_dir(uint slot, vec3 d) {
+  vec4 d0 = vec4(d, 0.0);
+  return vec3(dot(grids[slot].density_row0, d0), dot(grids[slot].density_row1, d0), dot(grids[slot].density_row2, d0));
+}
+
+// Emitted radiance Le of grid medium m at world point x (docs/scene-format.md "media": T = (v − offset)·scale,
+// no emission at or below cutoff_k; the LUT is uniform in ln T). With
+// TEMPERATURE_IN_DENSITY the grid's value v was read with the density at x.
+vec3 grid_le(GpuMedium m, uint slot, vec3 x, float value_read) {
+  uint mode = m.emission_mode;
+  if (mode == EMIT_CONSTANT) return m.emission;
+  if (mode != EMIT_TEMPERATURE) return vec3(0.0);
+  float value = value_read;
+  if (!TEMPERATURE_IN_DENSITY) {
+    vec4 p1 = vec4(x, 1.0);
+    vec3 u = vec3(dot(grids[slot].temperature_row0, p1), dot(grids[slot].temperature_row1, p1),
+                  dot(grids[slot].temperature_row2, p1));
+    value = temperature_at(slot, u / grids[slot].temperature_dims);
+  }
+  float T = (value - grids[slot].temperature_offset) * grids[slot].temperature_scale;
+  if (!(T > grids[slot].cutoff_k) || !(T >= grids[slot].t_min_k)) return vec3(0.0);
+  return m.emission * blackbody_at(slot, log(T) * grids[slot].lut_scale + grids[slot].lut_offset);
+}
+
+// The media's extent along a ray: [t_enter, t_exit], (-1,-1) when missed.
+void media_spans(vec3 o, vec3 d, out vec2 span[MEDIA_N], out bool any_hit) {
+  any_hit = false;
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+    GpuMedium m = media[i];
+    uint shape = m.shape;
+    vec2 t;
+    bool hit;
+    if (is_grid(m)) {
+      // The texel box [0, dims] in texel space; t is the same there (affine map).
+      uint slot = m.grid_slot;
+      // Clip to the trilinear support, between the zero padding texels' centres
+      // (u = 0.5 .. dims − 0.5): outside it every lookup is 0, and a dense grid's
+      // majorant there would only buy null collisions.
+      hit = intersect_box(density_texel(slot, o), density_texel_dir(slot, d), vec3(0.5),
+                          grids[slot].density_dims - 0.5, t);
+    } else if (shape == SHAPE_SPHERE) {
+      hit = intersect_sphere(o, d, m.center, m.radius, t);
+    } else {
+      hit = intersect_box(o, d, m.box_min, m.box_max, t);
+    }
+    span[i] = hit ? t : vec2(-1.0);
+    any_hit = any_hit || hit;
+  }
+}
+
+// Majorant of grid medium m over the DDA cell the ray is in at t, and the t at
+// which the ray leaves that cell. Stateless: the cell is found at t + a small
+// nudge along the ray, so a point on a face belongs to the cell being entered.
+float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, float t_span_end, inout float t_next) {
+  uint slot = m.grid_slot;
+  vec3 u = density_texel(slot, o + t * d);
+  vec3 du = density_texel_dir(slot, d);
+  vec3 cs = grids[slot].majorant_cell;
+  const uint offset = grids[slot].majorant_offset;
+  vec3 inv_du = 1.0 / du;
+  float nudge = 1e-4 * min3(cs) / max(max3(abs(du)), 1e-30);
+  // At least a few float ulps of t, so t always moves on (a far camera loses
+  // precision in u; see also the origin shift in path_begin).
+  float min_step = max(nudge, abs(t) * 1e-6);
+  ivec3 res = ivec3(grids[slot].majorant_res);
+  ivec3 cell = clamp(ivec3(floor((u + du * nudge) / cs)), ivec3(0), res - 1);
+  vec3 bound = (vec3(cell) + step(vec3(0.0), du)) * cs;
+  vec3 tx = (bound - u) * inv_du;  // ±inf on axes the ray runs parallel to
+  vec3 t_axis = t + mix(tx, vec3(INF), isnan(tx));  // where the ray crosses each axis' next face
+  uint index = offset + uint((cell.z * res.y + cell.y) * res.x + cell.x);
+  float majorant = majorants[index];
+  if (majorant > 0.0) {
+    t_next = min(t_next, max(min3(t_axis), t + min_step));
+    return majorant * grids[slot].majorant_scale;
+  }
+  // An empty cell: walk the DDA on to the first non-empty cell (or out of the
+  // grid) right here, so a run of empty cells costs one tracking step.
+  vec3 t_delta = abs(cs * inv_du);
+  ivec3 dir = ivec3(sign(du));
+  float t_enter = min3(t_axis);
+  for (uint n = 0u; n < 256u && t_enter < t_span_end; ++n) {
+    int a = t_axis.x <= t_axis.y ? (t_axis.x <= t_axis.z ? 0 : 2) : (t_axis.y <= t_axis.z ? 1 : 2);
+    cell[a] += dir[a];
+    if (cell[a] < 0 || cell[a] >= res[a]) {
+      t_enter = INF;  // left the grid: empty up to the span's end
+      break;
+    }
+    t_axis[a] += t_delta[a];
+    index = offset + uint((cell.z * res.y + cell.y) * res.x + cell.x);
+    if (majorants[index] > 0.0) break;
+    t_enter = min3(t_axis);
+  }
+  t_next = min(t_next, max(t_enter, t + min_step));
+  return 0.0;
+}
+
+// Media coefficients at a tentative collision; rho[i] keeps each grid's
+// density_scale · density for the scattering-lobe choice, and
+// temperature_value[i] its temperature grid's value where the density lookup
+// reads it (TEMPERATURE_IN_DENSITY; else 0).
+void coefficients_at(vec3 x, float t, vec2 span[MEDIA_N], out vec3 sigma_a, out vec3 sigma_s, out float rho[MEDIA_N],
+                     out float temperature_value[MEDIA_N], inout PathStats stats) {
+  sigma_a = vec3(0.0);
+  sigma_s = vec3(0.0);
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+    rho[i] = 0.0;
+    temperature_value[i] = 0.0;
+    if (!(span[i].x <= t && t < span[i].y)) continue;
+    GpuMedium m = media[i];
+    float r = 1.0;
+    if (is_grid(m)) {
+      uint slot = m.grid_slot;
+      const vec2 v = density_at(slot, density_texel(slot, x) / grids[slot].density_dims);
+      r = grids[slot].density_scale * v.x;
+      temperature_value[i] = v.y;
+      stats.lookups += 1.0;
+    }
+    rho[i] = r;
+    sigma_a += r * m.sigma_a;
+    sigma_s += r * m.sigma_s;
+  }
+}
+
+// Emitted power per unit length, Σ sigma_a_i(x)·Le_i(x), over the media at t.
+vec3 emission_at(vec3 x, float t, vec2 span[MEDIA_N], float rho[MEDIA_N], float temperature_value[MEDIA_N]) {
+  vec3 E = vec3(0.0);
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+    if (!(span[i].x <= t && t < span[i].y)) continue;
+    GpuMedium m = media[i];
+    if (is_grid(m)) {
+      if (rho[i] > 0.0) E += rho[i] * m.sigma_a * grid_le(m, m.grid_slot, x, temperature_value[i]);
+    } else {
+      E += m.emission;
+    }
+  }
+  return E;
+}
+
+// Local majorant over [t, t_next): sum over the media present of their bound.
+float majorant_at(vec3 o, vec3 d, float t, vec2 span[MEDIA_N], out float t_next, out bool any_ahead) {
+  float sigma_bar = 0.0;
+  t_next = INF;
+  any_ahead = false;
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+    vec2 s = span[i];
+    if (s.y <= t) continue;
+    any_ahead = true;
+    if (s.x > t) {
+      t_next = min(t_next, s.x);
+      continue;
+    }
+    t_next = min(t_next, s.y);
+    GpuMedium m = media[i];
+    if (is_grid(m)) sigma_bar += grid_majorant(m, o, d, t, s.y, t_next);
+    else sigma_bar += max3(m.sigma_a + m.sigma_s);
+  }
+  return sigma_bar;
+}
