@@ -131,7 +131,7 @@ void camera_path(uvec2 pixel, uint k, out uint rng, inout PathState p) {
   p.survival = 1.0;
   p.light_ray = false;
   p.light_T = 1.0;
-  p.continuation_ray = 0u;
+  p.continuation_ray = CONTINUATION_PLAIN;
   p.skip_segment = false;
   p.next_ends = true;
   p.next_o = p.next_d = p.next_w = vec3(0.0);

@@ -1,7 +1,15 @@
 // One path's state between tracking steps and its transitions between rays
-// (camera ray, light rays, continuation): render.comp's state machine.
-// One path's state between tracking steps (see main: paths are regenerated
-// within a lane, so the state must live outside any per-path loop).
+// (camera ray, light rays, continuation): render.comp's state machine. Paths
+// are regenerated within a lane, so the state lives outside any per-path loop.
+
+// PathState.continuation_ray (docs/mis.md "Ratio-tracked continuation"):
+// the vertex's continuation is an ordinary ray (PLAIN); a light ray along it
+// is still to come (PENDING); that light ray is running, so the continuation
+// then collects nothing on its first segment (TRACKING, skip_segment).
+const uint CONTINUATION_PLAIN = 0u;
+const uint CONTINUATION_PENDING = 1u;
+const uint CONTINUATION_TRACKING = 2u;
+
 struct PathState {
   vec3 o, d;   // current ray
   vec3 w;      // path weight (per channel)
@@ -27,14 +35,13 @@ struct PathState {
   // event) per path_step like any other ray (docs/rendering.md: divergence).
   // The path's phase, as flags (one uint was slower: docs/benchmarks.md "The
   // path's phase as one value"): a camera or continuation ray (!light_ray);
-  // a light ray (light_ray, continuation_ray < 2); the ratio-tracked
-  // continuation's first segment (light_ray, continuation_ray 2); the
-  // vertex's next light ray still to draw (light_pending).
+  // a light ray (light_ray, continuation_ray != CONTINUATION_TRACKING); the
+  // ratio-tracked continuation's first segment (light_ray,
+  // CONTINUATION_TRACKING); the vertex's next light ray still to draw
+  // (light_pending).
   bool light_ray;
   float light_T;  // a light ray's ratio-tracking transmittance (max channel) since its last roulette
-  // Ratio-tracked continuation (docs/mis.md): 1 while the surface vertex's
-  // ray along the continuation is still to come, 2 once it has run; the
-  // continuation then collects nothing on its first segment (skip_segment).
+  // Ratio-tracked continuation (docs/mis.md): CONTINUATION_* below.
   uint continuation_ray;
   bool skip_segment;
   bool next_ends;  // the continuation has no weight or depth left
@@ -99,8 +106,8 @@ bool hand_over(inout PathState p) {
     p.light_ray = false;
     return true;
   }
-  if (p.continuation_ray == 1u) {
-    p.continuation_ray = 2u;
+  if (p.continuation_ray == CONTINUATION_PENDING) {
+    p.continuation_ray = CONTINUATION_TRACKING;
     p.w = p.next_w * unidirectional_weight(p.next_pdf_dir, p.next_p_light);
     new_ray(p, p.next_o, p.next_d, 0.0, 0.0);
     return false;
@@ -108,8 +115,8 @@ bool hand_over(inout PathState p) {
   p.light_ray = false;
   p.w = p.next_w;
   new_ray(p, p.next_o, p.next_d, p.next_pdf_dir, p.next_p_light);
-  p.skip_segment = p.continuation_ray == 2u;
-  p.continuation_ray = 0u;
+  p.skip_segment = p.continuation_ray == CONTINUATION_TRACKING;
+  p.continuation_ray = CONTINUATION_PLAIN;
   return false;
 }
 

@@ -82,7 +82,8 @@ bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 f, float pdf_own, uint
   p.next_p_light = n * p_light_d;
   p.lights_left = lights_after;
   // The ratio-tracked continuation: surface vertices only.
-  p.continuation_ray = frame.ratio_tracked_continuation != 0u && lights_after > 0u && !p.vertex_medium ? 1u : 0u;
+  p.continuation_ray = frame.ratio_tracked_continuation != 0u && lights_after > 0u && !p.vertex_medium
+                         ? CONTINUATION_PENDING : CONTINUATION_PLAIN;
   p.light_ray = true;
   return ray_ends(p);  // the first light ray, or the continuation
 }
