@@ -273,9 +273,17 @@ void report_counts(const DenseBuilder& b, const std::string& file, Role role, co
                        " negative density voxels clamped to 0");
 }
 
-void warn_empty(const std::string& file, Role role, const std::string& grid, std::vector<std::string>& warnings) {
-  warnings.push_back(file + ": " + role_key(role, grid) + ": empty grid (no active voxels): " +
+// A grid with no active voxels: no texels, only its index maps, and a warning.
+DenseGrid empty_grid(std::string name, const glm::dmat4& grid_to_world, const VolumeOptions& m, Role role,
+                     const std::string& file, std::vector<std::string>& warnings) {
+  DenseGrid out;
+  out.name = std::move(name);
+  out.index_to_world = m.transform * grid_to_world;
+  out.world_to_index = glm::inverse(out.index_to_world);
+  check_index_maps(out, file, role);
+  warnings.push_back(file + ": " + role_key(role, out.name) + ": empty grid (no active voxels): " +
                      (role == Role::Density ? "renders as no medium" : "the medium does not emit"));
+  return out;
 }
 
 // ---- OpenVDB ----
@@ -287,13 +295,7 @@ DenseGrid dense_from_openvdb(const GridT& grid, const VolumeOptions& m, Role rol
   out.name = grid.getName();
   const glm::dmat4 grid_to_world = openvdb_index_to_world(grid.transform(), file, out.name);
   const openvdb::CoordBBox bbox = grid.evalActiveVoxelBoundingBox();
-  if (grid.activeVoxelCount() == 0 || bbox.empty()) {
-    out.index_to_world = m.transform * grid_to_world;
-    out.world_to_index = glm::inverse(out.index_to_world);
-    check_index_maps(out, file, role);
-    warn_empty(file, role, out.name, warnings);
-    return out;
-  }
+  if (grid.activeVoxelCount() == 0 || bbox.empty()) return empty_grid(out.name, grid_to_world, m, role, file, warnings);
   const auto& lo = bbox.min();
   const auto& hi = bbox.max();
   DenseBuilder b(out, {lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}, m.downsample, role == Role::Density, file,
@@ -384,13 +386,7 @@ DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Volume
   out.name = grid.gridName();
   const glm::dmat4 grid_to_world = nanovdb_index_to_world(grid);
   const auto& bbox = grid.indexBBox();  // bbox of the active values
-  if (grid.activeVoxelCount() == 0 || bbox.empty()) {
-    out.index_to_world = m.transform * grid_to_world;
-    out.world_to_index = glm::inverse(out.index_to_world);
-    check_index_maps(out, file, role);
-    warn_empty(file, role, out.name, warnings);
-    return out;
-  }
+  if (grid.activeVoxelCount() == 0 || bbox.empty()) return empty_grid(out.name, grid_to_world, m, role, file, warnings);
   DenseBuilder b(out, {bbox.min()[0], bbox.min()[1], bbox.min()[2]}, {bbox.max()[0], bbox.max()[1], bbox.max()[2]},
                  m.downsample, role == Role::Density, file, role, limits);
   auto acc = grid.getAccessor();

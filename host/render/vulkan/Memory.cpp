@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 namespace pyrolume::vk {
@@ -75,6 +76,21 @@ Allocation allocate(Context& ctx, const VkMemoryRequirements& req, MemoryKind ki
   return a;
 }
 
+// Memory for a new buffer or image, bound to it at offset 0.
+template <class Handle>
+Allocation bind_memory(Context& ctx, Handle handle, MemoryKind kind, const char* name) {
+  constexpr bool buffer = std::is_same_v<Handle, VkBuffer>;
+  VkMemoryRequirements req;
+  if constexpr (buffer) vkGetBufferMemoryRequirements(ctx.device(), handle, &req);
+  else vkGetImageMemoryRequirements(ctx.device(), handle, &req);
+  Allocation a = allocate(ctx, req, kind, name);
+  VkResult r;
+  if constexpr (buffer) r = vkBindBufferMemory(ctx.device(), handle, a.memory.get(), 0);
+  else r = vkBindImageMemory(ctx.device(), handle, a.memory.get(), 0);
+  VK_CHECK(r);
+  return a;
+}
+
 }  // namespace
 
 int find_memory_type(const VkPhysicalDeviceMemoryProperties& props, uint32_t type_bits, MemoryKind kind) {
@@ -112,11 +128,8 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
   VK_CHECK(vkCreateBuffer(device_, &bci, nullptr, &buf));
   buffer_ = UniqueBuffer(buf, {device_});
   ctx.set_name(buf, name);
-  VkMemoryRequirements req;
-  vkGetBufferMemoryRequirements(device_, buf, &req);
-  Allocation a = allocate(ctx, req, kind, name);
+  Allocation a = bind_memory(ctx, buf, kind, name);
   memory_ = std::move(a.memory);
-  VK_CHECK(vkBindBufferMemory(device_, buf, memory_.get(), 0));
   if (a.flags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) {
     VK_CHECK(vkMapMemory(device_, memory_.get(), 0, VK_WHOLE_SIZE, 0, &mapped_));
     coherent_ = (a.flags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
@@ -290,10 +303,7 @@ SampledImage::SampledImage(Context& ctx, VkImageType type, VkExtent3D extent, Vk
   VK_CHECK(vkCreateImage(dev, &ici, nullptr, &img));
   image_ = UniqueImage(img, {dev});
   ctx.set_name(img, name);
-  VkMemoryRequirements req;
-  vkGetImageMemoryRequirements(dev, img, &req);
-  memory_ = allocate(ctx, req, MemoryKind::DeviceLocal, name).memory;
-  VK_CHECK(vkBindImageMemory(dev, img, memory_.get(), 0));
+  memory_ = bind_memory(ctx, img, MemoryKind::DeviceLocal, name).memory;
 
   VkImageViewCreateInfo vci{.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
   vci.image = img;
