@@ -10,21 +10,24 @@ void kahan_add(inout vec3 s, inout vec3 c, vec3 x) {
   s = t;
 }
 
-// One sample's radiance into the pass's sums (NaN and Inf fail the
-// comparison too: counted, and recorded as 0).
-void add_sample(vec3 L, inout vec3 pass_sum, inout vec3 pass_sum_c, inout vec3 pass_sq, inout vec3 pass_sq_c,
-                inout float nonfinite) {
+// One sample's radiance and alpha into the pass's sums (NaN and Inf fail the
+// comparison too: counted, and recorded as 0; alpha as 1). The pass's alpha
+// sums (Σα, Σα²) are plain: α is at most ~1 and a pass is short.
+void add_sample(vec3 L, float alpha, inout vec3 pass_sum, inout vec3 pass_sum_c, inout vec3 pass_sq,
+                inout vec3 pass_sq_c, inout vec2 pass_alpha, inout float nonfinite) {
   if (!all(lessThanEqual(abs(L), vec3(MAX_SAMPLE_RADIANCE)))) {
     nonfinite += 1.0;
     L = vec3(0.0);
   }
+  if (!(abs(alpha) <= MAX_SAMPLE_RADIANCE)) alpha = 1.0;
   kahan_add(pass_sum, pass_sum_c, L);
   kahan_add(pass_sq, pass_sq_c, L * L);
+  pass_alpha += vec2(alpha, alpha * alpha);
 }
 
 // A pass's sums into the pixel's accumulation, Kahan-compensated across passes.
-void add_pass(uint pixel_index, vec3 pass_sum, vec3 pass_sum_c, vec3 pass_sq, vec3 pass_sq_c, PathStats stats,
-              float nonfinite) {
+void add_pass(uint pixel_index, vec3 pass_sum, vec3 pass_sum_c, vec3 pass_sq, vec3 pass_sq_c, vec2 pass_alpha,
+              PathStats stats, float nonfinite) {
   AccumTexel a = accum[pixel_index];
   precise vec4 y = vec4(pass_sum - pass_sum_c, stats.events) - vec4(a.sum_c, a.events_c);
   precise vec4 s = vec4(a.sum, a.events) + y;
@@ -37,6 +40,13 @@ void add_pass(uint pixel_index, vec3 pass_sum, vec3 pass_sum_c, vec3 pass_sq, ve
   precise vec3 s2 = a.sum_sq + y2;
   a.sum_sq_c = (s2 - a.sum_sq) - y2;
   a.sum_sq = s2;
+  precise vec2 ya = pass_alpha - vec2(a.alpha_sum_c, a.alpha_sq_c);
+  precise vec2 sa = vec2(a.alpha_sum, a.alpha_sq) + ya;
+  const vec2 ca = (sa - vec2(a.alpha_sum, a.alpha_sq)) - ya;
+  a.alpha_sum_c = ca.x;
+  a.alpha_sq_c = ca.y;
+  a.alpha_sum = sa.x;
+  a.alpha_sq = sa.y;
   a.lookups += stats.lookups;
   a.nonfinite += nonfinite;
   accum[pixel_index] = a;

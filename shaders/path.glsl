@@ -122,6 +122,7 @@ void camera_path(uvec2 pixel, uint k, out uint rng, inout PathState p) {
   p.d = d;
   p.w = vec3(1.0);
   p.L = vec3(0.0);
+  p.alpha = 1.0;
   p.t = 0.0;
   p.depth = 0u;
   p.fresh = true;

@@ -14,6 +14,9 @@ struct PathState {
   vec3 o, d;   // current ray
   vec3 w;      // path weight (per channel)
   vec3 L;      // radiance gathered so far
+  // This sample's alpha (docs/compositing.md "Alpha"): 1 unless the camera ray
+  // escapes, then 1 − avg(w), w its delta-tracking weight (E[w·escaped] = T).
+  float alpha;
   float t;     // distance along the current ray
   uint depth;  // scattering events (medium and surface) so far
   bool fresh;  // the ray changed: recompute the media spans and the surface hit
@@ -81,6 +84,10 @@ void escape(inout PathState p) {
   if (LIGHT_COUNT > 0u && p.delta_light < LIGHT_COUNT) {
     if (analytic_lights[p.delta_light].kind == LIGHT_DISTANT) p.L += p.w;
     return;
+  }
+  if (p.depth == 0u) {  // the camera ray (light rays start at vertices, after depth counts them)
+    p.alpha = 1.0 - avg3(p.w);
+    if (frame.transparent != 0u) return;  // the plate shows there: no background
   }
   if (!p.skip_segment) p.L += unidirectional_weight(p.pdf_dir, p.p_light) * p.w * escaped_radiance(p.d);
 }

@@ -40,6 +40,7 @@ void main() {
 
   vec3 pass_sum = vec3(0.0), pass_sq = vec3(0.0);
   vec3 pass_sum_c = vec3(0.0), pass_sq_c = vec3(0.0);  // their Kahan compensations
+  vec2 pass_alpha = vec2(0.0);                          // Σα, Σα²
   PathStats stats = PathStats(0.0, 0.0);
   float nonfinite = 0.0;
   const uint first = pass_constants.sample_offset, last = first + pass_constants.spp;
@@ -52,6 +53,7 @@ void main() {
       vec3 T = transmittance(p.o, p.d, DEBUG_MODE == DEBUG_RATIO_TRACKING, rng, stats);
       pass_sum += T;
       pass_sq += T * T;
+      pass_alpha += vec2(1.0 - avg3(T), (1.0 - avg3(T)) * (1.0 - avg3(T)));
     }
   } else {
     // Paths are regenerated within the lane: one loop iteration is one tracking
@@ -71,7 +73,7 @@ void main() {
     while (k < last) {
       for (uint n = 0u; n < 16384u && k < last; ++n) {
         if (!path_step(p, span, rng, stats)) continue;
-        add_sample(p.L, pass_sum, pass_sum_c, pass_sq, pass_sq_c, nonfinite);
+        add_sample(p.L, p.alpha, pass_sum, pass_sum_c, pass_sq, pass_sq_c, pass_alpha, nonfinite);
         if (++k < last) camera_path(pixel, k, rng, p);
       }
     }
@@ -82,5 +84,5 @@ void main() {
     return;
   }
 
-  add_pass(pixel_index, pass_sum, pass_sum_c, pass_sq, pass_sq_c, stats, nonfinite);
+  add_pass(pixel_index, pass_sum, pass_sum_c, pass_sq, pass_sq_c, pass_alpha, stats, nonfinite);
 }

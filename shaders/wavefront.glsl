@@ -43,6 +43,7 @@ struct SlotState {
   uint event;
   Collision c;
   vec3 sum, sum_c, sq, sq_c;
+  vec2 alpha;  // Σα, Σα²
   float nonfinite;
   PathStats stats;
 };
@@ -96,10 +97,11 @@ void path_io(bool store, bool everything, uint slot, inout PathState p, inout Sl
   s.pending = u.w;
   io_v3u(store, base + 6u, s.c.x, s.event);
   io_v3f(store, base + 7u, s.c.sigma_s, s.c.sigma_bar);
-  u = uvec4(floatBitsToUint(s.c.p_a), floatBitsToUint(s.c.p_s), 0u, 0u);
+  u = uvec4(floatBitsToUint(s.c.p_a), floatBitsToUint(s.c.p_s), floatBitsToUint(p.alpha), 0u);
   io(store, base + 8u, u);
   s.c.p_a = uintBitsToFloat(u.x);
   s.c.p_s = uintBitsToFloat(u.y);
+  p.alpha = uintBitsToFloat(u.z);
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     const uint m = base + WAVEFRONT_PATH_WORDS + i * WAVEFRONT_PATH_WORDS_PER_MEDIUM;
     vec4 f = vec4(span[i], rho[i], temperature_value[i]);
@@ -134,9 +136,8 @@ void path_io(bool store, bool everything, uint slot, inout PathState p, inout Sl
   io_v3b(store, base + 17u, p.vertex_d_in, p.vertex_medium);
   io_v3u(store, base + 18u, s.sum, s.k);
   io_v3f(store, base + 19u, s.sum_c, s.nonfinite);
-  float unused = 0.0;
-  io_v3f(store, base + 20u, s.sq, unused);
-  io_v3f(store, base + 21u, s.sq_c, unused);
+  io_v3f(store, base + 20u, s.sq, s.alpha.x);
+  io_v3f(store, base + 21u, s.sq_c, s.alpha.y);
 }
 
 // Append slot to queue q (0, 1: track queues; EVENT_QUEUE; BEGIN_QUEUE).
@@ -163,7 +164,7 @@ bool settle(uvec2 pixel, inout PathState p, inout SlotState s, inout vec2 span[M
   const uint last = pass_constants.sample_offset + pass_constants.spp;
   for (uint n = 0u; n < 4u; ++n) {
     if (ended) {
-      add_sample(p.L, s.sum, s.sum_c, s.sq, s.sq_c, s.nonfinite);
+      add_sample(p.L, p.alpha, s.sum, s.sum_c, s.sq, s.sq_c, s.alpha, s.nonfinite);
       if (++s.k >= last) return false;
       camera_path(pixel, s.k, s.rng, p);
     }
@@ -180,7 +181,7 @@ bool settle(uvec2 pixel, inout PathState p, inout SlotState s, inout vec2 span[M
 
 void finish_slot(uint slot, SlotState s) {
   const uvec2 pixel = slot_pixel(slot);
-  add_pass(pixel.y * frame.width + pixel.x, s.sum, s.sum_c, s.sq, s.sq_c, s.stats, s.nonfinite);
+  add_pass(pixel.y * frame.width + pixel.x, s.sum, s.sum_c, s.sq, s.sq_c, s.alpha, s.stats, s.nonfinite);
 }
 
 void wavefront_main() {
@@ -220,6 +221,7 @@ void wavefront_main() {
     const uint slot = (pixel.y - pass_constants.row_begin) * frame.width + pixel.x;
     s.k = pass_constants.sample_offset;
     s.sum = s.sum_c = s.sq = s.sq_c = vec3(0.0);
+    s.alpha = vec2(0.0);
     s.nonfinite = 0.0;
     s.stats = PathStats(0.0, 0.0);
     s.event = EVENT_NONE;

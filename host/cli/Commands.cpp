@@ -245,7 +245,8 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
                 << " spp; that frame is not written (rerun with --skip-existing to resume)\n";
       break;
     }
-    const Image image = image_from_render(result, args.variance);
+    Image image = image_from_render(result, args.variance);
+    image.transparent = frame_scene.film.transparent;
     const double stops = exposure.stops(frame_scene.film, image, display_log(out.image));
     {
       OutputCommit both;  // the image and its stats, or neither
@@ -385,6 +386,7 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   DisplayExposure exposure(parse_exposure(args.exposure));
   auto save = [&](const RenderResult& result, bool keep_checkpoint) {
     Image image = image_from_render(result, args.variance);
+    image.transparent = scene.film.transparent;
     const double stops = exposure.stops(scene.film, image, display_log(output));
     {
       OutputCommit both;  // the image and the stats, or neither

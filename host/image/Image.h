@@ -17,6 +17,11 @@ struct Image {
   // for (less when it was interrupted). EXR attributes "spp" and "spp_target";
   // 0 = unknown (not a render, or a format without metadata).
   int spp = 0, spp_target = 0;
+  // Empty, or width*height alpha values (EXR channel A, premultiplied: RGB
+  // already holds coverage; docs/compositing.md "Alpha").
+  std::vector<float> alpha;
+  // PNG carries alpha too (film.transparent), as straight alpha.
+  bool transparent = false;
 
   size_t pixel_count() const { return size_t(width) * size_t(height); }
   size_t index(int x, int y, int c) const { return (size_t(y) * size_t(width) + size_t(x)) * 3 + size_t(c); }
@@ -25,6 +30,7 @@ struct Image {
   float& var_at(int x, int y, int c) { return variance[index(x, y, c)]; }
   float var_at(int x, int y, int c) const { return variance[index(x, y, c)]; }
   bool has_variance() const { return !variance.empty(); }
+  bool has_alpha() const { return !alpha.empty(); }
 };
 
 // A black width×height image; with_variance also allocates zeroed variance.

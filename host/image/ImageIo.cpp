@@ -91,6 +91,7 @@ void write_exr(std::ostream& os, const Image& img) {
   for (const char* n : names) header.channels().insert(n, Imf::Channel(Imf::FLOAT));
   if (img.has_variance())
     for (const char* n : var_names) header.channels().insert(n, Imf::Channel(Imf::FLOAT));
+  if (img.has_alpha()) header.channels().insert("A", Imf::Channel(Imf::FLOAT));
 
   Imf::FrameBuffer fb;
   const size_t xs = 3 * sizeof(float), ys = xs * size_t(img.width);
@@ -99,16 +100,36 @@ void write_exr(std::ostream& os, const Image& img) {
     if (img.has_variance())
       fb.insert(var_names[c], Imf::Slice(Imf::FLOAT, (char*)(img.variance.data() + c), xs, ys));
   }
+  if (img.has_alpha())
+    fb.insert("A", Imf::Slice(Imf::FLOAT, (char*)img.alpha.data(), sizeof(float), sizeof(float) * size_t(img.width)));
   StdOStreamAdaptor stream(os);
   Imf::OutputFile out(stream, header);
   out.setFrameBuffer(fb);
   out.writePixels(img.height);
 }
 
+// With film.transparent, RGBA with straight alpha, as PNG defines it: the
+// colour is RGB/A through the view transform (0 where A is 0).
 void write_png(std::ostream& os, const Image& img, double exposure_stops, ViewTransform view) {
-  const std::vector<unsigned char> bytes = display_rgb8(img, exposure_stops, view);
   auto sink = [](void* ctx, void* data, int size) { static_cast<std::ostream*>(ctx)->write((const char*)data, size); };
-  if (!stbi_write_png_to_func(sink, &os, img.width, img.height, 3, bytes.data(), img.width * 3))
+  if (!(img.transparent && img.has_alpha())) {
+    const std::vector<unsigned char> bytes = display_rgb8(img, exposure_stops, view);
+    if (!stbi_write_png_to_func(sink, &os, img.width, img.height, 3, bytes.data(), img.width * 3))
+      throw std::runtime_error("PNG encoding failed");
+    return;
+  }
+  Image straight = make_image(img.width, img.height);
+  for (size_t i = 0; i < img.pixel_count(); ++i) {
+    const float a = img.alpha[i];
+    for (int c = 0; c < 3; ++c) straight.rgb[i * 3 + c] = a > 1e-6f ? img.rgb[i * 3 + c] / a : 0.0f;
+  }
+  const std::vector<unsigned char> rgb = display_rgb8(straight, exposure_stops, view);
+  std::vector<unsigned char> rgba(img.pixel_count() * 4);
+  for (size_t i = 0; i < img.pixel_count(); ++i) {
+    for (int c = 0; c < 3; ++c) rgba[i * 4 + c] = rgb[i * 3 + c];
+    rgba[i * 4 + 3] = (unsigned char)std::lround(std::clamp(img.alpha[i], 0.0f, 1.0f) * 255.0f);
+  }
+  if (!stbi_write_png_to_func(sink, &os, img.width, img.height, 4, rgba.data(), img.width * 4))
     throw std::runtime_error("PNG encoding failed");
 }
 
@@ -260,6 +281,7 @@ Image read_exr(const fs::path& file, const std::vector<unsigned char>& bytes) {
 
   const char* names[3] = {"R", "G", "B"};
   const char* var_names[3] = {"variance.R", "variance.G", "variance.B"};
+  const bool alpha = has("A");
   bool rgb_any = has("R") || has("G") || has("B");
   bool gray = !rgb_any && has("Y");
   if (!rgb_any && !gray) throw input_error(file.string(), "", "EXR has no R, G, B or Y channel");
@@ -276,13 +298,14 @@ Image read_exr(const fs::path& file, const std::vector<unsigned char>& bytes) {
   img.width = dw.max.x - dw.min.x + 1;
   img.height = dw.max.y - dw.min.y + 1;
   require_memory(file.string(), "", std::to_string(img.width) + " x " + std::to_string(img.height) + " pixels",
-                 uint64_t(img.width) * uint64_t(img.height) * 3 * sizeof(float) * (var_count == 3 ? 2 : 1));
+                 uint64_t(img.width) * uint64_t(img.height) * sizeof(float) * ((var_count == 3 ? 6 : 3) + (alpha ? 1 : 0)));
   const size_t row_floats = size_t(img.width) * 3, xs = 3 * sizeof(float), ys = xs * size_t(img.width);
   const int rows_per_block = int(std::max<size_t>(1, (size_t(16) << 20) / ys));
   for (int y0 = 0; y0 < img.height; y0 += rows_per_block) {
     const int rows = std::min(rows_per_block, img.height - y0);
     img.rgb.resize(size_t(y0 + rows) * row_floats, 0.0f);
     if (var_count == 3) img.variance.resize(img.rgb.size(), 0.0f);
+    if (alpha) img.alpha.resize(size_t(y0 + rows) * size_t(img.width), 0.0f);
     const Imath::Box2i block(Imath::V2i(dw.min.x, dw.min.y + y0), Imath::V2i(dw.max.x, dw.min.y + y0 + rows - 1));
     // A FrameBuffer maps each name once, so a Y-only file fills R and is copied to G, B.
     Imf::FrameBuffer fb;
@@ -293,6 +316,9 @@ Image read_exr(const fs::path& file, const std::vector<unsigned char>& bytes) {
       if (var_count == 3)
         fb.insert(var_names[c], Imf::Slice::Make(Imf::FLOAT, img.variance.data() + at, block, xs, ys));
     }
+    if (alpha)
+      fb.insert("A", Imf::Slice::Make(Imf::FLOAT, img.alpha.data() + size_t(y0) * size_t(img.width), block,
+                                      sizeof(float), sizeof(float) * size_t(img.width)));
     in.setFrameBuffer(fb);
     in.readPixels(block.min.y, block.max.y);
   }

@@ -20,11 +20,13 @@ float srgb_decode(float encoded);
 unsigned char srgb_encode_u8(float linear, double exposure_stops = 0.0);
 
 // Chooses the format by extension (case-insensitive):
-//   .exr  float32, ZIP, channels R, G, B (+ variance.R/G/B when img has variance);
+//   .exr  float32, ZIP, channels R, G, B (+ variance.R/G/B when img has variance,
+//         + A when img has alpha);
 //         int header attributes "spp" / "spp_target" when img.spp / spp_target > 0;
 //         linear, exposure NOT applied.
 //   .png  8-bit sRGB RGB through exposure and `view` (image/DisplayTransform.h
-//         display_rgb8), variance dropped. Renders pass film.view; the default,
+//         display_rgb8), variance dropped; RGBA, straight alpha, when
+//         img.transparent and img has alpha. Renders pass film.view; the default,
 //         Standard, suits data such as textures (a plain sRGB encode).
 // Atomic (see AtomicFile.h): a failure leaves no file at `file`.
 // Unknown extension, empty image, or an I/O failure → InputError.

@@ -382,6 +382,7 @@ void PreviewWindow::save_accumulation() {
   RenderResult result;
   session_->read(result);
   Image image = image_from_render(result, /*with_variance=*/true);
+  image.transparent = scene_.film.transparent;
   const fs::path exr = base.string() + ".exr", png = base.string() + ".png";
   try {
     write_image(exr, image);

@@ -138,11 +138,13 @@ Checkpoint read_checkpoint(const fs::path& file, const PayloadBytes& payload_byt
   if (payload_bytes(id.backend, id.width, id.height) == 0)
     throw input_error(name, "backend", "unknown backend \"" + id.backend + "\"");
   if (bytes != payload_bytes(id.backend, id.width, id.height))
-    throw input_error(name, "", "corrupt checkpoint: " + std::to_string(bytes) + " payload bytes for a " +
-                                    std::to_string(id.width) + "x" + std::to_string(id.height) + " " + id.backend +
-                                    " render");
+    throw input_error(name, "", "corrupt checkpoint, or one from another pyrolume version: " + std::to_string(bytes) +
+                                    " payload bytes where a " + std::to_string(id.width) + "x" +
+                                    std::to_string(id.height) + " " + id.backend + " render has " +
+                                    std::to_string(payload_bytes(id.backend, id.width, id.height)) +
+                                    " (render again without --resume)");
   // The header's claim against the file before anything is allocated by it: a
-  // forged 16384² header in a small file is refused here, not after 12 GiB.
+  // forged 16384² header in a small file is refused here, not after 16 GiB.
   const uint64_t expected = magic.size() + 1 + header.size() + 1 + bytes + 8;
   if (file_size < expected)
     throw input_error(name, "", "truncated checkpoint: the header describes " + std::to_string(expected) +

@@ -85,6 +85,8 @@ struct RenderResult {
   int resumed_spp = 0;  // of `spp`, those that came from RenderControl::resume
   // Interleaved RGB, width*height*3, row 0 = top.
   std::vector<double> sum, sum_sq;
+  // Per pixel (width*height): Σα and Σα² of the samples' alpha (docs/compositing.md).
+  std::vector<double> alpha_sum, alpha_sum_sq;
   std::string backend, device;
   // What the render resolved from integrator.mis / emission_estimator
   // (host/light/LightSelection.h): "bsdf" | "mis" | "light_only" and

@@ -8,7 +8,7 @@ namespace pyrolume {
 // mean = Σx / n, with n = result.spp.
 // with_variance: variance of the mean = s²/n, s² = (Σx² − (Σx)²/n)/(n − 1) (unbiased
 // sample variance), clamped at 0 against cancellation; +inf when n < 2 (unknown).
-// n = 0 gives a black image.
+// n = 0 gives a black image. Alpha: Σα / n per pixel, when the result has it.
 Image image_from_render(const RenderResult& result, bool with_variance);
 
 }  // namespace pyrolume

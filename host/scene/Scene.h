@@ -64,6 +64,10 @@ struct Film {
   bool exposure_auto = false;  // "exposure": "auto": chosen from the rendered image (docs/view-transform.md)
   ViewTransform view = ViewTransform::AgX;
   uint32_t seed = 1;
+  // Camera rays that leave the scene add no radiance (the background or sky
+  // still lights it), so RGB over A composites over a plate; PNG then has
+  // alpha (docs/compositing.md).
+  bool transparent = false;
 };
 
 struct Integrator {

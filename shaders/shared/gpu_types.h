@@ -168,7 +168,8 @@ struct FrameConstants {
   uint max_depth;
   uint seed;
   uint frame_index;      // the animation frame (rng_init's stream)
-  uint unused3, unused4;
+  uint transparent;      // film.transparent: camera rays that escape add no radiance
+  uint unused4;
   // Next-event estimation (LightSelection): the probability that it picks the
   // environment (each emissive grid's is its GpuEmissionCdf pick_probability);
   // the probability that a vertex's continuation comes from its own lobe
@@ -225,6 +226,10 @@ struct AccumTexel {
   float lookups;    // Σ density lookups (plain sum)
   vec3 sum_sq_c;    // compensation terms of sum_sq
   float nonfinite;  // count of non-finite samples (plain sum)
+  float alpha_sum;  // Σ α (docs/compositing.md "Alpha")
+  float alpha_sum_c;
+  float alpha_sq;   // Σ α²
+  float alpha_sq_c;
 };
 
 #ifdef __cplusplus
@@ -253,7 +258,7 @@ PYRO_OFFSET(FrameConstants, unused1, 60); PYRO_OFFSET(FrameConstants, background
 PYRO_OFFSET(FrameConstants, unused2, 76); PYRO_OFFSET(FrameConstants, width, 80);
 PYRO_OFFSET(FrameConstants, height, 84); PYRO_OFFSET(FrameConstants, medium_count, 88);
 PYRO_OFFSET(FrameConstants, max_depth, 92); PYRO_OFFSET(FrameConstants, seed, 96);
-PYRO_OFFSET(FrameConstants, frame_index, 100); PYRO_OFFSET(FrameConstants, unused3, 104);
+PYRO_OFFSET(FrameConstants, frame_index, 100); PYRO_OFFSET(FrameConstants, transparent, 104);
 PYRO_OFFSET(FrameConstants, unused4, 108); PYRO_OFFSET(FrameConstants, p_env, 112);
 PYRO_OFFSET(FrameConstants, p_continue_own, 116); PYRO_OFFSET(FrameConstants, surface_light_samples, 120);
 PYRO_OFFSET(FrameConstants, ratio_tracked_continuation, 124);
@@ -267,10 +272,12 @@ PYRO_OFFSET(WavefrontQueues, track_count0, 48); PYRO_OFFSET(WavefrontQueues, tra
 PYRO_OFFSET(WavefrontQueues, event_count, 56); PYRO_OFFSET(WavefrontQueues, track_read, 60);
 PYRO_OFFSET(WavefrontQueues, capacity, 64); PYRO_OFFSET(WavefrontQueues, begin_count, 68);
 PYRO_OFFSET(WavefrontQueues, unused0, 72); PYRO_OFFSET(WavefrontQueues, unused1, 76);
-static_assert(sizeof(AccumTexel) == 64);
+static_assert(sizeof(AccumTexel) == 80);
 PYRO_OFFSET(AccumTexel, events, 12); PYRO_OFFSET(AccumTexel, sum_c, 16); PYRO_OFFSET(AccumTexel, events_c, 28);
 PYRO_OFFSET(AccumTexel, sum_sq, 32); PYRO_OFFSET(AccumTexel, lookups, 44); PYRO_OFFSET(AccumTexel, sum_sq_c, 48);
 PYRO_OFFSET(AccumTexel, nonfinite, 60);
+PYRO_OFFSET(AccumTexel, alpha_sum, 64); PYRO_OFFSET(AccumTexel, alpha_sum_c, 68);
+PYRO_OFFSET(AccumTexel, alpha_sq, 72); PYRO_OFFSET(AccumTexel, alpha_sq_c, 76);
 }  // namespace pyrolume::gpu
 #endif
 #endif

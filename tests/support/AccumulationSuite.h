@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "render/Render.h"
+#include "render/cpu/CpuRenderer.h"
 #include "shared/gpu_types.h"
 #include "support/AccumulationChecks.h"
 #include "support/BackendSuite.h"
@@ -51,7 +52,7 @@ TEST_P(Accumulation, ResumeRefusesAnotherBackendsState) {
   Scene s = constant_background_scene(4, 4, 8, {1, 1, 1});
   AccumulationState wrong =
       cpu() ? AccumulationState{"vulkan", 4, 4, 4, std::vector<uint8_t>(4 * 4 * sizeof(gpu::AccumTexel))}
-            : AccumulationState{"cpu", 4, 4, 4, std::vector<uint8_t>(4 * 4 * 6 * sizeof(double) + 24)};
+            : AccumulationState{"cpu", 4, 4, 4, std::vector<uint8_t>(CpuRenderer::accumulation_bytes(4, 4))};
   RenderControl c;
   c.resume = &wrong;
   EXPECT_THROW(backend().render(s, settings_for(s), c), std::invalid_argument);

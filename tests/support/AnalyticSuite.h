@@ -37,6 +37,49 @@ TEST_P(Analytic, AbsorbingSphereMatchesClosedForm) { expect_single_collision_clo
 
 TEST_P(Analytic, AbsorbingBoxMatchesClosedForm) { expect_single_collision_closed_form(absorbing_box_scene()); }
 
+// film.transparent on the absorbing sphere (chromatic σa, a background):
+// escaping camera rays add nothing, so RGB = Le(1 − e^(−σa ℓ)) per channel,
+// and alpha = 1 − avg_c e^(−σa_c ℓ) (docs/compositing.md "Alpha"). Both are
+// pixel averages of the closed forms; alpha is z-tested as an image whose three
+// channels all hold it. A closed form with the red channel's σa alone must fail.
+TEST_P(Analytic, TransparentSphereRgbAndAlphaMatchClosedForms) {
+  Scene s = absorbing_sphere_scene(40, 32, 512);
+  s.film.transparent = true;
+  RenderResult r = render(s);
+  Scene no_background = s;
+  no_background.background = glm::dvec3(0.0);
+  ZTestReport rgb = ztest_against_exact(r, single_collision_exact(no_background), pooled());
+  EXPECT_TRUE(rgb.ok) << rgb.summary();
+  std::printf("rgb: %s\n", rgb.summary().c_str());
+
+  ASSERT_EQ(r.alpha_sum.size(), size_t(r.width) * r.height);
+  RenderResult alpha = r;
+  for (size_t i = 0; i < r.alpha_sum.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      alpha.sum[i * 3 + c] = r.alpha_sum[i];
+      alpha.sum_sq[i * 3 + c] = r.alpha_sum_sq[i];
+    }
+  const Medium& m = s.media[0];
+  auto alpha_exact = [&](glm::dvec3 sigma) {
+    auto a = [&, sigma](double fx, double fy, int* sig) {
+      const Chord ch = chord(m.bounds, s.camera.position, film_ray(s.camera, s.film.width, s.film.height, fx, fy));
+      if (sig) *sig = ch.signature;
+      const double T = (std::exp(-sigma.x * ch.length) + std::exp(-sigma.y * ch.length) +
+                        std::exp(-sigma.z * ch.length)) / 3.0;
+      return glm::dvec3(1.0 - T);
+    };
+    auto img = std::make_shared<std::vector<glm::dvec3>>(size_t(s.film.width) * s.film.height);
+    for (int y = 0; y < s.film.height; ++y)
+      for (int x = 0; x < s.film.width; ++x) (*img)[size_t(y) * s.film.width + x] = pixel_average(a, x, y);
+    return [img, W = s.film.width](int x, int y) { return (*img)[size_t(y) * W + x]; };
+  };
+  ZTestReport rep = ztest_against_exact(alpha, alpha_exact(m.sigma_a), pooled());
+  EXPECT_TRUE(rep.ok) << rep.summary();
+  std::printf("alpha: %s\n", rep.summary().c_str());
+  ZTestReport wrong = ztest_against_exact(alpha, alpha_exact(glm::dvec3(m.sigma_a.x)), pooled());
+  EXPECT_FALSE(wrong.ok) << wrong.summary();
+}
+
 TEST_P(Analytic, MaxDepthZeroTreatsScatteringAsExtinction) {
   Scene s = depth0_sphere_scene();
   RenderResult r = render(s);

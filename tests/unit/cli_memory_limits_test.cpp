@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "render/Checkpoint.h"
+#include "render/cpu/CpuRenderer.h"
 #include "support/AccumulationChecks.h"
 #include "support/VdbScenes.h"
 
@@ -97,8 +98,8 @@ TEST_F(CliMemoryLimits, EndlessStreamsAsInputsAreRefused) {
 TEST_F(CliMemoryLimits, AForgedCheckpointHeaderAllocatesNothing) {
   auto dir = temp_dir("mem-ckpt");
   write_file(dir / "s.json", R"({"film": {"width": 8, "height": 8, "spp": 4}})");
-  // A header claiming a 16384² CPU accumulation (12 GiB) in a file of a few bytes.
-  const uint64_t claimed = uint64_t(16384) * 16384 * 48 + 24;
+  // A header claiming a 16384² CPU accumulation (16 GiB) in a file of a few bytes.
+  const uint64_t claimed = CpuRenderer::accumulation_bytes(16384, 16384);
   write_file(dir / "o.exr.checkpoint",
              "pyrolume-checkpoint 2\n{\"backend\":\"cpu\",\"device\":\"x\",\"scene\":\"s.json\",\"scene_hash\":" +
                  std::to_string(scene_fingerprint(dir / "s.json")) +

@@ -74,7 +74,7 @@ class CheckpointFile : public ::testing::Test {
     state_.width = 4;
     state_.height = 2;
     state_.spp = 12;
-    state_.data.resize(4 * 2 * 6 * sizeof(double) + 3 * sizeof(uint64_t));
+    state_.data.resize(CpuRenderer::accumulation_bytes(4, 2));
     for (size_t i = 0; i < state_.data.size(); ++i) state_.data[i] = uint8_t(i * 37 + 1);
     file_ = dir_ / "o.exr.checkpoint";
   }
@@ -174,12 +174,12 @@ TEST_F(CheckpointFile, VersionOneFilesAreStillRead) {
 }
 
 TEST_F(CheckpointFile, AHeaderClaimingMoreThanTheFileHoldsAllocatesNothing) {
-  // 16384² CPU pixels (12 GiB) claimed by a header in a file of a few bytes:
+  // 16384² CPU pixels (16 GiB) claimed by a header in a file of a few bytes:
   // refused from the file's size before the payload is allocated (this test
-  // would otherwise need 12 GiB).
+  // would otherwise need 16 GiB).
   write_checkpoint(file_, id_, 100, state_);
   std::string bytes = test::read_file(file_);
-  const uint64_t claimed = uint64_t(16384) * 16384 * 48 + 24;
+  const uint64_t claimed = CpuRenderer::accumulation_bytes(16384, 16384);
   for (const auto& [from, to] : {std::pair<std::string, std::string>{"\"width\":4", "\"width\":16384"},
                                  {"\"height\":2", "\"height\":16384"},
                                  {"\"payload_bytes\":" + std::to_string(state_.data.size()),

@@ -152,6 +152,52 @@ TEST(ImageIo, ExrRoundTripWithoutVariance) {
   fs::remove_all(dir);
 }
 
+// Alpha (docs/compositing.md): EXR channel A, read back as written.
+TEST(ImageIo, ExrRoundTripWithAlpha) {
+  auto dir = test::temp_dir("exralpha");
+  Image img = sample_image(true);
+  img.alpha = {0.0f, 0.25f, 1.0f, 0.5f, -0.01f, 1.0f};
+  write_image(dir / "a.exr", img);
+  Image back = read_image(dir / "a.exr");
+  EXPECT_EQ(back.rgb, img.rgb);
+  EXPECT_EQ(back.variance, img.variance);
+  EXPECT_EQ(back.alpha, img.alpha);
+  Imf::InputFile f((dir / "a.exr").c_str());
+  ASSERT_NE(f.header().channels().findChannel("A"), nullptr);
+  EXPECT_EQ(f.header().channels().findChannel("A")->type, Imf::FLOAT);
+  // Without alpha there is no A channel.
+  write_image(dir / "b.exr", sample_image(false));
+  EXPECT_FALSE(read_image(dir / "b.exr").has_alpha());
+  fs::remove_all(dir);
+}
+
+// PNG: RGB unless the image is transparent; then RGBA with straight alpha,
+// the colour being RGB/A through the view transform.
+TEST(ImageIo, PngHasStraightAlphaOnlyWhenTransparent) {
+  auto dir = test::temp_dir("pngalpha");
+  Image img = make_image(2, 1);
+  img.rgb = {0.25f, 0.125f, 0.0f, 0.0f, 0.0f, 0.0f};  // premultiplied by A = 0.5, then A = 0
+  img.alpha = {0.5f, 0.0f};
+  write_image(dir / "opaque.png", img, 0.0);
+  int w = 0, h = 0, n = 0;
+  unsigned char* px = stbi_load((dir / "opaque.png").c_str(), &w, &h, &n, 0);
+  ASSERT_NE(px, nullptr);
+  EXPECT_EQ(n, 3);
+  EXPECT_EQ(px[0], 137);  // 0.25 as it is
+  stbi_image_free(px);
+  img.transparent = true;
+  write_image(dir / "t.png", img, 0.0);
+  px = stbi_load((dir / "t.png").c_str(), &w, &h, &n, 0);
+  ASSERT_NE(px, nullptr);
+  ASSERT_EQ(n, 4);
+  EXPECT_EQ(px[0], 188);  // 0.25 / 0.5 = 0.5
+  EXPECT_EQ(px[1], 137);  // 0.125 / 0.5 = 0.25
+  EXPECT_EQ(px[3], 128);  // A = 0.5
+  EXPECT_EQ(px[7], 0);    // A = 0
+  stbi_image_free(px);
+  fs::remove_all(dir);
+}
+
 TEST(ImageIo, ExrRoundTripWithVariance) {
   auto dir = test::temp_dir("exrvar");
   Image img = sample_image(true);

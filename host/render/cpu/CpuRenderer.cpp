@@ -157,6 +157,7 @@ struct WalkScene {
   int max_depth;
   bool collision_estimator;
   const WalkLights& lights;
+  bool transparent;  // film.transparent: the camera ray adds nothing where it escapes
 
   // Radiance of channel c seen by a ray escaping along d (camera and scattered
   // rays alike): the environment map replaces background.rgb (docs/scene-format.md "environment");
@@ -253,8 +254,9 @@ struct VertexLobe {
 // A light ray (next_event) or a path: how the walk treats tentative collisions.
 enum class WalkRole { Path, LightRay };
 
+// camera_escaped: set when the walk's first ray (a camera ray) leaves the scene.
 double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
-                    Scratch& s, int max_depth, WalkRole role = WalkRole::Path);
+                    Scratch& s, int max_depth, WalkRole role = WalkRole::Path, bool* camera_escaped = nullptr);
 
 // One light sample: a direction from the mixture of eq. (3) of docs/mis.md,
 // or the direction toward a delta light with what it delivers.
@@ -522,7 +524,7 @@ constexpr double kScatterRouletteBelow = 0.1;
 // the environment is (1 for camera rays). Delta lights only reach vertices
 // through next_event.
 double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
-                    Scratch& s, int max_depth, WalkRole role) {
+                    Scratch& s, int max_depth, WalkRole role, bool* camera_escaped) {
   const MediaData& md = ws.md;
   const WalkLights& lights = ws.lights;
   const bool collision_estimator = ws.collision_estimator;
@@ -644,7 +646,13 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
     // environment's (docs/lights.md "Sampling"); black from inside.
     if (sphere.light >= 0)
       return L + (sphere.outside ? beta * w_ray * lights.analytic[sphere.light].value[c] : 0.0);
-    if (!hit_surface) return L + beta * w_ray * ws.escaped(d, c);
+    if (!hit_surface) {
+      if (role == WalkRole::Path && scatters == 0) {  // the camera ray itself: alpha, transparency
+        if (camera_escaped) *camera_escaped = true;
+        if (ws.transparent) return L;
+      }
+      return L + beta * w_ray * ws.escaped(d, c);
+    }
 
     // Reached the surface: a Lambertian bounce.
     ++cnt.collisions;
@@ -707,11 +715,13 @@ AccumulationState save_state(const RenderResult& res, const CpuCounters& c) {
   st.width = res.width;
   st.height = res.height;
   st.spp = res.spp;
-  const size_t n = res.sum.size() * sizeof(double);
-  st.data.resize(2 * n + sizeof c);
+  const size_t n = res.sum.size() * sizeof(double), na = res.alpha_sum.size() * sizeof(double);
+  st.data.resize(2 * n + 2 * na + sizeof c);
   std::memcpy(st.data.data(), res.sum.data(), n);
   std::memcpy(st.data.data() + n, res.sum_sq.data(), n);
-  std::memcpy(st.data.data() + 2 * n, &c, sizeof c);
+  std::memcpy(st.data.data() + 2 * n, res.alpha_sum.data(), na);
+  std::memcpy(st.data.data() + 2 * n + na, res.alpha_sum_sq.data(), na);
+  std::memcpy(st.data.data() + 2 * n + 2 * na, &c, sizeof c);
   return st;
 }
 
@@ -721,16 +731,19 @@ void load_state(const AccumulationState& st, RenderResult& res, CpuCounters& c) 
       st.data.size() != CpuRenderer::accumulation_bytes(res.width, res.height))
     throw std::invalid_argument("cpu reference: the resumed accumulation is not a " + std::to_string(res.width) + "x" +
                                 std::to_string(res.height) + " cpu one");
+  const size_t na = res.alpha_sum.size() * sizeof(double);
   std::memcpy(res.sum.data(), st.data.data(), n);
   std::memcpy(res.sum_sq.data(), st.data.data() + n, n);
-  std::memcpy(&c, st.data.data() + 2 * n, sizeof c);
+  std::memcpy(res.alpha_sum.data(), st.data.data() + 2 * n, na);
+  std::memcpy(res.alpha_sum_sq.data(), st.data.data() + 2 * n + na, na);
+  std::memcpy(&c, st.data.data() + 2 * n + 2 * na, sizeof c);
   res.spp = res.resumed_spp = st.spp;
 }
 
 }  // namespace
 
 uint64_t CpuRenderer::accumulation_bytes(int width, int height) {
-  return uint64_t(width) * uint64_t(height) * 6 * sizeof(double) + sizeof(CpuCounters);
+  return uint64_t(width) * uint64_t(height) * 8 * sizeof(double) + sizeof(CpuCounters);
 }
 
 CpuRenderer::CpuRenderer(int threads) {
@@ -796,7 +809,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   }
   const bool collision_estimator = lights.selection.estimator == EmissionEstimator::Collision;
   const WalkScene walk_scene{media,     surfaces,           environment ? &*environment : nullptr, scene.background,
-                             max_depth, collision_estimator, lights};
+                             max_depth, collision_estimator, lights, scene.film.transparent};
   RenderResult res;
   res.warnings = media.warnings;  // the CLI prints them ("pyrolume: warning: ...")
   res.width = W;
@@ -808,6 +821,8 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   res.spp_target = settings.spp;
   res.sum.assign(size_t(W) * H * 3, 0.0);
   res.sum_sq.assign(size_t(W) * H * 3, 0.0);
+  res.alpha_sum.assign(size_t(W) * H, 0.0);
+  res.alpha_sum_sq.assign(size_t(W) * H, 0.0);
   // Resumed: the sums continue in sample order, so the result is bit-identical
   // to an uninterrupted render's (per-pixel sums never depend on passes).
   CpuCounters totals;
@@ -828,6 +843,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   // only when complete: a pass abandoned by a signal leaves res as the passes
   // before it made it.
   std::vector<double> next_sum(res.sum.size()), next_sum_sq(res.sum_sq.size());
+  std::vector<double> next_alpha(res.alpha_sum.size()), next_alpha_sq(res.alpha_sum_sq.size());
   while (spp_done < settings.spp) {
     const int s_begin = spp_done, s_end = std::min(settings.spp, spp_done + kPassSpp);
     std::atomic<int> next_tile{0};
@@ -845,6 +861,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
               sum[c] = res.sum[pix * 3 + c];
               sum_sq[c] = res.sum_sq[pix * 3 + c];
             }
+            double alpha_sum = res.alpha_sum[pix], alpha_sq = res.alpha_sum_sq[pix];
             for (int si = s_begin; si < s_end; ++si) {
               cnt.step();
               Pcg32 rng = Pcg32::for_sample(settings.seed, settings.frame, pix, uint64_t(si));
@@ -852,8 +869,19 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
               double fx = x + rng.uniform(), fy = y + rng.uniform();
               glm::dvec3 dir = camera_ray_direction(scene.camera, W, H, fx, fy);
               glm::dvec3 L;
-              for (int c = 0; c < 3; ++c)
-                L[c] = walk_channel(walk_scene, c, scene.camera.position, dir, rng, cnt, scratch, max_depth);
+              // Alpha (docs/compositing.md): each channel's walk is a grey delta
+              // tracker whose camera ray escapes with probability T_c, so
+              // 1 − (escapes)/3 has mean 1 − avg_c T_c.
+              int escapes = 0;
+              for (int c = 0; c < 3; ++c) {
+                bool escaped = false;
+                L[c] = walk_channel(walk_scene, c, scene.camera.position, dir, rng, cnt, scratch, max_depth,
+                                    WalkRole::Path, &escaped);
+                escapes += escaped ? 1 : 0;
+              }
+              const double alpha = 1.0 - escapes / 3.0;
+              alpha_sum += alpha;
+              alpha_sq += alpha * alpha;
               // NaN, Inf and beyond MAX_SAMPLE_RADIANCE (where float sums of
               // squares could overflow): recorded as 0, counted in nonfinite_samples.
               const double kMaxL = kMaxSampleRadiance;
@@ -870,6 +898,8 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
               next_sum[pix * 3 + c] = sum[c];
               next_sum_sq[pix * 3 + c] = sum_sq[c];
             }
+            next_alpha[pix] = alpha_sum;
+            next_alpha_sq[pix] = alpha_sq;
           }
       }
     };
@@ -893,6 +923,8 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
     }
     res.sum.swap(next_sum);
     res.sum_sq.swap(next_sum_sq);
+    res.alpha_sum.swap(next_alpha);
+    res.alpha_sum_sq.swap(next_alpha_sq);
     for (const auto& cnt : counters) {
       totals.collisions += cnt.collisions;
       totals.nonfinite += cnt.nonfinite;

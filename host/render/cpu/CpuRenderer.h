@@ -33,8 +33,8 @@ class CpuRenderer : public Backend {
   // maps (naming the file) and std::invalid_argument for bad settings.
   RenderResult render(const Scene& scene, const RenderSettings& settings, const RenderControl& control) override;
 
-  // Bytes of its AccumulationState for a width×height render: Σ L and Σ L² as
-  // doubles, then three uint64 counters (CpuRenderer.cpp save_state).
+  // Bytes of its AccumulationState for a width×height render: Σ L, Σ L², Σα
+  // and Σα² as doubles, then three uint64 counters (CpuRenderer.cpp save_state).
   static uint64_t accumulation_bytes(int width, int height);
 
   // Samples per pixel per progressive pass (progress/cancel/time-limit granularity).

@@ -201,6 +201,7 @@ gpu::FrameConstants build_frame_constants(const Scene& scene, const RenderSettin
   f.max_depth = uint32_t(scene.integrator.max_depth);
   f.seed = s.seed;
   f.frame_index = s.frame;
+  f.transparent = scene.film.transparent ? 1u : 0u;
   return f;
 }
 

@@ -790,6 +790,8 @@ void RenderSession::result_from_state(const AccumulationState& state, RenderResu
   result.spp = state.spp;
   result.sum.assign(pixels * 3, 0.0);
   result.sum_sq.assign(pixels * 3, 0.0);
+  result.alpha_sum.assign(pixels, 0.0);
+  result.alpha_sum_sq.assign(pixels, 0.0);
   result.events = result.density_lookups = 0.0;
   result.nonfinite_samples = 0;
   for (size_t i = 0; i < pixels; ++i) {
@@ -800,6 +802,8 @@ void RenderSession::result_from_state(const AccumulationState& state, RenderResu
       result.sum[i * 3 + c] = double(t.sum[c]) - double(t.sum_c[c]);
       result.sum_sq[i * 3 + c] = double(t.sum_sq[c]) - double(t.sum_sq_c[c]);
     }
+    result.alpha_sum[i] = double(t.alpha_sum) - double(t.alpha_sum_c);
+    result.alpha_sum_sq[i] = double(t.alpha_sq) - double(t.alpha_sq_c);
     result.events += double(t.events) - double(t.events_c);
     result.density_lookups += double(t.lookups);
     result.nonfinite_samples += uint64_t(t.nonfinite);
