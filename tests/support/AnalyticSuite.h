@@ -53,12 +53,7 @@ TEST_P(Analytic, TransparentSphereRgbAndAlphaMatchClosedForms) {
   std::printf("rgb: %s\n", rgb.summary().c_str());
 
   ASSERT_EQ(r.alpha_sum.size(), size_t(r.width) * r.height);
-  RenderResult alpha = r;
-  for (size_t i = 0; i < r.alpha_sum.size(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      alpha.sum[i * 3 + c] = r.alpha_sum[i];
-      alpha.sum_sq[i * 3 + c] = r.alpha_sum_sq[i];
-    }
+  const RenderResult alpha = alpha_image(r);
   const Medium& m = s.media[0];
   auto alpha_exact = [&](glm::dvec3 sigma) {
     auto a = [&, sigma](double fx, double fy, int* sig) {

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -248,6 +249,19 @@ inline double pixel_spread(const RenderResult& r, int x, int y) {
     worst = std::max(worst, std::abs(r.sum_sq[p + c] / r.spp - m * m) / (1.0 + m * m));
   }
   return worst;
+}
+
+// The render's alpha (Σα, Σα²) as an image whose three channels all hold it,
+// so that the z-tests below compare alpha (docs/compositing.md).
+inline RenderResult alpha_image(const RenderResult& r) {
+  RenderResult a = r;
+  if (r.alpha_sum.size() * 3 != r.sum.size()) throw std::logic_error("alpha_image: the render has no alpha");
+  for (size_t i = 0; i < r.alpha_sum.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      a.sum[i * 3 + c] = r.alpha_sum[i];
+      a.sum_sq[i * 3 + c] = r.alpha_sum_sq[i];
+    }
+  return a;
 }
 
 // Render vs closed form. `exact(x, y)` is the expected pixel value (the average

@@ -136,6 +136,9 @@ TEST_F(VulkanSurface, AgreesWithCpuOnSmallTerrainExplosion) {
   c.film.seed = 12;
   RenderResult cpu = render_cpu(c);
   expect_same(gpu, cpu, 0.01, 0.005, "terrain_explosion 32x18");
+  // Alpha (docs/compositing.md): the terrain is opaque, the fire above the
+  // horizon partly so.
+  expect_same(test::alpha_image(gpu), test::alpha_image(cpu), 0.01, 0.005, "terrain_explosion 32x18 alpha");
 }
 
 // An emissive, scattering, chromatic homogeneous sphere above a textured plane
