@@ -40,15 +40,13 @@ void add_pass(uint pixel_index, vec3 pass_sum, vec3 pass_sum_c, vec3 pass_sq, ve
   precise vec3 s2 = a.sum_sq + y2;
   a.sum_sq_c = (s2 - a.sum_sq) - y2;
   a.sum_sq = s2;
-  precise vec2 ya = pass_alpha - vec2(a.alpha_sum_c, a.alpha_sq_c);
-  precise vec2 sa = vec2(a.alpha_sum, a.alpha_sq) + ya;
-  const vec2 ca = (sa - vec2(a.alpha_sum, a.alpha_sq)) - ya;
-  a.alpha_sum_c = ca.x;
-  a.alpha_sq_c = ca.y;
-  a.alpha_sum = sa.x;
-  a.alpha_sq = sa.y;
   a.lookups += stats.lookups;
   a.nonfinite += nonfinite;
   accum[pixel_index] = a;
+  AlphaTexel al = alpha_accum[pixel_index];
+  precise vec2 ya = pass_alpha - vec2(al.sum_c, al.sq_c);
+  precise vec2 sa = vec2(al.sum, al.sq) + ya;
+  const vec2 ca = (sa - vec2(al.sum, al.sq)) - ya;
+  alpha_accum[pixel_index] = AlphaTexel(sa.x, ca.x, sa.y, ca.y);
 }
 

@@ -39,6 +39,7 @@ layout(std140, set = 0, binding = BINDING_FRAME) uniform FrameBlock { FrameConst
 // uniform loads serve without per-lane gathers.
 layout(std140, set = 0, binding = BINDING_MEDIA) uniform MediaBlock { GpuMedium media[MAX_MEDIA]; };
 layout(std430, set = 0, binding = BINDING_ACCUM) buffer AccumBlock { AccumTexel accum[]; };
+layout(std430, set = 0, binding = BINDING_ALPHA) buffer AlphaBlock { AlphaTexel alpha_accum[]; };
 layout(std140, set = 0, binding = BINDING_GRIDS) uniform GridBlock { GpuGrid grids[MAX_GRIDS]; };
 layout(std430, set = 0, binding = BINDING_MAJORANTS) readonly buffer MajorantBlock { float majorants[]; };
 layout(set = 0, binding = BINDING_DENSITY) uniform sampler3D density_tex[MAX_GRIDS];

@@ -12,7 +12,8 @@
 
 namespace pyrolume::preview {
 
-DisplayPass::DisplayPass(vk::Context& ctx, const vk::Buffer& accum, uint32_t image_w, uint32_t image_h)
+DisplayPass::DisplayPass(vk::Context& ctx, const vk::Buffer& accum, VkDeviceSize accum_bytes, uint32_t image_w,
+                         uint32_t image_h)
     : ctx_(ctx),
       image_w_(image_w),
       image_h_(image_h),
@@ -21,7 +22,7 @@ DisplayPass::DisplayPass(vk::Context& ctx, const vk::Buffer& accum, uint32_t ima
                  {gpu::PREVIEW_BINDING_DISPLAY, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
                 sizeof(gpu::DisplayConstants), {}, "preview display"),
       set_(ctx, pipeline_, "preview display set") {
-  set_.write_buffer(gpu::PREVIEW_BINDING_ACCUM, accum);
+  set_.write_buffer(gpu::PREVIEW_BINDING_ACCUM, accum, 0, accum_bytes);
 }
 
 void DisplayPass::resize(VkExtent2D target, bool bgra) {

@@ -41,8 +41,9 @@ inline ImageRect fit_image(uint32_t image_w, uint32_t image_h, uint32_t target_w
 
 class DisplayPass {
  public:
-  // accum: RenderSession::accumulation() of an image_w × image_h render.
-  DisplayPass(vk::Context& ctx, const vk::Buffer& accum, uint32_t image_w, uint32_t image_h);
+  // accum: RenderSession::accumulation() of an image_w × image_h render;
+  // accum_bytes: its AccumTexels' part (RenderSession::accumulation_texel_bytes).
+  DisplayPass(vk::Context& ctx, const vk::Buffer& accum, VkDeviceSize accum_bytes, uint32_t image_w, uint32_t image_h);
 
   // (Re)allocate the display buffer for a target (swapchain) size. The device must be idle.
   void resize(VkExtent2D target, bool bgra);

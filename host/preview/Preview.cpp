@@ -272,7 +272,8 @@ PreviewWindow::PreviewWindow(const PreviewArgs& args, Scene scene)
 
   session_.emplace(*ctx_, scene_, settings_);
   for (const std::string& warning : session_->warnings()) std::cerr << "pyrolume: warning: " << warning << "\n";
-  display_.emplace(*ctx_, session_->accumulation(), uint32_t(settings_.width), uint32_t(settings_.height));
+  display_.emplace(*ctx_, session_->accumulation(), session_->accumulation_texel_bytes(), uint32_t(settings_.width),
+                   uint32_t(settings_.height));
   swapchain_.emplace(*ctx_, surface);
 
   VkDevice dev = ctx_->device();

@@ -53,6 +53,7 @@ PYRO_CONST uint BINDING_PASS_STATUS = 21;      // buffer PassStatus: what the pa
 PYRO_CONST uint BINDING_PATHS = 23;    // uimageBuffer (rgba32ui): the wavefront's path states (shaders/wavefront.glsl path_io)
 PYRO_CONST uint BINDING_LIGHTS = 25;    // readonly buffer GpuLight[]: the scene's analytic lights (shared/light_types.h)
 PYRO_CONST uint BINDING_QUEUES = 24;   // buffer WavefrontQueues, then its queues of path slots
+PYRO_CONST uint BINDING_ALPHA = 26;    // buffer AlphaTexel[] (one per pixel)
 
 // Specialisation constants of render.comp: a scene pays only for what it uses.
 PYRO_CONST uint SPEC_HAS_GRIDS = 0;
@@ -226,10 +227,17 @@ struct AccumTexel {
   float lookups;    // Σ density lookups (plain sum)
   vec3 sum_sq_c;    // compensation terms of sum_sq
   float nonfinite;  // count of non-finite samples (plain sum)
-  float alpha_sum;  // Σ α (docs/compositing.md "Alpha")
-  float alpha_sum_c;
-  float alpha_sq;   // Σ α²
-  float alpha_sq_c;
+};
+
+// Per-pixel alpha (docs/compositing.md "Alpha"), Kahan-compensated like
+// AccumTexel. Its own binding after the AccumTexels in the same buffer: one
+// binding of 80 B per pixel would pass lavapipe's 128 MiB storage-buffer
+// range below 1920×1080.
+struct AlphaTexel {
+  float sum;    // Σ α
+  float sum_c;  // compensation term of sum
+  float sq;     // Σ α²
+  float sq_c;
 };
 
 #ifdef __cplusplus
@@ -272,12 +280,12 @@ PYRO_OFFSET(WavefrontQueues, track_count0, 48); PYRO_OFFSET(WavefrontQueues, tra
 PYRO_OFFSET(WavefrontQueues, event_count, 56); PYRO_OFFSET(WavefrontQueues, track_read, 60);
 PYRO_OFFSET(WavefrontQueues, capacity, 64); PYRO_OFFSET(WavefrontQueues, begin_count, 68);
 PYRO_OFFSET(WavefrontQueues, unused0, 72); PYRO_OFFSET(WavefrontQueues, unused1, 76);
-static_assert(sizeof(AccumTexel) == 80);
+static_assert(sizeof(AccumTexel) == 64);
 PYRO_OFFSET(AccumTexel, events, 12); PYRO_OFFSET(AccumTexel, sum_c, 16); PYRO_OFFSET(AccumTexel, events_c, 28);
 PYRO_OFFSET(AccumTexel, sum_sq, 32); PYRO_OFFSET(AccumTexel, lookups, 44); PYRO_OFFSET(AccumTexel, sum_sq_c, 48);
 PYRO_OFFSET(AccumTexel, nonfinite, 60);
-PYRO_OFFSET(AccumTexel, alpha_sum, 64); PYRO_OFFSET(AccumTexel, alpha_sum_c, 68);
-PYRO_OFFSET(AccumTexel, alpha_sq, 72); PYRO_OFFSET(AccumTexel, alpha_sq_c, 76);
+static_assert(sizeof(AlphaTexel) == 16);
+PYRO_OFFSET(AlphaTexel, sum_c, 4); PYRO_OFFSET(AlphaTexel, sq, 8); PYRO_OFFSET(AlphaTexel, sq_c, 12);
 }  // namespace pyrolume::gpu
 #endif
 #endif

@@ -36,8 +36,11 @@ TEST(VulkanAccumulation, ReadbackAppliesTheKahanCompensation) {
   t.lookups = 11.0f;
   t.sum_sq_c = gpu::vec3(-std::ldexp(1.0f, -29), 0.0f, std::ldexp(1.0f, -20));
   t.nonfinite = 3.0f;
-  AccumulationState st{"vulkan", 1, 1, 5, std::vector<uint8_t>(sizeof t)};
+  // The alpha texel follows (docs/compositing.md): Σα 4 less 2^-24, Σα² 3.
+  const gpu::AlphaTexel a{4.0f, std::ldexp(1.0f, -24), 3.0f, 0.0f};
+  AccumulationState st{"vulkan", 1, 1, 5, std::vector<uint8_t>(sizeof t + sizeof a)};
   std::memcpy(st.data.data(), &t, sizeof t);
+  std::memcpy(st.data.data() + sizeof t, &a, sizeof a);
   RenderResult r;
   RenderSession::result_from_state(st, r);
   EXPECT_EQ(r.spp, 5);
@@ -49,6 +52,9 @@ TEST(VulkanAccumulation, ReadbackAppliesTheKahanCompensation) {
   EXPECT_EQ(r.events, 7.5);
   EXPECT_EQ(r.density_lookups, 11.0);
   EXPECT_EQ(r.nonfinite_samples, 3u);
+  ASSERT_EQ(r.alpha_sum.size(), 1u);
+  EXPECT_EQ(r.alpha_sum[0], 4.0 - std::ldexp(1.0, -24));
+  EXPECT_EQ(r.alpha_sum_sq[0], 3.0);
 }
 
 }  // namespace

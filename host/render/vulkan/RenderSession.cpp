@@ -51,8 +51,12 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   check_accumulation_size(scene.file.string(), settings.width, settings.height, sizeof(gpu::AccumTexel),
                           range_binds ? range : ctx.max_allocation_size(),
                           range_binds ? "this device's maxStorageBufferRange" : "this device's maxMemoryAllocationSize");
+  // The alpha texels follow the AccumTexels in the same buffer, as a binding of their own.
+  check_accumulation_size(scene.file.string(), settings.width, settings.height,
+                          sizeof(gpu::AccumTexel) + sizeof(gpu::AlphaTexel), ctx.max_allocation_size(),
+                          "this device's maxMemoryAllocationSize");
   check_accumulation_fits_memory(scene.file.string(), settings.width, settings.height,
-                                 sizeof(gpu::AccumTexel) + 6 * sizeof(double));
+                                 sizeof(gpu::AccumTexel) + sizeof(gpu::AlphaTexel) + 8 * sizeof(double));
   check_scene_ranges(scene);
   // Load only what the scene uses: the grids of its vdb media, each checked
   // against the device's texture limits before its dense array is allocated.
@@ -70,7 +74,10 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   media_buffer_ = vk::Buffer(ctx, gpu::MAX_MEDIA * sizeof(gpu::GpuMedium), kUniform, vk::MemoryKind::HostVisible, "media");
   grid_buffer_ = vk::Buffer(ctx, gpu::MAX_GRIDS * sizeof(gpu::GpuGrid), kUniform, vk::MemoryKind::HostVisible, "grids");
   majorant_buffer_ = storage_buffer(ctx, gpu_scene_.majorants, "majorant cells");
-  accum_ = vk::Buffer(ctx, size_t(settings.width) * size_t(settings.height) * sizeof(gpu::AccumTexel),
+  const VkDeviceSize pixels = VkDeviceSize(settings.width) * VkDeviceSize(settings.height);
+  const VkDeviceSize align = std::max<VkDeviceSize>(ctx.properties().limits.minStorageBufferOffsetAlignment, 1);
+  alpha_offset_ = (pixels * sizeof(gpu::AccumTexel) + align - 1) / align * align;
+  accum_ = vk::Buffer(ctx, alpha_offset_ + pixels * sizeof(gpu::AlphaTexel),
                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                           VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                       vk::MemoryKind::DeviceLocal, "accumulation");
@@ -92,6 +99,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                         {gpu::BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
                         {gpu::BINDING_MEDIA, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
                         {gpu::BINDING_ACCUM, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_ALPHA, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_GRIDS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
                         {gpu::BINDING_MAJORANTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_DENSITY, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS},
@@ -120,7 +128,8 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   create_wavefront(code);
   set_->write_buffer(gpu::BINDING_FRAME, frame_buffer_);
   set_->write_buffer(gpu::BINDING_MEDIA, media_buffer_);
-  set_->write_buffer(gpu::BINDING_ACCUM, accum_);
+  set_->write_buffer(gpu::BINDING_ACCUM, accum_, 0, accumulation_texel_bytes());
+  set_->write_buffer(gpu::BINDING_ALPHA, accum_, alpha_offset_, accum_.size() - alpha_offset_);
   set_->write_buffer(gpu::BINDING_PASS_STATUS, pass_status_);
   set_->write_buffer(gpu::BINDING_GRIDS, grid_buffer_);
   write_grid_descriptors();
@@ -763,18 +772,25 @@ AccumulationState RenderSession::save_state() {
   st.width = settings_.width;
   st.height = settings_.height;
   st.spp = spp_done_;
-  st.data.assign(pixels * sizeof(gpu::AccumTexel), 0);
-  if (spp_done_ > 0 && !needs_clear_) accum_.download(ctx_, st.data.data(), st.data.size());
+  // The AccumTexels, then the AlphaTexels (without the alignment gap between them on the device).
+  const size_t texels = pixels * sizeof(gpu::AccumTexel);
+  st.data.assign(texels + pixels * sizeof(gpu::AlphaTexel), 0);
+  if (spp_done_ > 0 && !needs_clear_) {
+    accum_.download(ctx_, st.data.data(), texels);
+    accum_.download(ctx_, st.data.data() + texels, st.data.size() - texels, alpha_offset_);
+  }
   return st;
 }
 
 void RenderSession::load_state(const AccumulationState& st) {
-  const size_t bytes = size_t(settings_.width) * size_t(settings_.height) * sizeof(gpu::AccumTexel);
+  const size_t texels = accumulation_texel_bytes(),
+               bytes = texels + size_t(settings_.width) * size_t(settings_.height) * sizeof(gpu::AlphaTexel);
   if (st.backend != "vulkan" || st.width != settings_.width || st.height != settings_.height ||
       st.data.size() != bytes || st.spp < 0)
     throw std::invalid_argument("vulkan: the resumed accumulation is not a " + std::to_string(settings_.width) + "x" +
                                 std::to_string(settings_.height) + " vulkan one");
-  accum_.upload(ctx_, st.data.data(), bytes);
+  accum_.upload(ctx_, st.data.data(), texels);
+  accum_.upload(ctx_, st.data.data() + texels, bytes - texels, alpha_offset_);
   spp_done_ = st.spp;
   needs_clear_ = st.spp == 0;
 }
@@ -783,7 +799,7 @@ void RenderSession::read(RenderResult& result) { result_from_state(save_state(),
 
 void RenderSession::result_from_state(const AccumulationState& state, RenderResult& result) {
   const size_t pixels = size_t(state.width) * size_t(state.height);
-  if (state.data.size() != pixels * sizeof(gpu::AccumTexel))
+  if (state.data.size() != pixels * (sizeof(gpu::AccumTexel) + sizeof(gpu::AlphaTexel)))
     throw std::logic_error("RenderSession::result_from_state: state size does not match its image");
   result.width = state.width;
   result.height = state.height;
@@ -802,8 +818,10 @@ void RenderSession::result_from_state(const AccumulationState& state, RenderResu
       result.sum[i * 3 + c] = double(t.sum[c]) - double(t.sum_c[c]);
       result.sum_sq[i * 3 + c] = double(t.sum_sq[c]) - double(t.sum_sq_c[c]);
     }
-    result.alpha_sum[i] = double(t.alpha_sum) - double(t.alpha_sum_c);
-    result.alpha_sum_sq[i] = double(t.alpha_sq) - double(t.alpha_sq_c);
+    gpu::AlphaTexel a;
+    std::memcpy(&a, state.data.data() + pixels * sizeof t + i * sizeof a, sizeof a);
+    result.alpha_sum[i] = double(a.sum) - double(a.sum_c);
+    result.alpha_sum_sq[i] = double(a.sq) - double(a.sq_c);
     result.events += double(t.events) - double(t.events_c);
     result.density_lookups += double(t.lookups);
     result.nonfinite_samples += uint64_t(t.nonfinite);

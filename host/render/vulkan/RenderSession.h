@@ -76,6 +76,10 @@ class RenderSession {
   int height() const { return settings_.height; }
   // AccumTexel per pixel (shaders/shared/gpu_types.h), row 0 = top.
   const vk::Buffer& accumulation() const { return accum_; }
+  // The AccumTexels' part of accumulation() (the AlphaTexels follow).
+  VkDeviceSize accumulation_texel_bytes() const {
+    return VkDeviceSize(settings_.width) * VkDeviceSize(settings_.height) * sizeof(gpu::AccumTexel);
+  }
   // Read the sums and counters back into result (sum, sum_sq, spp, counters).
   void read(RenderResult& result);
   // The accumulation as it is on the device (raw AccumTexels, backend "vulkan"),
@@ -136,6 +140,7 @@ class RenderSession {
   std::optional<vk::DescriptorSet> set_;
   std::vector<std::pair<uint32_t, uint32_t>> spec_;  // the variant pipeline_ was compiled for
   vk::Buffer pass_status_, accum_backup_;  // PassStatus; the accumulation before the pass in flight
+  VkDeviceSize alpha_offset_ = 0;          // where accum_'s AlphaTexels start (aligned for their binding)
   int max_pass_spp_ = 1 << 30;
   int band_rows_ = 0;  // 0: not measured yet (first_band_rows)
   // Rows for one dispatch of `spp` samples per pixel before anything is measured.

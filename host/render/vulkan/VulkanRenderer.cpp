@@ -37,7 +37,7 @@ void VulkanRenderer::set_frame_reuse(bool on) {
 }
 
 uint64_t VulkanRenderer::accumulation_bytes(int width, int height) {
-  return uint64_t(width) * uint64_t(height) * sizeof(gpu::AccumTexel);
+  return uint64_t(width) * uint64_t(height) * (sizeof(gpu::AccumTexel) + sizeof(gpu::AlphaTexel));
 }
 
 int VulkanRenderer::spp_per_pass(int width, int height, int spp, int rays_per_vertex) {

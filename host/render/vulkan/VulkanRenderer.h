@@ -23,7 +23,7 @@ class VulkanRenderer : public Backend {
   uint64_t validation_messages() const override;
 
   // Bytes of its AccumulationState for a width×height render: one
-  // gpu::AccumTexel per pixel (RenderSession::save_state).
+  // gpu::AccumTexel per pixel, then one gpu::AlphaTexel per pixel (RenderSession::save_state).
   static uint64_t accumulation_bytes(int width, int height);
 
   // Samples per pixel per dispatch: a fixed function of the image size, so the
