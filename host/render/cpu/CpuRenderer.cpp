@@ -765,9 +765,9 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
     if (!(glm::length(glm::cross(f, scene.camera.up)) > 0.0))
       throw std::invalid_argument("cpu reference: camera up is parallel to the view direction");
   }
-  // Σ L and Σ L² in double, the pass being accumulated beside them, and one
-  // copy of them for a checkpoint.
-  check_accumulation_fits_memory(scene.file.string(), settings.width, settings.height, 3 * 6 * sizeof(double));
+  // Σ L, Σ L², Σα and Σα² in double, the pass being accumulated beside them,
+  // and one copy of them for a checkpoint.
+  check_accumulation_fits_memory(scene.file.string(), settings.width, settings.height, 3 * 8 * sizeof(double));
   check_scene_ranges(scene);
   const MediaData media = prepare_media(scene);  // loads the vdb media's grids
   for (size_t i = 0; i < media.media.size(); ++i)
