@@ -216,6 +216,15 @@ GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<Sto
   return out;
 }
 
+void keep_baked_grid_fields(const gpu::GpuGrid& baked, gpu::GpuGrid& grid) {
+  grid.lut_scale = baked.lut_scale;
+  grid.lut_offset = baked.lut_offset;
+  grid.t_min_k = baked.t_min_k;
+  grid.majorant_res = baked.majorant_res;
+  grid.majorant_offset = baked.majorant_offset;
+  grid.majorant_cell = baked.majorant_cell;
+}
+
 void set_blackbody_lut(gpu::GpuGrid& grid, const color::BlackbodyLutParams& p) {
   grid.lut_scale = p.log_scale;
   grid.lut_offset = p.log_bias;

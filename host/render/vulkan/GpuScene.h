@@ -68,6 +68,9 @@ GpuScene pack_gpu_media(const Scene& scene, const std::vector<std::optional<Stor
 // Each grid's majorant cells (from its density as stored and the scene's
 // integrator.majorant settings) into g.majorants, and where they lie into its GpuGrid.
 void add_majorant_cells(const Scene& scene, GpuScene& g);
+// The fields of a GpuGrid that describe what the session baked (the blackbody
+// LUT's coordinates, the majorant cells' geometry), copied from `baked`.
+void keep_baked_grid_fields(const gpu::GpuGrid& baked, gpu::GpuGrid& grid);
 // The grid's blackbody LUT coordinate map (GpuGrid lut_scale, lut_offset, t_min_k).
 void set_blackbody_lut(gpu::GpuGrid& grid, const color::BlackbodyLutParams& p);
 

@@ -453,13 +453,12 @@ void RenderSession::upload_emission_lights(const EmissionLights& lights) {
 }
 
 void RenderSession::upload_constants(const Scene& scene) {
-  GpuScene now = build_gpu_scene(scene, volumes_, /*with_luts=*/false);
-  // Keep the LUT parameters of the baked textures (the mode is not editable live).
-  for (size_t i = 0; i < now.grids.size() && i < gpu_scene_.grids.size(); ++i) {
-    now.grids[i].lut_scale = gpu_scene_.grids[i].lut_scale;
-    now.grids[i].lut_offset = gpu_scene_.grids[i].lut_offset;
-    now.grids[i].t_min_k = gpu_scene_.grids[i].t_min_k;
-  }
+  // Only the headers: the blackbody LUTs and majorant cells stay as baked (an
+  // edit changes neither the emission's mode nor the grids), so they are not
+  // rebuilt; the majorant scale, which follows the coefficients, is.
+  GpuScene now = pack_gpu_media(scene, volumes_, /*with_luts=*/false);
+  for (size_t i = 0; i < now.grids.size() && i < gpu_scene_.grids.size(); ++i)
+    keep_baked_grid_fields(gpu_scene_.grids[i], now.grids[i]);
   const gpu::FrameConstants frame = build_frame_constants(scene, settings_, uint32_t(now.media.size()), light_selection_);
   frame_buffer_.upload(ctx_, &frame, sizeof frame);
   if (!now.media.empty()) media_buffer_.upload(ctx_, now.media.data(), now.media.size() * sizeof(gpu::GpuMedium));
