@@ -69,9 +69,9 @@ bool intersect_triangle(TriangleRay r, uint tri, float t_max, out float t, out v
   t = 0.0;
   bary = vec2(0.0);
   GpuTriangle g = bvh_triangles[tri];
-  precise vec3 A = r.shear * (g.v0.xyz - r.o);
-  precise vec3 B = r.shear * (g.v1.xyz - r.o);
-  precise vec3 C = r.shear * (g.v2.xyz - r.o);
+  precise vec3 A = r.shear * (g.v0 - r.o);
+  precise vec3 B = r.shear * (g.v1 - r.o);
+  precise vec3 C = r.shear * (g.v2 - r.o);
   precise float U = C.x * B.y - C.y * B.x;
   precise float V = A.x * C.y - A.y * C.x;
   precise float W = B.x * A.y - B.y * A.x;
@@ -126,12 +126,11 @@ bool bvh_traverse(vec3 o, vec3 d, float t_max, bool any_hit, inout SurfaceHit hi
     vec2 t_in = max(max(min(tx.xy, tx.zw), min(ty.xy, ty.zw)), max(min(tz.xy, tz.zw), vec2(0.0)));
     vec2 t_out = min(min(max(tx.xy, tx.zw), max(ty.xy, ty.zw)), min(max(tz.xy, tz.zw), vec2(t_closest))) * 1.0000004;
     bvec2 enter = lessThanEqual(t_in, t_out);
-    uvec4 c = n.children;
     // The hit leaf children's triangles: child 0's, then child 1's.
-    uint count0 = enter.x && c.z != BVH_INTERIOR_CHILD ? c.z : 0u;
-    uint count1 = enter.y && c.w != BVH_INTERIOR_CHILD ? c.w : 0u;
-    for (uint k = 0u; k < count0 + count1; ++k) {
-      uint i = k < count0 ? c.x + k : c.y + (k - count0);
+    uint tris0 = enter.x && n.count0 != BVH_INTERIOR_CHILD ? n.count0 : 0u;
+    uint tris1 = enter.y && n.count1 != BVH_INTERIOR_CHILD ? n.count1 : 0u;
+    for (uint k = 0u; k < tris0 + tris1; ++k) {
+      uint i = k < tris0 ? n.child0 + k : n.child1 + (k - tris0);
       float t;
       vec2 bary;
       if (intersect_triangle(r, i, t_closest, t, bary)) {
@@ -147,16 +146,16 @@ bool bvh_traverse(vec3 o, vec3 d, float t_max, bool any_hit, inout SurfaceHit hi
     if (any_hit && found) break;
     // Interior children still in reach (a leaf's hit may have moved t_closest).
     float t_reach = t_closest * 1.0000004;
-    bool in0 = enter.x && c.z == BVH_INTERIOR_CHILD && t_in.x <= t_reach;
-    bool in1 = enter.y && c.w == BVH_INTERIOR_CHILD && t_in.y <= t_reach;
+    bool in0 = enter.x && n.count0 == BVH_INTERIOR_CHILD && t_in.x <= t_reach;
+    bool in1 = enter.y && n.count1 == BVH_INTERIOR_CHILD && t_in.y <= t_reach;
     if (in0 && in1) {
       bool near1 = t_in.y < t_in.x;
-      stack_node[sp] = near1 ? c.x : c.y;
+      stack_node[sp] = near1 ? n.child0 : n.child1;
       stack_t[sp] = near1 ? t_in.x : t_in.y;
       ++sp;
-      node = near1 ? c.y : c.x;
+      node = near1 ? n.child1 : n.child0;
     } else if (in0 || in1) {
-      node = in0 ? c.x : c.y;
+      node = in0 ? n.child0 : n.child1;
     } else {
       bool popped = false;
       while (sp > 0u && !popped) {
@@ -184,13 +183,13 @@ bool bvh_any_hit(vec3 o, vec3 d, float t_max) {
 bool intersect_surface_shape(uint i, vec3 o, vec3 d, float t_max, out float t) {
   t = 0.0;
   GpuSurfaceShape s = surface_shapes[i];
-  if (s.info.x == SURFACE_SPHERE) {
+  if (s.kind == SURFACE_SPHERE) {
     // Stable quadratic (Ray Tracing Gems ch. 7) for a non-unit direction.
-    vec3 oc = o - s.p0.xyz;
+    vec3 oc = o - s.center;
     float a = dot(d, d);
     float b = dot(oc, d);
     vec3 perp = oc - (b / a) * d;
-    float r = s.p0.w;
+    float r = s.radius;
     float disc = a * (r * r - dot(perp, perp));
     if (disc < 0.0) return false;
     float q = -b - (b < 0.0 ? -1.0 : 1.0) * sqrt(disc);
@@ -201,15 +200,15 @@ bool intersect_surface_shape(uint i, vec3 o, vec3 d, float t_max, out float t) {
     if (hi > 0.0 && hi < t_max) { t = hi; return true; }
     return false;
   }
-  vec3 n = s.p1.xyz;
+  vec3 n = s.normal;
   float denom = dot(n, d);
   if (denom == 0.0) return false;
-  float tp = dot(s.p0.xyz - o, n) / denom;
+  float tp = dot(s.center - o, n) / denom;
   if (!(tp > 0.0 && tp < t_max)) return false;
-  vec3 local = o + tp * d - s.p0.xyz;
-  vec3 v_axis = cross(n, s.p2.xyz);
-  if (s.p0.w > 0.0 && abs(dot(local, s.p2.xyz)) > s.p0.w) return false;
-  if (s.p1.w > 0.0 && abs(dot(local, v_axis)) > s.p1.w) return false;
+  vec3 local = o + tp * d - s.center;
+  vec3 v_axis = cross(n, s.u_axis);
+  if (s.half_u > 0.0 && abs(dot(local, s.u_axis)) > s.half_u) return false;
+  if (s.half_v > 0.0 && abs(dot(local, v_axis)) > s.half_v) return false;
   t = tp;
   return true;
 }
@@ -254,35 +253,33 @@ SurfaceInteraction surface_interaction(vec3 o, vec3 d, SurfaceHit hit) {
   if (hit.kind == SURFACE_HIT_TRIANGLE) {
     GpuTriangle g = bvh_triangles[hit.primitive];
     GpuTriangleAttributes a = bvh_attributes[hit.primitive];
-    vec3 ng = cross(g.v1.xyz - g.v0.xyz, g.v2.xyz - g.v0.xyz);
+    vec3 ng = cross(g.v1 - g.v0, g.v2 - g.v0);
     float len = length(ng);
     si.normal = len > 0.0 ? ng / len : vec3(0.0, 1.0, 0.0);
     float b0 = 1.0 - hit.bary.x - hit.bary.y;
     si.shading_normal = si.normal;
-    if ((a.info.w & TRIANGLE_HAS_NORMALS) != 0u) {
-      vec3 ns = b0 * a.n0.xyz + hit.bary.x * a.n1.xyz + hit.bary.y * a.n2.xyz;
+    if ((a.flags & TRIANGLE_HAS_NORMALS) != 0u) {
+      vec3 ns = b0 * a.n0 + hit.bary.x * a.n1 + hit.bary.y * a.n2;
       float ls = length(ns);
       if (ls > 0.0) si.shading_normal = ns / ls;
     }
-    si.uv = (a.info.w & TRIANGLE_HAS_UVS) != 0u
-                ? b0 * a.uv01.xy + hit.bary.x * a.uv01.zw + hit.bary.y * a.uv2.xy
-                : vec2(0.0);
-    si.material = a.info.x;
+    si.uv = (a.flags & TRIANGLE_HAS_UVS) != 0u ? b0 * a.uv0 + hit.bary.x * a.uv1 + hit.bary.y * a.uv2 : vec2(0.0);
+    si.material = a.material;
   } else {
     GpuSurfaceShape s = surface_shapes[hit.primitive];
-    si.material = s.info.y;
-    if (s.info.x == SURFACE_SPHERE) {
-      vec3 local = (si.position - s.p0.xyz) / s.p0.w;
+    si.material = s.material;
+    if (s.kind == SURFACE_SPHERE) {
+      vec3 local = (si.position - s.center) / s.radius;
       si.normal = normalize(local);
       float phi = atan(local.z, local.x);
       if (phi < 0.0) phi += 2.0 / SURFACE_INV_PI;
       float theta = acos(clamp(si.normal.y, -1.0, 1.0));
       si.uv = vec2(phi * 0.5 * SURFACE_INV_PI, 1.0 - theta * SURFACE_INV_PI);
     } else {
-      vec3 local = si.position - s.p0.xyz;
-      float a = dot(local, s.p2.xyz), b = dot(local, cross(s.p1.xyz, s.p2.xyz));
-      si.normal = s.p1.xyz;
-      si.uv = vec2(s.p0.w > 0.0 ? a / (2.0 * s.p0.w) + 0.5 : a, s.p1.w > 0.0 ? b / (2.0 * s.p1.w) + 0.5 : b);
+      vec3 local = si.position - s.center;
+      float a = dot(local, s.u_axis), b = dot(local, cross(s.normal, s.u_axis));
+      si.normal = s.normal;
+      si.uv = vec2(s.half_u > 0.0 ? a / (2.0 * s.half_u) + 0.5 : a, s.half_v > 0.0 ? b / (2.0 * s.half_v) + 0.5 : b);
     }
     si.shading_normal = si.normal;
   }

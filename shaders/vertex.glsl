@@ -110,9 +110,9 @@ bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float
     if (p.depth >= frame.max_depth) return true;  // max_depth reached
     ++p.depth;
     GpuMaterial m = surface_materials[si.material];
-    albedo = m.albedo.rgb;
-    if (ALBEDO_TEXTURE_COUNT > 0u && m.info.x != NO_TEXTURE)
-      albedo *= albedo_texture_at(m.info.x, vec2(si.uv.x, 1.0 - si.uv.y));  // OBJ v=0 at the bottom
+    albedo = m.albedo;
+    if (ALBEDO_TEXTURE_COUNT > 0u && m.texture_slot != NO_TEXTURE)
+      albedo *= albedo_texture_at(m.texture_slot, vec2(si.uv.x, 1.0 - si.uv.y));  // OBJ v=0 at the bottom
     n = dot(si.normal, p.d) < 0.0 ? si.normal : -si.normal;
     o = offset_ray_origin(si.position, n);
   } else {

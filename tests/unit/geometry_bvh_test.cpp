@@ -217,16 +217,17 @@ TEST(Bvh, GpuNodesHoldBothChildrenAndEveryTriangleOnce) {
     const BvhNode& n = bvh.nodes[b];
     ASSERT_FALSE(n.is_leaf());
     const uint32_t kids[2] = {b + 1, n.offset};
+    const uint32_t child[2] = {g[k].child0, g[k].child1}, count[2] = {g[k].count0, g[k].count1};
     for (int j = 0; j < 2; ++j) {
       const BvhNode& c = bvh.nodes[kids[j]];
       EXPECT_EQ(glm::vec3(g[k].x[j], g[k].y[j], g[k].z[j]), c.bounds_min);
       EXPECT_EQ(glm::vec3(g[k].x[2 + j], g[k].y[2 + j], g[k].z[2 + j]), c.bounds_max);
       if (c.is_leaf()) {
-        ASSERT_EQ(g[k].children[2 + j], c.count);
-        for (uint32_t i = 0; i < c.count; ++i) ++covered[g[k].children[j] + i];
+        ASSERT_EQ(count[j], c.count);
+        for (uint32_t i = 0; i < c.count; ++i) ++covered[child[j] + i];
       } else {
-        ASSERT_EQ(g[k].children[2 + j], gpu::BVH_INTERIOR_CHILD);
-        todo.push_back({kids[j], g[k].children[j]});
+        ASSERT_EQ(count[j], gpu::BVH_INTERIOR_CHILD);
+        todo.push_back({kids[j], child[j]});
       }
     }
   }
@@ -455,16 +456,17 @@ TEST(Surfaces, ClosestOfTrianglesAndShapesAndAlbedo) {
 
   const GpuSurfaces g = pack_gpu_surfaces(s);
   ASSERT_EQ(g.nodes.size(), 1u);  // the single leaf as the root's child 0, an empty leaf as child 1
-  EXPECT_EQ(g.nodes[0].children, glm::uvec4(0u, 0u, 1u, 0u));
+  const auto children = [](const gpu::GpuBvhNode& n) { return glm::uvec4(n.child0, n.child1, n.count0, n.count1); };
+  EXPECT_EQ(children(g.nodes[0]), glm::uvec4(0u, 0u, 1u, 0u));
   EXPECT_EQ(g.shape_count, 1u);
-  EXPECT_EQ(g.shapes[0].info.x, gpu::SURFACE_SPHERE);
-  EXPECT_EQ(g.attributes[0].info.x, 1u);
-  EXPECT_EQ(g.attributes[0].info.w, gpu::TRIANGLE_HAS_UVS);
-  EXPECT_EQ(g.materials[0].info.x, gpu::NO_TEXTURE);
-  EXPECT_EQ(g.materials[1].info.x, 0u);
+  EXPECT_EQ(g.shapes[0].kind, gpu::SURFACE_SPHERE);
+  EXPECT_EQ(g.attributes[0].material, 1u);
+  EXPECT_EQ(g.attributes[0].flags, gpu::TRIANGLE_HAS_UVS);
+  EXPECT_EQ(g.materials[0].texture_slot, gpu::NO_TEXTURE);
+  EXPECT_EQ(g.materials[1].texture_slot, 0u);
   const GpuSurfaces none = pack_gpu_surfaces(Surfaces{});
   EXPECT_EQ(none.nodes.size(), 1u);
-  EXPECT_EQ(none.nodes[0].children, glm::uvec4(0u, 0u, 0u, 0u));  // two empty leaves
+  EXPECT_EQ(children(none.nodes[0]), glm::uvec4(0u, 0u, 0u, 0u));  // two empty leaves
   EXPECT_EQ(none.triangles.size(), 1u);  // a dummy: Vulkan buffers cannot be empty
   EXPECT_EQ(none.triangle_count, 0u);
   EXPECT_EQ(none.shape_count, 0u);

@@ -1,10 +1,14 @@
 // Per-sequence work is done once: a VulkanRenderer with frame reuse keeps its
 // session (pipeline, BVH, environment) and reloads only the grids per frame,
 // and the frames it renders are bit-identical to fresh renders of each frame.
+// Likewise a live edit (the preview's): RenderSession::update re-packs only
+// the media's headers and renders what a fresh session of the edited scene does.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 
+#include "render/vulkan/Context.h"
+#include "render/vulkan/RenderSession.h"
 #include "render/vulkan/VulkanRenderer.h"
 #include "scene/Scene.h"
 #include "support/TestSupport.h"
@@ -83,4 +87,44 @@ TEST(SequenceReuse, KeptSessionRendersEachFrameAsAFreshOneDoes) {
   RenderResult small = seq.render(s, other, {});
   EXPECT_EQ(small.width, 10);
   EXPECT_EQ(seq.reused_frames(), 2);
+}
+
+// The preview's temperature edit ([ and ]): the session keeps its majorant
+// cells and blackbody LUT, and its render equals a fresh session's.
+TEST(SessionEdit, TemperatureEditRendersAsAFreshSessionDoes) {
+  fs::path dir = temp_dir("session-edit");
+  write_explosion_shell_vdb(dir / "g.vdb", Lattice{}, 3.0, 7.0, 1.5f, 2200.0f, 600.0f);
+  write_file(dir / "s.json", R"({
+    "camera": {"position": [0, 0.3, -3], "look_at": [0, 0, 0]},
+    "integrator": {"majorant_grid": [3, 2, 2]},
+    "media": [{"type": "vdb", "file": "g.vdb", "sigma_a": [1, 1, 1], "sigma_s": [2, 2, 2],
+               "emission": {"scale": 1}}]
+  })");
+  const Scene scene = load_scene(dir / "s.json");
+  Scene edited = scene;
+  edited.media[0].temperature.scale *= 1.25;
+  RenderSettings settings;
+  settings.width = 16;
+  settings.height = 12;
+  settings.seed = 3;
+  vk::Context::Options o;
+  o.validation = true;
+  vk::Context ctx(o);
+  const uint64_t before = vk::Context::total_validation_messages();
+  auto render = [](RenderSession& s) {
+    EXPECT_TRUE(s.run_pass(4));
+    RenderResult r;
+    s.read(r);
+    return r;
+  };
+  RenderSession kept(ctx, scene, settings);
+  const RenderResult original = render(kept);
+  kept.update(edited);
+  const RenderResult after_edit = render(kept);
+  RenderSession fresh(ctx, edited, settings);
+  const RenderResult expected = render(fresh);
+  EXPECT_EQ(after_edit.sum, expected.sum);
+  EXPECT_EQ(after_edit.sum_sq, expected.sum_sq);
+  EXPECT_NE(after_edit.sum, original.sum);  // the edit changed the image
+  EXPECT_EQ(vk::Context::total_validation_messages(), before);
 }

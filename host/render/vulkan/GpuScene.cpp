@@ -4,7 +4,6 @@
 
 #include "color/Blackbody.h"
 #include "color/EmissionModel.h"
-#include "light/AnalyticLights.h"
 #include "scene/MediumVolume.h"
 #include "util/Error.h"
 #include "volume/MajorantGrid.h"
@@ -83,96 +82,147 @@ DensityTemperatureTexels density_temperature_texels(const StoredGrid& density, c
   return out;
 }
 
-GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes, bool with_luts,
-                         uint64_t max_texture_bytes) {
+namespace {
+// The coefficients every medium has.
+gpu::GpuMedium medium_coefficients(const Medium& m) {
+  gpu::GpuMedium g{};
+  g.sigma_a = v3(m.sigma_a);
+  g.sigma_s = v3(m.sigma_s);
+  g.g = float(m.g);
+  return g;
+}
+
+// A sphere or box medium.
+gpu::GpuMedium pack_analytic_medium(const Medium& m) {
+  gpu::GpuMedium g = medium_coefficients(m);
+  const bool sphere = m.bounds.kind == Bounds::Kind::Sphere;
+  g.shape = sphere ? gpu::SHAPE_SPHERE : gpu::SHAPE_BOX;
+  // A medium emits sigma_a·Le per unit length (docs/scene-format.md "media").
+  g.emission = v3(m.sigma_a * homogeneous_le(m.emission));
+  if (sphere) {
+    g.center = v3(m.bounds.center);
+    g.radius = float(m.bounds.radius);
+  } else {
+    g.box_min = v3(m.bounds.min);
+    g.box_max = v3(m.bounds.max);
+  }
+  return g;
+}
+
+// How a grid medium emits: a constant Le, or the blackbody of its temperature
+// grid (that grid's texel map, temperature mapping and LUT coordinates), or not.
+void pack_grid_emission(const Medium& m, const StoredVolume& v, bool with_luts, gpu::GpuMedium& g,
+                        gpu::GpuGrid& grid, GpuGridSource& src) {
+  if (m.emission.rgb) {
+    g.emission = v3(*m.emission.rgb * m.emission.scale);
+    g.emission_mode = gpu::EMIT_CONSTANT;
+  } else if (needs_temperature_grid(m) && v.temperature && !v.temperature->grid.empty()) {
+    g.emission = v3(glm::dvec3(m.emission.scale));
+    g.emission_mode = gpu::EMIT_TEMPERATURE;
+    src.temperature = &*v.temperature;
+    texel_rows(v.temperature->grid, grid.temperature_row0, grid.temperature_row1, grid.temperature_row2);
+    grid.temperature_dims = v3(glm::dvec3(v.temperature->grid.dims));
+    grid.temperature_offset = float(m.temperature.offset);
+    grid.temperature_scale = float(m.temperature.scale);
+    grid.cutoff_k = float(m.temperature.cutoff_k);
+    if (with_luts) src.blackbody.emplace(m.emission.blackbody, m.emission.observer, m.emission.adapt_to_k);
+    set_blackbody_lut(grid, src.blackbody ? src.blackbody->params() : color::BlackbodyLutParams{});
+  } else {
+    g.emission_mode = gpu::EMIT_NONE;
+  }
+}
+
+// Medium i, a grid, in the next grid slot: its GpuMedium, GpuGrid (all but the
+// majorant cells' geometry, add_majorant_cells') and source.
+void pack_grid_medium(const Medium& m, size_t i, const StoredVolume& v, bool with_luts, GpuScene& out) {
+  gpu::GpuMedium g = medium_coefficients(m);
+  g.shape = gpu::SHAPE_GRID;
+  g.grid_slot = uint32_t(out.grids.size());
+  gpu::GpuGrid grid{};
+  GpuGridSource src;
+  src.medium = i;
+  src.density = &v.density;
+  texel_rows(v.density.grid, grid.density_row0, grid.density_row1, grid.density_row2);
+  grid.density_dims = v3(glm::dvec3(v.density.grid.dims));
+  grid.density_scale = float(m.density_scale);
+  // Depends on the medium's coefficients, not on the cells: edits change it.
+  grid.majorant_scale = float(max3(m.sigma_a + m.sigma_s) * m.density_scale);
+  pack_grid_emission(m, v, with_luts, g, grid, src);
+  out.has_emission = out.has_emission || (g.emission_mode != gpu::EMIT_NONE && m.emission.scale > 0.0);
+  out.media.push_back(g);
+  out.grids.push_back(grid);
+  out.grid_sources.push_back(std::move(src));
+  out.has_grids = true;
+}
+
+// One texture per grid for density and temperature where every emitting grid
+// allows it: the shader variant reads the temperature one way for all.
+bool every_temperature_fits_density(const std::vector<GpuGridSource>& sources, uint64_t max_texture_bytes) {
+  bool any_temperature = false, all_fit = true;
+  for (const GpuGridSource& src : sources)
+    if (src.temperature) {
+      any_temperature = true;
+      all_fit = all_fit && temperature_fits_density_texture(*src.density, *src.temperature, max_texture_bytes);
+    }
+  return any_temperature && all_fit;
+}
+}  // namespace
+
+GpuScene pack_gpu_media(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes, bool with_luts) {
   GpuScene out;
   for (size_t i = 0; i < scene.media.size(); ++i) {
     const Medium& m = scene.media[i];
-    gpu::GpuMedium g{};
-    g.sigma_s = v3(m.sigma_s);
-    g.g = float(m.g);
     if (m.type == Medium::Type::Homogeneous) {
-      bool sphere = m.bounds.kind == Bounds::Kind::Sphere;
-      g.sigma_a = v3(m.sigma_a);
-      g.shape = sphere ? gpu::SHAPE_SPHERE : gpu::SHAPE_BOX;
+      out.media.push_back(pack_analytic_medium(m));
       out.has_analytic = true;
-      // A medium emits sigma_a·Le per unit length (docs/scene-format.md "media").
-      g.emission = v3(m.sigma_a * homogeneous_le(m.emission));
-      if (sphere) {
-        g.center = v3(m.bounds.center);
-        g.radius = float(m.bounds.radius);
-      } else {
-        g.box_min = v3(m.bounds.min);
-        g.box_max = v3(m.bounds.max);
-      }
-      out.has_emission = out.has_emission || max3(glm::dvec3(g.emission)) > 0.0;
+      out.has_emission = out.has_emission || max3(glm::dvec3(out.media.back().emission)) > 0.0;
     } else {
       const StoredVolume& v = *volumes.at(i);
       if (v.density.grid.empty()) continue;  // an empty grid renders as no medium
       if (out.grids.size() >= gpu::MAX_GRIDS)
         throw input_error(scene.file.string(), "media[" + std::to_string(i) + "]",
                           "at most " + std::to_string(gpu::MAX_GRIDS) + " vdb media per scene");
-      const uint32_t slot = uint32_t(out.grids.size());
-      g.sigma_a = v3(m.sigma_a);
-      g.shape = gpu::SHAPE_GRID;
-      g.grid_slot = slot;
-
-      gpu::GpuGrid grid{};
-      GpuGridSource src;
-      src.medium = i;
-      src.density = &v.density;
-      texel_rows(v.density.grid, grid.density_row0, grid.density_row1, grid.density_row2);
-      grid.density_dims = v3(glm::dvec3(v.density.grid.dims));
-      grid.density_scale = float(m.density_scale);
-      if (m.emission.rgb) {
-        g.emission = v3(*m.emission.rgb * m.emission.scale);
-        g.emission_mode = gpu::EMIT_CONSTANT;
-      } else if (needs_temperature_grid(m) && v.temperature && !v.temperature->grid.empty()) {
-        g.emission = v3(glm::dvec3(m.emission.scale));
-        g.emission_mode = gpu::EMIT_TEMPERATURE;
-        src.temperature = &*v.temperature;
-        texel_rows(v.temperature->grid, grid.temperature_row0, grid.temperature_row1, grid.temperature_row2);
-        grid.temperature_dims = v3(glm::dvec3(v.temperature->grid.dims));
-        grid.temperature_offset = float(m.temperature.offset);
-        grid.temperature_scale = float(m.temperature.scale);
-        grid.cutoff_k = float(m.temperature.cutoff_k);
-        if (with_luts) src.blackbody.emplace(m.emission.blackbody, m.emission.observer, m.emission.adapt_to_k);
-        color::BlackbodyLutParams p = src.blackbody ? src.blackbody->params() : color::BlackbodyLutParams{};
-        set_blackbody_lut(grid, p);
-      } else {
-        g.emission_mode = gpu::EMIT_NONE;
-      }
-      out.has_emission = out.has_emission || (g.emission_mode != gpu::EMIT_NONE && m.emission.scale > 0.0);
-
-      // Majorant cells over the stored (rounded) density.
-      glm::ivec3 res = scene.integrator.majorant == "global"
-                           ? glm::ivec3(1)
-                           : scene.integrator.majorant_grid.value_or(default_majorant_resolution(v.density.grid.dims));
-      MajorantGrid mg = build_majorant_grid(v.density.grid, res);
-      grid.majorant_res = gpu::uvec3(uint32_t(mg.res.x), uint32_t(mg.res.y), uint32_t(mg.res.z));
-      grid.majorant_offset = uint32_t(out.majorants.size());
-      grid.majorant_cell = v3(mg.cell_size);
-      grid.majorant_scale = float(max3(m.sigma_a + m.sigma_s) * m.density_scale);
-      out.majorants.insert(out.majorants.end(), mg.max_density.begin(), mg.max_density.end());
-      out.grids.push_back(grid);
-      out.grid_sources.push_back(std::move(src));
-      out.has_grids = true;
+      pack_grid_medium(m, i, v, with_luts, out);
     }
     out.has_scattering = out.has_scattering || max3(m.sigma_s) > 0.0;
-    out.media.push_back(g);
   }
-  // One texture per grid for density and temperature where every emitting
-  // grid allows it: the shader variant reads the temperature one way for all.
-  bool any_temperature = false, all_fit = true;
-  for (const GpuGridSource& src : out.grid_sources)
-    if (src.temperature) {
-      any_temperature = true;
-      all_fit = all_fit && temperature_fits_density_texture(*src.density, *src.temperature, max_texture_bytes);
-    }
-  out.temperature_in_density = any_temperature && all_fit;
   if (out.media.size() > gpu::MAX_MEDIA)
     throw input_error(scene.file.string(), "media", "at most " + std::to_string(gpu::MAX_MEDIA) + " media are supported");
   return out;
+}
+
+void add_majorant_cells(const Scene& scene, GpuScene& g) {
+  g.majorants.clear();
+  for (size_t slot = 0; slot < g.grids.size(); ++slot) {
+    // Majorant cells over the stored (rounded) density.
+    const DenseGrid& density = g.grid_sources[slot].density->grid;
+    const glm::ivec3 res = scene.integrator.majorant == "global"
+                               ? glm::ivec3(1)
+                               : scene.integrator.majorant_grid.value_or(default_majorant_resolution(density.dims));
+    const MajorantGrid mg = build_majorant_grid(density, res);
+    gpu::GpuGrid& grid = g.grids[slot];
+    grid.majorant_res = gpu::uvec3(uint32_t(mg.res.x), uint32_t(mg.res.y), uint32_t(mg.res.z));
+    grid.majorant_offset = uint32_t(g.majorants.size());
+    grid.majorant_cell = v3(mg.cell_size);
+    g.majorants.insert(g.majorants.end(), mg.max_density.begin(), mg.max_density.end());
+  }
+}
+
+GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes, bool with_luts,
+                         uint64_t max_texture_bytes) {
+  GpuScene out = pack_gpu_media(scene, volumes, with_luts);
+  add_majorant_cells(scene, out);
+  out.temperature_in_density = every_temperature_fits_density(out.grid_sources, max_texture_bytes);
+  return out;
+}
+
+void keep_baked_grid_fields(const gpu::GpuGrid& baked, gpu::GpuGrid& grid) {
+  grid.lut_scale = baked.lut_scale;
+  grid.lut_offset = baked.lut_offset;
+  grid.t_min_k = baked.t_min_k;
+  grid.majorant_res = baked.majorant_res;
+  grid.majorant_offset = baked.majorant_offset;
+  grid.majorant_cell = baked.majorant_cell;
 }
 
 void set_blackbody_lut(gpu::GpuGrid& grid, const color::BlackbodyLutParams& p) {
@@ -181,7 +231,8 @@ void set_blackbody_lut(gpu::GpuGrid& grid, const color::BlackbodyLutParams& p) {
   grid.t_min_k = p.t_min_k;
 }
 
-gpu::FrameConstants build_frame_constants(const Scene& scene, const RenderSettings& s, uint32_t medium_count) {
+gpu::FrameConstants build_frame_constants(const Scene& scene, const RenderSettings& s, uint32_t medium_count,
+                                          const LightSelection& lights) {
   const Camera& c = scene.camera;
   glm::dvec3 forward = glm::normalize(c.look_at - c.position);
   glm::dvec3 right = glm::normalize(glm::cross(forward, c.up));  // image x grows along cross(forward, up)
@@ -202,50 +253,11 @@ gpu::FrameConstants build_frame_constants(const Scene& scene, const RenderSettin
   f.seed = s.seed;
   f.frame_index = s.frame;
   f.transparent = scene.film.transparent ? 1u : 0u;
+  f.p_env = float(lights.p_env);
+  f.p_continue_own = float(lights.p_continue_own);
+  f.surface_light_samples = uint32_t(lights.surface_light_samples);
+  f.ratio_tracked_continuation = lights.ratio_tracked_continuation ? 1u : 0u;
   return f;
 }
 
-}  // namespace pyrolume
-
-namespace pyrolume {
-std::vector<gpu::GpuLight> pack_gpu_lights(const Scene& scene, const LightSelection& selection) {
-  std::vector<gpu::GpuLight> out;
-  for (size_t i = 0; i < scene.lights.size(); ++i) {
-    const Light& l = scene.lights[i];
-    gpu::GpuLight g{};
-    const glm::dvec3 value = l.type == Light::Type::Distant && !l.is_delta() ? disc_radiance(l) : light_value(l);
-    g.value = gpu::vec3(value);
-    g.pick_probability = float(i < selection.p_light.size() ? selection.p_light[i] : 0.0);
-    g.direction = gpu::vec3(l.direction);
-    switch (l.type) {
-      case Light::Type::Point:
-        g.kind = gpu::LIGHT_POINT;
-        g.position = gpu::vec3(l.position);
-        break;
-      case Light::Type::Spot: {
-        g.kind = gpu::LIGHT_SPOT;
-        g.position = gpu::vec3(l.position);
-        const SpotCone c = spot_cone(l);
-        g.cos_cone = float(c.cos_end);
-        g.cos_falloff = float(c.cos_start);
-        break;
-      }
-      case Light::Type::Distant: {
-        g.kind = l.is_delta() ? gpu::LIGHT_DISTANT : gpu::LIGHT_DISC;
-        const double s = std::sin(disc_half_angle(l));
-        g.one_minus_cos = float(disc_one_minus_cos(l));
-        g.sin2 = float(s * s);
-        break;
-      }
-      case Light::Type::Sphere:
-        g.kind = gpu::LIGHT_SPHERE;
-        g.position = gpu::vec3(l.center);
-        g.radius = float(l.radius);
-        break;
-    }
-    out.push_back(g);
-  }
-  if (out.empty()) out.push_back(gpu::GpuLight{});
-  return out;
-}
 }  // namespace pyrolume

@@ -10,7 +10,6 @@
 #include "render/Render.h"
 #include "scene/Scene.h"
 #include "shared/gpu_types.h"
-#include "shared/light_types.h"
 #include "volume/StoredVolume.h"
 
 namespace pyrolume {
@@ -56,20 +55,27 @@ DensityTemperatureTexels density_temperature_texels(const StoredGrid& density, c
 // volumes[i] holds medium i's grids when it is a vdb medium. Empty grids are
 // left out (they render as no medium). `with_luts` = false skips the blackbody
 // LUT bake (for updates that keep the existing textures); max_texture_bytes
-// bounds one texture (the device's largest allocation).
+// bounds one texture (the device's largest allocation). The composition of
+// pack_gpu_media, add_majorant_cells and the temperature_in_density choice.
 GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes,
                          bool with_luts = true,
                          uint64_t max_texture_bytes = std::numeric_limits<uint64_t>::max());
+// The media and grid headers alone (no majorant cells: GpuGrid majorant_res,
+// majorant_offset and majorant_cell stay 0; temperature_in_density false):
+// all that a live edit of a medium's parameters changes.
+GpuScene pack_gpu_media(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes,
+                        bool with_luts = true);
+// Each grid's majorant cells (from its density as stored and the scene's
+// integrator.majorant settings) into g.majorants, and where they lie into its GpuGrid.
+void add_majorant_cells(const Scene& scene, GpuScene& g);
+// The fields of a GpuGrid that describe what the session baked (the blackbody
+// LUT's coordinates, the majorant cells' geometry), copied from `baked`.
+void keep_baked_grid_fields(const gpu::GpuGrid& baked, gpu::GpuGrid& grid);
 // The grid's blackbody LUT coordinate map (GpuGrid lut_scale, lut_offset, t_min_k).
 void set_blackbody_lut(gpu::GpuGrid& grid, const color::BlackbodyLutParams& p);
 
-gpu::FrameConstants build_frame_constants(const Scene& scene, const RenderSettings& settings, uint32_t medium_count);
+// The camera, image and integrator settings, and next-event estimation's choices.
+gpu::FrameConstants build_frame_constants(const Scene& scene, const RenderSettings& settings, uint32_t medium_count,
+                                          const LightSelection& lights);
 
-}  // namespace pyrolume
-
-namespace pyrolume {
-// The scene's analytic lights as GpuLight (docs/lights.md "Analytic lights"),
-// with light selection's probabilities; one zero placeholder when there are
-// none (a storage buffer cannot be empty).
-std::vector<gpu::GpuLight> pack_gpu_lights(const Scene& scene, const LightSelection& selection);
 }  // namespace pyrolume

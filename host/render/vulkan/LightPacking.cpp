@@ -1,6 +1,9 @@
 #include "render/vulkan/LightPacking.h"
 
+#include <cmath>
 #include <stdexcept>
+
+#include "light/AnalyticLights.h"
 
 namespace pyrolume {
 
@@ -56,6 +59,25 @@ gpu::GpuEmissionCdf pack_gpu_emission_header(const EmissionCdf& cdf, uint32_t en
   return g;
 }
 
+GpuEmissionLights pack_gpu_emission_lights(const std::vector<const EmissionCdf*>& by_slot,
+                                           const std::vector<double>& pick) {
+  GpuEmissionLights out;
+  for (size_t slot = 0; slot < by_slot.size(); ++slot) {
+    if (!by_slot[slot]) continue;
+    const EmissionCdf& c = *by_slot[slot];
+    gpu::GpuEmissionCdf h = pack_gpu_emission_header(c, uint32_t(out.cdf.size()), uint32_t(out.pmf.size()),
+                                                     uint32_t(out.clusters.size()));
+    h.pick_probability = float(pick[slot]);
+    out.headers.at(slot) = h;
+    out.cdf.insert(out.cdf.end(), c.cluster_cdf().begin(), c.cluster_cdf().end());
+    out.cells.insert(out.cells.end(), c.entry_cells().begin(), c.entry_cells().end());
+    out.pmf.insert(out.pmf.end(), c.cluster_pmf().begin(), c.cluster_pmf().end());
+    const std::vector<gpu::GpuEmissionCluster> clusters = pack_gpu_emission_clusters(c);
+    out.clusters.insert(out.clusters.end(), clusters.begin(), clusters.end());
+  }
+  return out;
+}
+
 gpu::GpuEnvironment pack_gpu_environment_header(const EnvironmentMap& env) {
   gpu::GpuEnvironment g{};
   g.cos_rotation = float(env.cos_rotation());
@@ -81,6 +103,47 @@ std::vector<float> pack_gpu_environment_texels(const EnvironmentMap& env) {
       t[k * 4 + 3] = float(env.pdf_uv_texel(i, j));
     }
   return t;
+}
+
+std::vector<gpu::GpuLight> pack_gpu_lights(const Scene& scene, const LightSelection& selection) {
+  std::vector<gpu::GpuLight> out;
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& l = scene.lights[i];
+    gpu::GpuLight g{};
+    const glm::dvec3 value = l.type == Light::Type::Distant && !l.is_delta() ? disc_radiance(l) : light_value(l);
+    g.value = gpu::vec3(value);
+    g.pick_probability = float(i < selection.p_light.size() ? selection.p_light[i] : 0.0);
+    g.direction = gpu::vec3(l.direction);
+    switch (l.type) {
+      case Light::Type::Point:
+        g.kind = gpu::LIGHT_POINT;
+        g.position = gpu::vec3(l.position);
+        break;
+      case Light::Type::Spot: {
+        g.kind = gpu::LIGHT_SPOT;
+        g.position = gpu::vec3(l.position);
+        const SpotCone c = spot_cone(l);
+        g.cos_cone = float(c.cos_end);
+        g.cos_falloff = float(c.cos_start);
+        break;
+      }
+      case Light::Type::Distant: {
+        g.kind = l.is_delta() ? gpu::LIGHT_DISTANT : gpu::LIGHT_DISC;
+        const double s = std::sin(disc_half_angle(l));
+        g.one_minus_cos = float(disc_one_minus_cos(l));
+        g.sin2 = float(s * s);
+        break;
+      }
+      case Light::Type::Sphere:
+        g.kind = gpu::LIGHT_SPHERE;
+        g.position = gpu::vec3(l.center);
+        g.radius = float(l.radius);
+        break;
+    }
+    out.push_back(g);
+  }
+  if (out.empty()) out.push_back(gpu::GpuLight{});
+  return out;
 }
 
 }  // namespace pyrolume

@@ -425,7 +425,6 @@ void RenderSession::create_environment(const Scene& scene) {
 RenderSession::EmissionLights RenderSession::build_emission_lights(
     const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes, const GpuScene& g) const {
   EmissionLights out;
-  out.headers.assign(gpu::MAX_GRIDS, gpu::GpuEmissionCdf{});
   std::vector<std::optional<EmissionCdf>> cdfs(scene.media.size());
   std::vector<const EmissionCdf*> by_medium(scene.media.size(), nullptr);
   if (light_candidates(scene).media)
@@ -438,46 +437,38 @@ RenderSession::EmissionLights RenderSession::build_emission_lights(
   out.selection = select_lights(scene, environment_ ? &*environment_ : nullptr, by_medium);
   out.analytic = pack_gpu_lights(scene, out.selection);
   if (out.selection.strategy == LightStrategy::Bsdf) return out;
+  // By grid slot: the CDFs next-event estimation may pick.
+  std::vector<const EmissionCdf*> by_slot(g.grid_sources.size(), nullptr);
+  std::vector<double> pick(g.grid_sources.size(), 0.0);
   for (size_t slot = 0; slot < g.grid_sources.size(); ++slot) {
     const size_t i = g.grid_sources[slot].medium;
     if (!by_medium[i] || !(out.selection.p_medium[i] > 0.0)) continue;
-    const EmissionCdf& c = *by_medium[i];
-    gpu::GpuEmissionCdf h = pack_gpu_emission_header(c, uint32_t(out.cdf.size()), uint32_t(out.pmf.size()),
-                                                     uint32_t(out.clusters.size()));
-    h.pick_probability = float(out.selection.p_medium[i]);
-    out.headers[slot] = h;
-    out.cdf.insert(out.cdf.end(), c.cluster_cdf().begin(), c.cluster_cdf().end());
-    out.cells.insert(out.cells.end(), c.entry_cells().begin(), c.entry_cells().end());
-    out.pmf.insert(out.pmf.end(), c.cluster_pmf().begin(), c.cluster_pmf().end());
-    const std::vector<gpu::GpuEmissionCluster> clusters = pack_gpu_emission_clusters(c);
-    out.clusters.insert(out.clusters.end(), clusters.begin(), clusters.end());
+    by_slot[slot] = by_medium[i];
+    pick[slot] = out.selection.p_medium[i];
   }
+  out.emission = pack_gpu_emission_lights(by_slot, pick);
   return out;
 }
 
 void RenderSession::upload_emission_lights(const EmissionLights& lights) {
   light_selection_ = lights.selection;
-  emission_cdf_ = storage_buffer(ctx_, lights.cdf, "emission cdf");
-  emission_cells_ = storage_buffer(ctx_, lights.cells, "emission cells");
-  emission_pmf_ = storage_buffer(ctx_, lights.pmf, "emission pmf");
-  emission_clusters_ = storage_buffer(ctx_, lights.clusters, "emission clusters");
+  const GpuEmissionLights& e = lights.emission;
+  emission_cdf_ = storage_buffer(ctx_, e.cdf, "emission cdf");
+  emission_cells_ = storage_buffer(ctx_, e.cells, "emission cells");
+  emission_pmf_ = storage_buffer(ctx_, e.pmf, "emission pmf");
+  emission_clusters_ = storage_buffer(ctx_, e.clusters, "emission clusters");
   analytic_lights_ = storage_buffer(ctx_, lights.analytic, "analytic lights");
-  emission_headers_.upload(ctx_, lights.headers.data(), lights.headers.size() * sizeof(gpu::GpuEmissionCdf));
+  emission_headers_.upload(ctx_, e.headers.data(), e.headers.size() * sizeof(gpu::GpuEmissionCdf));
 }
 
 void RenderSession::upload_constants(const Scene& scene) {
-  GpuScene now = build_gpu_scene(scene, volumes_, /*with_luts=*/false);
-  // Keep the LUT parameters of the baked textures (the mode is not editable live).
-  for (size_t i = 0; i < now.grids.size() && i < gpu_scene_.grids.size(); ++i) {
-    now.grids[i].lut_scale = gpu_scene_.grids[i].lut_scale;
-    now.grids[i].lut_offset = gpu_scene_.grids[i].lut_offset;
-    now.grids[i].t_min_k = gpu_scene_.grids[i].t_min_k;
-  }
-  gpu::FrameConstants frame = build_frame_constants(scene, settings_, uint32_t(now.media.size()));
-  frame.p_env = float(light_selection_.p_env);
-  frame.p_continue_own = float(light_selection_.p_continue_own);
-  frame.surface_light_samples = uint32_t(light_selection_.surface_light_samples);
-  frame.ratio_tracked_continuation = light_selection_.ratio_tracked_continuation ? 1u : 0u;
+  // Only the headers: the blackbody LUTs and majorant cells stay as baked (an
+  // edit changes neither the emission's mode nor the grids), so they are not
+  // rebuilt; the majorant scale, which follows the coefficients, is.
+  GpuScene now = pack_gpu_media(scene, volumes_, /*with_luts=*/false);
+  for (size_t i = 0; i < now.grids.size() && i < gpu_scene_.grids.size(); ++i)
+    keep_baked_grid_fields(gpu_scene_.grids[i], now.grids[i]);
+  const gpu::FrameConstants frame = build_frame_constants(scene, settings_, uint32_t(now.media.size()), light_selection_);
   frame_buffer_.upload(ctx_, &frame, sizeof frame);
   if (!now.media.empty()) media_buffer_.upload(ctx_, now.media.data(), now.media.size() * sizeof(gpu::GpuMedium));
   if (!now.grids.empty()) grid_buffer_.upload(ctx_, now.grids.data(), now.grids.size() * sizeof(gpu::GpuGrid));

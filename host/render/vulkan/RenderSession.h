@@ -10,11 +10,13 @@
 #include "render/Render.h"
 #include "render/vulkan/Context.h"
 #include "render/vulkan/GpuScene.h"
+#include "render/vulkan/LightPacking.h"
 #include "render/vulkan/Memory.h"
 #include "render/vulkan/Pipeline.h"
 #include "render/vulkan/SurfacePacking.h"
 #include "scene/Scene.h"
 #include "shared/gpu_types.h"
+#include "shared/light_types.h"
 #include "light/EnvironmentMap.h"
 #include "light/LightSelection.h"
 #include "volume/StoredVolume.h"
@@ -103,11 +105,8 @@ class RenderSession {
   // next-event estimation (docs/mis.md), from the loaded volumes.
   struct EmissionLights {
     LightSelection selection;
-    std::vector<float> cdf, pmf;
-    std::vector<uint32_t> cells;
-    std::vector<gpu::GpuEmissionCluster> clusters;
-    std::vector<gpu::GpuEmissionCdf> headers;  // per grid slot (MAX_GRIDS)
-    std::vector<gpu::GpuLight> analytic;       // the scene's `lights` (one placeholder when none)
+    GpuEmissionLights emission;
+    std::vector<gpu::GpuLight> analytic;  // the scene's `lights` (one placeholder when none)
   };
   EmissionLights build_emission_lights(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes,
                                        const GpuScene& gpu_scene) const;

@@ -20,8 +20,8 @@ std::vector<gpu::GpuBvhNode> pack_gpu_nodes(const Bvh& bvh) {
     g.x[2 + k] = c.bounds_max.x;
     g.y[2 + k] = c.bounds_max.y;
     g.z[2 + k] = c.bounds_max.z;
-    g.children[k] = c.is_leaf() ? c.offset : target;
-    g.children[2 + k] = c.is_leaf() ? c.count : gpu::BVH_INTERIOR_CHILD;
+    (k == 0 ? g.child0 : g.child1) = c.is_leaf() ? c.offset : target;
+    (k == 0 ? g.count0 : g.count1) = c.is_leaf() ? c.count : gpu::BVH_INTERIOR_CHILD;
   };
   if (bvh.nodes.empty() || bvh.nodes[0].is_leaf()) {
     // A root that is a leaf (or a Bvh never built): its triangles as child 0,
@@ -45,14 +45,17 @@ std::vector<gpu::GpuBvhNode> pack_gpu_nodes(const Bvh& bvh) {
 
 gpu::GpuSurfaceShape pack_gpu_shape(const SurfaceShape& s) {
   gpu::GpuSurfaceShape g{};
+  g.center = gpu::vec3(s.center);
+  g.material = s.material;
   if (s.type == SurfaceShape::Type::Sphere) {
-    g.p0 = glm::vec4(glm::vec3(s.center), float(s.radius));
-    g.info = glm::uvec4(gpu::SURFACE_SPHERE, s.material, 0u, 0u);
+    g.kind = gpu::SURFACE_SPHERE;
+    g.radius = float(s.radius);
   } else {
-    g.p0 = glm::vec4(glm::vec3(s.center), float(s.half_u));
-    g.p1 = glm::vec4(glm::vec3(s.normal), float(s.half_v));
-    g.p2 = glm::vec4(glm::vec3(s.u_axis), 0.0f);
-    g.info = glm::uvec4(gpu::SURFACE_PLANE, s.material, 0u, 0u);
+    g.kind = gpu::SURFACE_PLANE;
+    g.normal = gpu::vec3(s.normal);
+    g.half_u = float(s.half_u);
+    g.u_axis = gpu::vec3(s.u_axis);
+    g.half_v = float(s.half_v);
   }
   return g;
 }
@@ -63,22 +66,25 @@ GpuSurfaces pack_gpu_surfaces(const Surfaces& s) {
   g.triangle_count = uint32_t(s.bvh.triangles.size());
   for (const Triangle& t : s.bvh.triangles) {
     gpu::GpuTriangle gt{};
-    gt.v0 = glm::vec4(t.p[0], 0.0f);
-    gt.v1 = glm::vec4(t.p[1], 0.0f);
-    gt.v2 = glm::vec4(t.p[2], 0.0f);
+    gt.v0 = t.p[0];
+    gt.v1 = t.p[1];
+    gt.v2 = t.p[2];
     g.triangles.push_back(gt);
     gpu::GpuTriangleAttributes a{};
     if (t.has_normals) {
-      a.n0 = glm::vec4(t.n[0], 0.0f);
-      a.n1 = glm::vec4(t.n[1], 0.0f);
-      a.n2 = glm::vec4(t.n[2], 0.0f);
+      a.n0 = t.n[0];
+      a.n1 = t.n[1];
+      a.n2 = t.n[2];
     }
     if (t.has_uvs) {
-      a.uv01 = glm::vec4(t.uv[0], t.uv[1]);
-      a.uv2 = glm::vec4(t.uv[2], 0.0f, 0.0f);
+      a.uv0 = t.uv[0];
+      a.uv1 = t.uv[1];
+      a.uv2 = t.uv[2];
     }
-    a.info = glm::uvec4(t.material, t.source, t.mesh,
-                        (t.has_normals ? gpu::TRIANGLE_HAS_NORMALS : 0u) | (t.has_uvs ? gpu::TRIANGLE_HAS_UVS : 0u));
+    a.material = t.material;
+    a.source = t.source;
+    a.mesh = t.mesh;
+    a.flags = (t.has_normals ? gpu::TRIANGLE_HAS_NORMALS : 0u) | (t.has_uvs ? gpu::TRIANGLE_HAS_UVS : 0u);
     g.attributes.push_back(a);
   }
   if (g.triangles.empty()) {
@@ -90,12 +96,12 @@ GpuSurfaces pack_gpu_surfaces(const Surfaces& s) {
   if (g.shapes.empty()) g.shapes.push_back({});
   for (const Material& m : s.materials) {
     gpu::GpuMaterial gm{};
-    gm.albedo = glm::vec4(glm::vec3(m.albedo), 0.0f);
-    gm.info = glm::uvec4(m.texture < 0 ? gpu::NO_TEXTURE : uint32_t(m.texture), 0u, 0u, 0u);
+    gm.albedo = gpu::vec3(m.albedo);
+    gm.texture_slot = m.texture < 0 ? gpu::NO_TEXTURE : uint32_t(m.texture);
     g.materials.push_back(gm);
   }
   if (g.materials.empty())
-    g.materials.push_back({glm::vec4(0.5f, 0.5f, 0.5f, 0.0f), glm::uvec4(gpu::NO_TEXTURE, 0, 0, 0)});
+    g.materials.push_back({gpu::vec3(0.5f), gpu::NO_TEXTURE});
   return g;
 }
 
