@@ -66,6 +66,16 @@ struct Film {
   uint32_t seed = 1;
 };
 
+// How emission in media is collected: at absorptions only, or at every
+// tentative collision (docs/rendering.md "Emission estimators").
+enum class EmissionEstimator { Absorption, Collision };
+// Per-cell majorants walked by DDA, or one bound per grid (integrator.majorant).
+enum class Majorant { Grid, Global };
+
+// Their names in the scene file and in --stats.
+inline const char* to_string(EmissionEstimator e) { return e == EmissionEstimator::Collision ? "collision" : "absorption"; }
+inline const char* to_string(Majorant m) { return m == Majorant::Global ? "global" : "grid"; }
+
 struct Integrator {
   int max_depth = 8;
   // Light sampling: next-event estimation + MIS (docs/mis.md "When light
@@ -82,11 +92,11 @@ struct Integrator {
   // Debug: next-event estimation only, no BSDF/phase-found light (docs/mis.md);
   // asks for light sampling as "mis": true does.
   bool light_only = false;
-  // As the file writes it: "auto" | "absorption" | "collision". "auto" is
-  // "collision" where lights are sampled (what MIS needs), otherwise
-  // "absorption"; LightSelection::estimator is the value a render uses.
-  std::string emission_estimator = "auto";
-  std::string majorant = "grid";                  // "grid" | "global"
+  // The file's "absorption" | "collision"; unset: "auto", which is
+  // collision where lights are sampled (what MIS needs), otherwise absorption.
+  // LightSelection::estimator is the value a render uses.
+  std::optional<EmissionEstimator> emission_estimator;
+  Majorant majorant = Majorant::Grid;
   std::optional<glm::ivec3> majorant_grid;
 };
 
@@ -149,7 +159,7 @@ struct Medium {
   TemperatureMapping temperature;
   Transform transform;
   int downsample = 1;
-  std::string texture_format = "r16f";  // "r16f" | "r32f" (R32F is also used when values exceed R16F)
+  TextureFormat texture_format = TextureFormat::R16F;  // R32F is also used when values exceed R16F
 };
 
 // A surface: a triangle mesh (OBJ), an analytic sphere, or a plane (a

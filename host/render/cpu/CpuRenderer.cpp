@@ -804,7 +804,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   res.backend = name();
   res.device = device_name();
   res.light_strategy = strategy_name(lights.selection.strategy);
-  res.emission_estimator = estimator_name(lights.selection.estimator);
+  res.emission_estimator = to_string(lights.selection.estimator);
   res.spp_target = settings.spp;
   res.sum.assign(size_t(W) * H * 3, 0.0);
   res.sum_sq.assign(size_t(W) * H * 3, 0.0);

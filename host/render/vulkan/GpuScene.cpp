@@ -145,7 +145,7 @@ GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<Sto
       out.has_emission = out.has_emission || (g.emission_mode != gpu::EMIT_NONE && m.emission.scale > 0.0);
 
       // Majorant cells over the stored (rounded) density.
-      glm::ivec3 res = scene.integrator.majorant == "global"
+      glm::ivec3 res = scene.integrator.majorant == Majorant::Global
                            ? glm::ivec3(1)
                            : scene.integrator.majorant_grid.value_or(default_majorant_resolution(v.density.grid.dims));
       MajorantGrid mg = build_majorant_grid(v.density.grid, res);

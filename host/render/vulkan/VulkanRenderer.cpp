@@ -68,7 +68,7 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
   result.backend = name();
   result.device = device_name();
   result.light_strategy = strategy_name(session.light_selection().strategy);
-  result.emission_estimator = estimator_name(session.light_selection().estimator);
+  result.emission_estimator = to_string(session.light_selection().estimator);
   result.warnings = session.warnings();
   result.load_seconds = since(load_start) + context_seconds_;
   context_seconds_ = 0.0;
