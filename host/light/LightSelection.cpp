@@ -34,7 +34,7 @@ bool media_scatter(const Scene& scene) {
 LightCandidates light_candidates(const Scene& scene) {
   const Integrator& in = scene.integrator;
   LightCandidates c;
-  if (in.mis == false || in.emission_estimator == EmissionEstimator::Absorption || in.max_depth < 1) return c;
+  if (!in.allows_light_sampling() || in.max_depth < 1) return c;
   const bool surfaces = !scene.shapes.empty();
   const bool scatters = surfaces || media_scatter(scene);
   const bool asked = in.mis == true || in.light_only;

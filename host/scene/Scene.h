@@ -98,6 +98,12 @@ struct Integrator {
   std::optional<EmissionEstimator> emission_estimator;
   Majorant majorant = Majorant::Grid;
   std::optional<glm::ivec3> majorant_grid;
+
+  // Whether these keys let light sampling run at all: "mis": false turns it
+  // off, and so does the absorption estimator (MIS needs the collision one).
+  // The one rule behind light_candidates (host/light/LightSelection.h; it
+  // also needs max_depth >= 1) and integrator_conflict (which names the key).
+  bool allows_light_sampling() const { return mis != false && emission_estimator != EmissionEstimator::Absorption; }
 };
 
 struct Environment {

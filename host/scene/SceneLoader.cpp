@@ -369,19 +369,20 @@ Shape read_shape(Reader r, const std::filesystem::path& base) {
 }  // namespace
 
 std::optional<IntegratorConflict> integrator_conflict(const Integrator& in, bool has_lights) {
-  const bool absorption = in.emission_estimator == EmissionEstimator::Absorption;
-  if (has_lights && in.mis == false)
+  if (in.allows_light_sampling()) return std::nullopt;
+  const bool mis_off = in.mis == false;  // otherwise the absorption estimator turned it off
+  if (has_lights && mis_off)
     return IntegratorConflict{"mis", "false turns off light sampling, the only way the scene's \"lights\" are reached "
                                      "(remove it, or remove the lights)"};
-  if (has_lights && absorption)
+  if (has_lights)
     return IntegratorConflict{"emission_estimator", "\"absorption\" turns off light sampling, the only way the scene's "
                                                     "\"lights\" are reached (write \"auto\" or leave it out)"};
-  if (in.light_only && in.mis == false)
+  if (in.light_only && mis_off)
     return IntegratorConflict{"light_only", "true asks for light sampling, which \"mis\": false turns off"};
-  if (in.light_only && absorption)
+  if (in.light_only)
     return IntegratorConflict{"light_only", "true asks for light sampling, which needs the collision estimator, "
                                             "not \"emission_estimator\": \"absorption\" (write \"auto\" or leave it out)"};
-  if (in.mis == true && absorption)
+  if (in.mis == true)
     return IntegratorConflict{"emission_estimator", "\"absorption\" contradicts \"mis\": true (light sampling needs "
                                                     "the collision estimator: write \"auto\" or leave it out)"};
   return std::nullopt;
