@@ -23,20 +23,12 @@ const char* strategy_name(LightStrategy k) {
   return k == LightStrategy::Mis ? "mis" : k == LightStrategy::LightOnly ? "light_only" : "bsdf";
 }
 
-namespace {
-bool media_scatter(const Scene& scene) {
-  for (const Medium& m : scene.media)
-    if (m.sigma_s.x > 0.0 || m.sigma_s.y > 0.0 || m.sigma_s.z > 0.0) return true;
-  return false;
-}
-}  // namespace
-
 LightCandidates light_candidates(const Scene& scene) {
   const Integrator& in = scene.integrator;
   LightCandidates c;
   if (!in.allows_light_sampling() || in.max_depth < 1) return c;
   const bool surfaces = !scene.shapes.empty();
-  const bool scatters = surfaces || media_scatter(scene);
+  const bool scatters = scene_scatters(scene);
   const bool asked = in.mis == true || in.light_only;
   c.environment = scatters;
   c.media = asked ? scatters : surfaces;

@@ -224,6 +224,16 @@ struct Scene {
   std::vector<Light> lights;
 };
 
+// Whether anything in the scene can be lit by another light: a surface, or a
+// medium that scatters (sigma_s > 0 in some channel). Where nothing is, the
+// lights show only themselves and light sampling has nothing to do.
+inline bool scene_scatters(const Scene& scene) {
+  if (!scene.shapes.empty()) return true;
+  for (const Medium& m : scene.media)
+    if (m.sigma_s.x > 0.0 || m.sigma_s.y > 0.0 || m.sigma_s.z > 0.0) return true;
+  return false;
+}
+
 // Integrator keys that contradict each other ("mis": true with the absorption
 // estimator; "light_only": true with "mis": false or with absorption): the key
 // to name and why. Nullopt: none. The loader refuses such a file; select_lights
