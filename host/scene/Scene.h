@@ -52,6 +52,15 @@ struct Camera {
 // (docs/view-transform.md). EXR output is never transformed.
 enum class ViewTransform { AgX, Standard };
 
+// Samples per pixel are 1 to 2^24 (16 777 216) everywhere (film.spp, --spp,
+// both backends, a checkpoint's count): per-pixel counts and the GPU's uint
+// sample indices then stay exact, float-accumulated per-pixel counters too,
+// and image totals (pixels × spp, up to 2^28 · 2^24) need 64-bit arithmetic:
+// total_samples() (render/Render.h). The loader and the CLI hand these bounds
+// to their range checks, whose messages users see.
+inline constexpr int kMinSpp = 1, kMaxSpp = 1 << 24;
+inline constexpr bool spp_in_range(long long spp) { return spp >= kMinSpp && spp <= kMaxSpp; }
+
 struct Film {
   int width = 640;
   int height = 360;

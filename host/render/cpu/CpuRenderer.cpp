@@ -745,7 +745,7 @@ std::string CpuRenderer::device_name() const {
 RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& settings, const RenderControl& control) {
   using namespace cpu;
   auto load_start = Clock::now();
-  if (settings.width <= 0 || settings.height <= 0 || settings.spp <= 0 || settings.spp > kMaxSpp)
+  if (settings.width <= 0 || settings.height <= 0 || !spp_in_range(settings.spp))
     throw std::invalid_argument("cpu reference: width, height and spp must be positive (spp at most 2^24)");
   {
     glm::dvec3 f = scene.camera.look_at - scene.camera.position;
