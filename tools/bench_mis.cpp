@@ -132,7 +132,7 @@ int main(int argc, char** argv) try {
   auto with = [&](bool mis) {
     Scene s = base;
     s.integrator.mis = mis;
-    s.integrator.emission_estimator = "collision";
+    s.integrator.emission_estimator = EmissionEstimator::Collision;
     s.integrator.light_only = mis && std::getenv("BENCH_MIS_LIGHT_ONLY");
     return s;
   };

@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
   render->add_option("-o,--output", render_args.output, "Output image (.exr linear float, .png sRGB)");
   render->add_option("--backend", render_args.backend, "vulkan (default) or cpu")->check(CLI::IsMember({"vulkan", "cpu"}));
   render->add_option("--spp", render_args.spp, "Samples per pixel (overrides film.spp), at most 2^24")
-      ->check(CLI::Range(1, pyrolume::kMaxSpp));
+      ->check(CLI::Range(pyrolume::kMinSpp, pyrolume::kMaxSpp));
   render->add_option("--width", render_args.width, "Image width (overrides film.width)")->check(CLI::Range(1, 16384));
   render->add_option("--height", render_args.height, "Image height (overrides film.height)")->check(CLI::Range(1, 16384));
   render->add_option("--seed", render_args.seed, "Random seed (overrides film.seed)");

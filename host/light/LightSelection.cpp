@@ -19,28 +19,16 @@ bool LightSelection::any() const {
   return false;
 }
 
-const char* estimator_name(EmissionEstimator e) {
-  return e == EmissionEstimator::Collision ? "collision" : "absorption";
-}
-
 const char* strategy_name(LightStrategy k) {
   return k == LightStrategy::Mis ? "mis" : k == LightStrategy::LightOnly ? "light_only" : "bsdf";
 }
 
-namespace {
-bool media_scatter(const Scene& scene) {
-  for (const Medium& m : scene.media)
-    if (m.sigma_s.x > 0.0 || m.sigma_s.y > 0.0 || m.sigma_s.z > 0.0) return true;
-  return false;
-}
-}  // namespace
-
 LightCandidates light_candidates(const Scene& scene) {
   const Integrator& in = scene.integrator;
   LightCandidates c;
-  if (in.mis == false || in.emission_estimator == "absorption" || in.max_depth < 1) return c;
+  if (!in.allows_light_sampling() || in.max_depth < 1) return c;
   const bool surfaces = !scene.shapes.empty();
-  const bool scatters = surfaces || media_scatter(scene);
+  const bool scatters = scene_scatters(scene);
   const bool asked = in.mis == true || in.light_only;
   c.environment = scatters;
   c.media = asked ? scatters : surfaces;
@@ -52,8 +40,6 @@ LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, cons
   const Integrator& in = scene.integrator;
   if (const std::optional<IntegratorConflict> c = integrator_conflict(in, !scene.lights.empty()))
     throw std::invalid_argument("integrator." + c->key + ": " + c->reason);
-  if (in.emission_estimator != "auto" && in.emission_estimator != "absorption" && in.emission_estimator != "collision")
-    throw std::invalid_argument("integrator.emission_estimator: unknown \"" + in.emission_estimator + "\"");
   const LightCandidates want = light_candidates(scene);
   LightSelection s;
   s.p_medium.assign(cdfs.size(), 0.0);
@@ -82,10 +68,8 @@ LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, cons
     if (power[i] > 0.0) s.p_light[i] = distant ? far_share * power[i] / far_power : near_share * power[i] / near_power;
   }
   s.strategy = !s.any() ? LightStrategy::Bsdf : (in.light_only ? LightStrategy::LightOnly : LightStrategy::Mis);
-  s.estimator = in.emission_estimator == "collision" ? EmissionEstimator::Collision
-                : in.emission_estimator == "absorption"
-                    ? EmissionEstimator::Absorption
-                    : (s.strategy == LightStrategy::Bsdf ? EmissionEstimator::Absorption : EmissionEstimator::Collision);
+  s.estimator = in.emission_estimator.value_or(s.strategy == LightStrategy::Bsdf ? EmissionEstimator::Absorption
+                                                                                 : EmissionEstimator::Collision);
   s.p_continue_own =
       s.strategy == LightStrategy::Bsdf ? 1.0 : 1.0 - in.guided_continuation.value_or(1.0 - kContinueOwn);
   s.surface_light_samples = s.strategy == LightStrategy::Bsdf ? 1 : in.surface_light_samples;

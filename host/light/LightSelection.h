@@ -19,11 +19,6 @@ enum class LightStrategy {
   LightOnly,  // debug (integrator.light_only): next-event estimation only
 };
 
-// The emission estimator a render uses (integrator.emission_estimator with
-// "auto" resolved; docs/rendering.md "Emission estimators").
-enum class EmissionEstimator { Absorption, Collision };
-// "absorption" | "collision"
-const char* estimator_name(EmissionEstimator e);
 // "bsdf" | "mis" | "light_only"
 const char* strategy_name(LightStrategy k);
 

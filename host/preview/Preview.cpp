@@ -59,8 +59,9 @@ void on_glfw_error(int, const char* description) { g_glfw_error = description ? 
 constexpr double kTargetFrameSeconds = 1.0 / 30.0;  // the issue: hold about 30 fps
 constexpr int kMaxSppPerFrame = 4096;
 // After this many samples per pixel the preview stops sampling and only
-// redraws: an idle window must not keep the GPU busy forever.
-constexpr int kMaxSpp = 1 << 16;
+// redraws: an idle window must not keep the GPU busy forever. Not a render's
+// spp limit (kMaxSpp): the preview keeps sampling past film.spp up to this.
+constexpr int kPreviewStopSpp = 1 << 16;
 constexpr double kOrbitRadPerPixel = 0.005;
 constexpr double kExposureStep = 0.5;       // stops per key press
 constexpr double kTemperatureStep = 1.05;   // factor per key press
@@ -424,7 +425,7 @@ void PreviewWindow::draw_frame() {
   else
     VK_CHECK(r);
 
-  const int pass_spp = session_->spp_done() >= kMaxSpp ? 0 : spp_per_frame_;
+  const int pass_spp = session_->spp_done() >= kPreviewStopSpp ? 0 : spp_per_frame_;
   VK_CHECK(vkResetCommandBuffer(cmd_, 0));
   VkCommandBufferBeginInfo bi{.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -531,7 +532,7 @@ void PreviewWindow::update_title(bool force) {
   if (!note_.empty() && now > note_until_) note_.clear();
   char head[256];
   std::snprintf(head, sizeof head, "pyrolume preview: %d spp%s | %.1f Msamples/s | %s | exposure %+.1f",
-                session_->spp_done(), session_->spp_done() >= kMaxSpp ? " (done)" : "", msamples_per_s_,
+                session_->spp_done(), session_->spp_done() >= kPreviewStopSpp ? " (done)" : "", msamples_per_s_,
                 ctx_->info().name.c_str(), exposure_);
   std::string title = head;
   if (int i = first_grid_medium(); i >= 0) {
@@ -547,7 +548,7 @@ void PreviewWindow::update_title(bool force) {
 void PreviewWindow::run() {
   while (!glfwWindowShouldClose(window_.get()) && g_signal == 0) {
     // Converged: nothing to add, so wait for input instead of spinning.
-    if (session_->spp_done() >= kMaxSpp)
+    if (session_->spp_done() >= kPreviewStopSpp)
       glfwWaitEventsTimeout(0.1);
     else
       glfwPollEvents();

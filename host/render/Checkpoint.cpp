@@ -132,8 +132,9 @@ Checkpoint read_checkpoint(const fs::path& file, const PayloadBytes& payload_byt
     throw input_error(name, "", std::string("corrupt checkpoint header: ") + e.what());
   }
   const CheckpointIdentity& id = c.identity;
-  if (id.width < 1 || id.height < 1 || id.width > 16384 || id.height > 16384 || c.state.spp < 0 ||
-      c.state.spp > kMaxSpp)
+  // spp 0: saved before the first pass ended.
+  if (id.width < 1 || id.height < 1 || id.width > 16384 || id.height > 16384 ||
+      (c.state.spp != 0 && !spp_in_range(c.state.spp)))
     throw input_error(name, "", "corrupt checkpoint header: impossible width, height or spp");
   if (payload_bytes(id.backend, id.width, id.height) == 0)
     throw input_error(name, "backend", "unknown backend \"" + id.backend + "\"");

@@ -8,15 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "scene/Scene.h"  // kMaxSpp
+
 namespace pyrolume {
-
-struct Scene;
-
-// Samples per pixel are at most 2^24 (16 777 216) everywhere (CLI, scene key,
-// both backends): per-pixel counts and the GPU's uint sample indices then stay
-// exact, float-accumulated per-pixel counters too, and image totals
-// (pixels × spp, up to 2^28 · 2^24) need 64-bit arithmetic: total_samples().
-inline constexpr int kMaxSpp = 1 << 24;
 
 // A sample whose radiance exceeds this in any channel (or is NaN or infinite)
 // is counted as non-finite and adds nothing: beyond it float sums of 2^24

@@ -144,11 +144,7 @@ std::string nothing_in_view(const Camera& camera, const std::vector<WorldBox>& b
 }
 
 std::string nothing_emits(const Scene& scene) {
-  // The lights have something to light: a surface or a scattering medium.
-  bool lit = !scene.shapes.empty();
-  for (const Medium& m : scene.media)
-    if (m.sigma_s.x > 0.0 || m.sigma_s.y > 0.0 || m.sigma_s.z > 0.0) lit = true;
-  if (!scene.lights.empty() && !lit && scene.integrator.max_depth > 0)
+  if (!scene.lights.empty() && !scene_scatters(scene) && scene.integrator.max_depth > 0)
     return "the scene's lights light nothing: no medium scatters (sigma_s is 0 unless set) and there are no "
            "surfaces, so only the lights themselves can show: set the media's sigma_s to light smoke";
   if (!scene.lights.empty()) return "";

@@ -26,7 +26,7 @@ VolumeOptions volume_options(const Medium& m, bool need_temperature) {
   o.need_temperature = need_temperature;
   o.transform = medium_transform_matrix(m.transform);
   o.downsample = m.downsample;
-  o.texture_format = m.texture_format == "r32f" ? TextureFormat::R32F : TextureFormat::R16F;
+  o.texture_format = m.texture_format;
   o.temperature = m.temperature;
   return o;
 }

@@ -18,7 +18,7 @@ glm::dmat4 medium_transform_matrix(const Transform& t);
 bool needs_temperature_grid(const Medium& m);
 
 // The loaders' options for a vdb medium: its file, grids, transform,
-// downsample, texture_format ("r16f" default, "r32f") and temperature mapping.
+// downsample, texture_format and temperature mapping.
 VolumeOptions volume_options(const Medium& m, bool need_temperature);
 
 // load_volume / load_stored_volume (volume/) for a medium; the stored one

@@ -52,6 +52,15 @@ struct Camera {
 // (docs/view-transform.md). EXR output is never transformed.
 enum class ViewTransform { AgX, Standard };
 
+// Samples per pixel are 1 to 2^24 (16 777 216) everywhere (film.spp, --spp,
+// both backends, a checkpoint's count): per-pixel counts and the GPU's uint
+// sample indices then stay exact, float-accumulated per-pixel counters too,
+// and image totals (pixels × spp, up to 2^28 · 2^24) need 64-bit arithmetic:
+// total_samples() (render/Render.h). The loader and the CLI hand these bounds
+// to their range checks, whose messages users see.
+inline constexpr int kMinSpp = 1, kMaxSpp = 1 << 24;
+inline constexpr bool spp_in_range(long long spp) { return spp >= kMinSpp && spp <= kMaxSpp; }
+
 struct Film {
   int width = 640;
   int height = 360;
@@ -70,6 +79,16 @@ struct Film {
   bool transparent = false;
 };
 
+// How emission in media is collected: at absorptions only, or at every
+// tentative collision (docs/rendering.md "Emission estimators").
+enum class EmissionEstimator { Absorption, Collision };
+// Per-cell majorants walked by DDA, or one bound per grid (integrator.majorant).
+enum class Majorant { Grid, Global };
+
+// Their names in the scene file and in --stats.
+inline const char* to_string(EmissionEstimator e) { return e == EmissionEstimator::Collision ? "collision" : "absorption"; }
+inline const char* to_string(Majorant m) { return m == Majorant::Global ? "global" : "grid"; }
+
 struct Integrator {
   int max_depth = 8;
   // Light sampling: next-event estimation + MIS (docs/mis.md "When light
@@ -86,12 +105,18 @@ struct Integrator {
   // Debug: next-event estimation only, no BSDF/phase-found light (docs/mis.md);
   // asks for light sampling as "mis": true does.
   bool light_only = false;
-  // As the file writes it: "auto" | "absorption" | "collision". "auto" is
-  // "collision" where lights are sampled (what MIS needs), otherwise
-  // "absorption"; LightSelection::estimator is the value a render uses.
-  std::string emission_estimator = "auto";
-  std::string majorant = "grid";                  // "grid" | "global"
+  // The file's "absorption" | "collision"; unset: "auto", which is
+  // collision where lights are sampled (what MIS needs), otherwise absorption.
+  // LightSelection::estimator is the value a render uses.
+  std::optional<EmissionEstimator> emission_estimator;
+  Majorant majorant = Majorant::Grid;
   std::optional<glm::ivec3> majorant_grid;
+
+  // Whether these keys let light sampling run at all: "mis": false turns it
+  // off, and so does the absorption estimator (MIS needs the collision one).
+  // The one rule behind light_candidates (host/light/LightSelection.h; it
+  // also needs max_depth >= 1) and integrator_conflict (which names the key).
+  bool allows_light_sampling() const { return mis != false && emission_estimator != EmissionEstimator::Absorption; }
 };
 
 struct Environment {
@@ -153,7 +178,7 @@ struct Medium {
   TemperatureMapping temperature;
   Transform transform;
   int downsample = 1;
-  std::string texture_format = "r16f";  // "r16f" | "r32f" (R32F is also used when values exceed R16F)
+  TextureFormat texture_format = TextureFormat::R16F;  // R32F is also used when values exceed R16F
 };
 
 // A surface: a triangle mesh (OBJ), an analytic sphere, or a plane (a
@@ -211,6 +236,16 @@ struct Scene {
   std::vector<Shape> shapes;
   std::vector<Light> lights;
 };
+
+// Whether anything in the scene can be lit by another light: a surface, or a
+// medium that scatters (sigma_s > 0 in some channel). Where nothing is, the
+// lights show only themselves and light sampling has nothing to do.
+inline bool scene_scatters(const Scene& scene) {
+  if (!scene.shapes.empty()) return true;
+  for (const Medium& m : scene.media)
+    if (m.sigma_s.x > 0.0 || m.sigma_s.y > 0.0 || m.sigma_s.z > 0.0) return true;
+  return false;
+}
 
 // Integrator keys that contradict each other ("mis": true with the absorption
 // estimator; "light_only": true with "mis": false or with absorption): the key

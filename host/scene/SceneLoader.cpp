@@ -78,6 +78,23 @@ class Reader {
     for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + ("\"" + a + "\"");
     fail(key, "must be one of " + list + ", got \"" + s + "\"");
   }
+  // One of `values`, spelled in the file as its to_string names it.
+  template <typename E>
+  E enum_choice(const std::string& key, E fallback, std::initializer_list<E> values) {
+    return *optional_choice(key, to_string(fallback), values);
+  }
+  // The same with one more spelling, `none`, read as nullopt (e.g. "auto").
+  template <typename E>
+  std::optional<E> optional_choice(const std::string& key, const std::string& fallback,
+                                   std::initializer_list<E> values, const char* none = nullptr) {
+    std::vector<std::string> names;
+    if (none) names.push_back(none);
+    for (E v : values) names.push_back(to_string(v));
+    const std::string s = choice(key, fallback, names);
+    for (E v : values)
+      if (s == to_string(v)) return v;
+    return std::nullopt;  // `none`
+  }
   glm::dvec3 vec3(const std::string& key, glm::dvec3 fallback) {
     if (!has(key)) return fallback;
     const json& v = raw(key);
@@ -267,7 +284,7 @@ Medium read_medium(Reader r, const std::filesystem::path& base, int index) {
     m.density_scale = r.number("density_scale", 1.0);
     if (m.density_scale < 0) r.fail("density_scale", "must be >= 0");
     m.downsample = r.integer("downsample", 1, 1, 64);
-    m.texture_format = r.choice("texture_format", "r16f", {"r16f", "r32f"});
+    m.texture_format = r.enum_choice("texture_format", TextureFormat::R16F, {TextureFormat::R16F, TextureFormat::R32F});
     if (r.has("temperature")) {
       Reader t = r.child("temperature");
       m.given.temperature_scale = t.has("scale");
@@ -352,19 +369,20 @@ Shape read_shape(Reader r, const std::filesystem::path& base) {
 }  // namespace
 
 std::optional<IntegratorConflict> integrator_conflict(const Integrator& in, bool has_lights) {
-  const bool absorption = in.emission_estimator == "absorption";
-  if (has_lights && in.mis == false)
+  if (in.allows_light_sampling()) return std::nullopt;
+  const bool mis_off = in.mis == false;  // otherwise the absorption estimator turned it off
+  if (has_lights && mis_off)
     return IntegratorConflict{"mis", "false turns off light sampling, the only way the scene's \"lights\" are reached "
                                      "(remove it, or remove the lights)"};
-  if (has_lights && absorption)
+  if (has_lights)
     return IntegratorConflict{"emission_estimator", "\"absorption\" turns off light sampling, the only way the scene's "
                                                     "\"lights\" are reached (write \"auto\" or leave it out)"};
-  if (in.light_only && in.mis == false)
+  if (in.light_only && mis_off)
     return IntegratorConflict{"light_only", "true asks for light sampling, which \"mis\": false turns off"};
-  if (in.light_only && absorption)
+  if (in.light_only)
     return IntegratorConflict{"light_only", "true asks for light sampling, which needs the collision estimator, "
                                             "not \"emission_estimator\": \"absorption\" (write \"auto\" or leave it out)"};
-  if (in.mis == true && absorption)
+  if (in.mis == true)
     return IntegratorConflict{"emission_estimator", "\"absorption\" contradicts \"mis\": true (light sampling needs "
                                                     "the collision estimator: write \"auto\" or leave it out)"};
   return std::nullopt;
@@ -466,7 +484,7 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
     s.film.size_given = f.has("width") || f.has("height");
     s.film.width = f.integer("width", s.film.width, 1, 16384);
     s.film.height = f.integer("height", s.film.height, 1, 16384);
-    s.film.spp = f.integer("spp", s.film.spp, 1, 1 << 24);
+    s.film.spp = f.integer("spp", s.film.spp, kMinSpp, kMaxSpp);
     if (f.has("exposure") && f.raw("exposure").is_string()) {
       const std::string e = f.string("exposure", "");
       if (e != "auto") f.fail("exposure", "expected a number of stops, keys or \"auto\", got \"" + e + "\"");
@@ -493,9 +511,10 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
         i.integer("surface_light_samples", s.integrator.surface_light_samples, 1, 64);
     s.integrator.ratio_tracked_continuation =
         i.boolean("ratio_tracked_continuation", s.integrator.ratio_tracked_continuation);
-    s.integrator.emission_estimator = i.choice("emission_estimator", "auto", {"auto", "absorption", "collision"});
+    s.integrator.emission_estimator = i.optional_choice(
+        "emission_estimator", "auto", {EmissionEstimator::Absorption, EmissionEstimator::Collision}, "auto");
     if (const std::optional<IntegratorConflict> c = integrator_conflict(s.integrator)) i.fail(c->key, c->reason);
-    s.integrator.majorant = i.choice("majorant", "grid", {"grid", "global"});
+    s.integrator.majorant = i.enum_choice("majorant", Majorant::Grid, {Majorant::Grid, Majorant::Global});
     if (i.has("majorant_grid")) {
       glm::dvec3 g = i.vec3("majorant_grid", {});
       for (int k = 0; k < 3; ++k)

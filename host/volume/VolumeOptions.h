@@ -24,6 +24,8 @@ enum class UpAxis { Y, Z };
 
 // The texture format grids are stored in (volume/StoredVolume.h).
 enum class TextureFormat { R16F, R32F };
+// Its name in the scene file (media[].texture_format).
+inline const char* to_string(TextureFormat f) { return f == TextureFormat::R32F ? "r32f" : "r16f"; }
 
 struct VolumeOptions {
   std::filesystem::path file;

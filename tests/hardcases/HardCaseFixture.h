@@ -51,7 +51,7 @@ struct BackendNames {
   }
 };
 
-inline const char* const kEstimators[] = {"absorption", "collision"};
+inline const EmissionEstimator kEstimators[] = {EmissionEstimator::Absorption, EmissionEstimator::Collision};
 
 // Absorption-estimator samples are Bernoulli-like: pool the variance over 3×3
 // (Stats.h explains).
@@ -150,14 +150,14 @@ class HardCase : public B, protected test::ConstantBoxSetup {
   RenderResult expect_closed_form(Scene s, const std::function<glm::dvec3(int, int)>& exact, const char* what,
                                   const test::ZTestOptions& o = pooled(), glm::dvec3 rare_range = glm::dvec3(0.0)) {
     RenderResult r;
-    for (const char* est : kEstimators) {
+    for (const EmissionEstimator est : kEstimators) {
       s.integrator.emission_estimator = est;
       r = render(s, what);
       const bool rare = rare_range.x > 0.0 || rare_range.y > 0.0 || rare_range.z > 0.0;
       const test::ZTestReport rep =
           test::ztest_against_exact(r, rare ? allow_unseen_rare_events(r, exact, rare_range) : exact, o);
-      EXPECT_TRUE(rep.ok) << what << " [" << est << "] " << rep.summary();
-      std::printf("%s [%s, %s]: %s; %.2f s\n", what, est, kVulkan ? "vulkan" : "cpu", rep.summary().c_str(),
+      EXPECT_TRUE(rep.ok) << what << " [" << to_string(est) << "] " << rep.summary();
+      std::printf("%s [%s, %s]: %s; %.2f s\n", what, to_string(est), kVulkan ? "vulkan" : "cpu", rep.summary().c_str(),
                   r.seconds);
     }
     return r;

@@ -222,9 +222,9 @@ TYPED_TEST(HardLightRender, AllZeroEnvironmentMap) {
   Scene furnace = test::white_furnace_scene(16, 16, 16);
   furnace.background = glm::dvec3(7.0);
   furnace.environment = Environment{exr, 1.0, 0.0};
-  for (const char* est : hard::kEstimators) {
+  for (const EmissionEstimator est : hard::kEstimators) {
     furnace.integrator.emission_estimator = est;
-    const RenderResult r = this->render(furnace, est);
+    const RenderResult r = this->render(furnace, to_string(est));
     this->expect_every_pixel(r, glm::dvec3(0.0), "zero map furnace");
   }
   Scene glow = test::chromatic_scattering_scene(16, 16, 1024);

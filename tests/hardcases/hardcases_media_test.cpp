@@ -53,12 +53,12 @@ TYPED_TEST(HardMedia, DensityZeroEverywhere) {
                                      {1, 1, 1}, {0, 0, 0}, 0.0, std::nullopt, 10.0, true));
   s.media.push_back(test::homogeneous_sphere("vacuum", {0.1, 0.0, 0.0}, 1.0, {0, 0, 0}, {0, 0, 0}, 0.0,
                                              glm::dvec3(5.0, 5.0, 5.0)));
-  for (const char* est : hard::kEstimators) {
+  for (const EmissionEstimator est : hard::kEstimators) {
     s.integrator.emission_estimator = est;
-    const RenderResult r = this->render(s, est);
-    this->expect_every_pixel(r, s.background, est);
-    EXPECT_EQ(r.density_lookups, 0.0) << est;
-    EXPECT_EQ(r.events, 0.0) << est;
+    const RenderResult r = this->render(s, to_string(est));
+    this->expect_every_pixel(r, s.background, to_string(est));
+    EXPECT_EQ(r.density_lookups, 0.0) << to_string(est);
+    EXPECT_EQ(r.events, 0.0) << to_string(est);
   }
 }
 
@@ -159,7 +159,7 @@ TYPED_TEST(HardMedia, OpticalDepth1e4PerVoxelWithScattering) {
     const Medium& m = s->media[0];
     const glm::dvec3 Le = m.emission.scale * m.emission.rgb.value();
     const Bounds inner = s == &g ? test::centre_box(this->lat, this->box) : m.bounds;
-    for (const char* est : hard::kEstimators) {
+    for (const EmissionEstimator est : hard::kEstimators) {
       s->integrator.emission_estimator = est;
       const RenderResult r = this->render(*s, what);
       const test::PixelStats ps = test::pixel_stats(r, true);
@@ -178,16 +178,16 @@ TYPED_TEST(HardMedia, OpticalDepth1e4PerVoxelWithScattering) {
             const size_t i = (size_t(y) * r.width + x) * 3 + k;
             const double mean = ps.mean[i], se4 = 4.0 * ps.se[i] + 1e-6 * Le[k];
             const double half = 0.5 * (Le[k] + s->background[k]);
-            EXPECT_GE(mean + se4, std::min(Le[k], half)) << what << " [" << est << "] pixel " << x << "," << y << " channel " << k;
-            EXPECT_LE(mean - se4, std::max(Le[k], half)) << what << " [" << est << "] pixel " << x << "," << y << " channel " << k;
+            EXPECT_GE(mean + se4, std::min(Le[k], half)) << what << " [" << to_string(est) << "] pixel " << x << "," << y << " channel " << k;
+            EXPECT_LE(mean - se4, std::max(Le[k], half)) << what << " [" << to_string(est) << "] pixel " << x << "," << y << " channel " << k;
           }
         }
       EXPECT_GT(inside, 40) << what;
       if constexpr (TestFixture::kVulkan) {
         const RenderResult ref = this->cpu_reference(*s, 128, 77);
         const test::ZTestReport rep = test::ztest_images(r, ref, pooled(0.01));
-        EXPECT_TRUE(rep.ok) << what << " vs CPU [" << est << "] " << rep.summary();
-        std::printf("%s vs CPU [%s]: %s\n", what, est, rep.summary().c_str());
+        EXPECT_TRUE(rep.ok) << what << " vs CPU [" << to_string(est) << "] " << rep.summary();
+        std::printf("%s vs CPU [%s]: %s\n", what, to_string(est), rep.summary().c_str());
       }
     }
   }
@@ -213,9 +213,9 @@ TYPED_TEST(HardMedia, ScatteringOnlyEmitsNothingAndConservesEnergy) {
     this->expect_closed_form(*s, [bg](int, int) { return bg; }, what);
     Scene dark = *s;
     dark.background = glm::dvec3(0.0);
-    for (const char* est : hard::kEstimators) {
+    for (const EmissionEstimator est : hard::kEstimators) {
       dark.integrator.emission_estimator = est;
-      const RenderResult r = this->render(dark, est);
+      const RenderResult r = this->render(dark, to_string(est));
       this->expect_every_pixel(r, glm::dvec3(0.0), what);
       EXPECT_GT(r.events, 0.0) << what;
     }
@@ -272,7 +272,7 @@ TYPED_TEST(HardMedia, LongPathsAlbedo09995WithMaxDepth5000) {
   const double alpha = 9.995 / 10.0, events = (1.0 - std::pow(alpha, 5001.0)) / (1.0 - alpha);
   const glm::dvec3 L = glm::dvec3(1.0, 0.0, 0.0) * (1.0 - std::pow(alpha, 5001.0));
   Scene one = s;
-  one.integrator.emission_estimator = "absorption";
+  one.integrator.emission_estimator = EmissionEstimator::Absorption;
   const RenderResult r = this->render(one, "long paths");
   const test::ZTestReport rep = test::ztest_against_exact(r, [L](int, int) { return L; }, pooled(0.02));
   EXPECT_TRUE(rep.ok) << rep.summary();
@@ -334,13 +334,13 @@ TYPED_TEST(HardMedia, TemperaturesZeroTinyHugeAndNaN) {
   // Seed mode with both estimators, and physical mode (absolute Planck
   // radiance: ~1e10 at 1e6 K) with the absorption estimator.
   struct Config {
-    const char* estimator;
+    EmissionEstimator estimator;
     BlackbodyMode mode;
     const char* what;
   };
-  const Config configs[] = {{"absorption", BlackbodyMode::Seed, "seed, absorption"},
-                            {"collision", BlackbodyMode::Seed, "seed, collision"},
-                            {"absorption", BlackbodyMode::Physical, "physical, absorption"}};
+  const Config configs[] = {{EmissionEstimator::Absorption, BlackbodyMode::Seed, "seed, absorption"},
+                            {EmissionEstimator::Collision, BlackbodyMode::Seed, "seed, collision"},
+                            {EmissionEstimator::Absorption, BlackbodyMode::Physical, "physical, absorption"}};
   RenderResult r[3];
   for (int e = 0; e < 3; ++e) {
     const Config& cf = configs[e];

@@ -166,7 +166,7 @@ TEST_F(RealRender, Blender279FireWithHeat) {
   Scene s = framed(m, {0, 1, 0}, {0, 0, 1}, 20, 32);
   s.background = {0.05, 0.05, 0.08};
   s.integrator.max_depth = 4;
-  s.integrator.emission_estimator = "collision";
+  s.integrator.emission_estimator = EmissionEstimator::Collision;
   compare(s, 4096, 1536, "blender 2.79 fire");
 }
 

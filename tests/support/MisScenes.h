@@ -22,7 +22,7 @@ namespace pyrolume::test {
 enum class Strategy { Bsdf, Mis, LightOnly };
 
 inline void set_strategy(Scene& s, Strategy k) {
-  s.integrator.emission_estimator = "collision";
+  s.integrator.emission_estimator = EmissionEstimator::Collision;
   s.integrator.mis = k != Strategy::Bsdf;
   s.integrator.light_only = k == Strategy::LightOnly;
 }

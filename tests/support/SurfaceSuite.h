@@ -263,7 +263,7 @@ TEST_P(Surface, SurfaceBounceCountsAsOneEvent) {
 // z-test.
 TEST_P(Surface, FurnaceConcaveMeshSphereAndMediumIsOne) {
   auto obj = write_open_box_obj(temp_dir(backend_name() + "_surface_furnace"));
-  for (const char* estimator : {"absorption", "collision"}) {
+  for (const EmissionEstimator estimator : {EmissionEstimator::Absorption, EmissionEstimator::Collision}) {
     Scene s = concave_furnace_scene(obj, 1000, glm::dvec3(1.0));
     s.integrator.emission_estimator = estimator;
     RenderResult r = render(s);
@@ -271,7 +271,7 @@ TEST_P(Surface, FurnaceConcaveMeshSphereAndMediumIsOne) {
       for (int x = 0; x < r.width; ++x) {
         const glm::dvec3 m = pixel_mean(r, x, y);
         for (int c = 0; c < 3; ++c)
-          EXPECT_NEAR(m[c], 1.0, per_backend(1e-12, 1e-4)) << estimator << " pixel " << x << "," << y;
+          EXPECT_NEAR(m[c], 1.0, per_backend(1e-12, 1e-4)) << to_string(estimator) << " pixel " << x << "," << y;
       }
     EXPECT_GT(r.events / (double(r.width) * r.height * r.spp), 1.5) << "paths should bounce and scatter";
   }
@@ -420,7 +420,7 @@ TEST_P(Surface, EnvironmentMapSeenByCameraRays) {
 // shows. Both emission estimators.
 TEST_P(Surface, PlaneOccludesEmissiveMedium) {
   const glm::dvec3 a(0.5, 0.25, 0.8), bg(0.2, 0.4, 0.6);
-  for (const char* estimator : {"absorption", "collision"}) {
+  for (const EmissionEstimator estimator : {EmissionEstimator::Absorption, EmissionEstimator::Collision}) {
     Scene s = analytic_base_scene(16, 16, 16);
     s.background = bg;
     s.integrator.emission_estimator = estimator;
@@ -433,10 +433,10 @@ TEST_P(Surface, PlaneOccludesEmissiveMedium) {
       for (int x = 0; x < r.width; ++x) {
         const glm::dvec3 m = pixel_mean(r, x, y);
         for (int c = 0; c < 3; ++c)
-          EXPECT_NEAR(m[c], a[c] * bg[c], per_backend(1e-12, kFloatTol)) << estimator << " " << x << "," << y;
+          EXPECT_NEAR(m[c], a[c] * bg[c], per_backend(1e-12, kFloatTol)) << to_string(estimator) << " " << x << "," << y;
       }
     RenderResult glow = render(open);
-    EXPECT_GT(pixel_mean(glow, 8, 8).x, 1.0) << estimator;
+    EXPECT_GT(pixel_mean(glow, 8, 8).x, 1.0) << to_string(estimator);
   }
 }
 

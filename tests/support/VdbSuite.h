@@ -27,7 +27,7 @@
 
 namespace pyrolume::test {
 
-inline const char* const kVdbEstimators[] = {"absorption", "collision"};
+inline const EmissionEstimator kVdbEstimators[] = {EmissionEstimator::Absorption, EmissionEstimator::Collision};
 
 inline double per_sample(double count, const RenderResult& r) {
   return count / (double(r.width) * r.height * r.spp);
@@ -45,12 +45,12 @@ class VdbFixture : public BackendFixture, public ConstantBoxSetup {
   RenderResult expect_closed_form(Scene s, const std::function<glm::dvec3(int, int)>& exact, const char* what,
                                   double tolerance = ZTestOptions{}.bias_tolerance) {
     RenderResult r;
-    for (const char* est : kVdbEstimators) {
+    for (const EmissionEstimator est : kVdbEstimators) {
       s.integrator.emission_estimator = est;
       r = render(s);
       ZTestReport rep = ztest_against_exact(r, exact, pooled(tolerance));
-      EXPECT_TRUE(rep.ok) << what << " [" << est << "] " << rep.summary();
-      std::printf("%s [%s] on %s: %s; lookups/sample %.2f, events/sample %.3f, %.2f s\n", what, est,
+      EXPECT_TRUE(rep.ok) << what << " [" << to_string(est) << "] " << rep.summary();
+      std::printf("%s [%s] on %s: %s; lookups/sample %.2f, events/sample %.3f, %.2f s\n", what, to_string(est),
                   backend_name().c_str(), rep.summary().c_str(), per_sample(r.density_lookups, r),
                   per_sample(r.events, r), r.seconds);
       EXPECT_LE(r.events, r.density_lookups) << "a real collision without a density lookup";
@@ -158,13 +158,14 @@ TEST_P(Vdb, ZeroAndEmptyGridsRenderTheBackground) {
                                {1, 1, 1}, 0.0, glm::dvec3(1.0)));
   s.media.push_back(
       vdb_medium("empty", write_empty_vdb(dir / "empty.vdb"), {1, 1, 1}, {1, 1, 1}, 0.0, glm::dvec3(1.0)));
-  for (const char* majorant : {"grid", "global"})
-    for (const char* est : kVdbEstimators) {
+  for (const Majorant majorant : {Majorant::Grid, Majorant::Global})
+    for (const EmissionEstimator est : kVdbEstimators) {
       s.integrator.emission_estimator = est;
       s.integrator.majorant = majorant;
       RenderResult r = render(s);
-      expect_background(r, s, std::string(est) + " " + majorant);
-      EXPECT_EQ(r.events, 0.0) << est << " " << majorant;
+      const std::string what = std::string(to_string(est)) + " " + to_string(majorant);
+      expect_background(r, s, what);
+      EXPECT_EQ(r.events, 0.0) << what;
     }
   for (int keep = 0; keep < 2; ++keep) {
     Scene one = s;
@@ -220,10 +221,10 @@ TEST_P(Vdb, TinyDensityWithHighTemperature) {
   s.media[0].emission.scale = 1e6;
   s.film.width = s.film.height = 8;
   s.film.spp = 64;
-  for (const char* est : kVdbEstimators) {
+  for (const EmissionEstimator est : kVdbEstimators) {
     s.integrator.emission_estimator = est;
     RenderResult r = render(s);
-    for (double v : r.sum) ASSERT_TRUE(std::isfinite(v) && v >= 0.0) << est;
+    for (double v : r.sum) ASSERT_TRUE(std::isfinite(v) && v >= 0.0) << to_string(est);
   }
 }
 

@@ -97,7 +97,7 @@ TEST(LightSelection, ProbabilitiesAndStrategies) {
   EXPECT_DOUBLE_EQ(select_lights(off, &env, {&cdf}).p_continue_own, 1.0);  // BSDF sampling only
   Scene absorption = s;
   absorption.integrator.mis.reset();  // "mis": true with absorption is refused (light_selection_test)
-  absorption.integrator.emission_estimator = "absorption";
+  absorption.integrator.emission_estimator = EmissionEstimator::Absorption;
   EXPECT_EQ(select_lights(absorption, &env, {&cdf}).strategy, LightStrategy::Bsdf);
   Scene depth0 = s;
   depth0.integrator.max_depth = 0;

@@ -96,7 +96,7 @@ TEST(CpuSurface, SurfaceClipsMediumBehindIt) {
   const glm::dvec3 sigma_a(0.6, 1.2, 2.4), Le(1.0, 0.7, 0.4);
   const glm::dvec3 c0(0.2, 0.1, 0.0);
   const double R = 1.2;
-  for (const char* estimator : {"absorption", "collision"}) {
+  for (const EmissionEstimator estimator : {EmissionEstimator::Absorption, EmissionEstimator::Collision}) {
     Scene s = test::analytic_base_scene(24, 24, 512);
     s.integrator.emission_estimator = estimator;
     s.background = glm::dvec3(3.0);  // hidden everywhere by the plane
@@ -123,10 +123,10 @@ TEST(CpuSurface, SurfaceClipsMediumBehindIt) {
       return std::function<glm::dvec3(int, int)>([vals, W](int x, int y) { return (*vals)[size_t(y) * W + x]; });
     };
     ZTestReport ok = test::ztest_against_exact(r, exact_for(true), pooled());
-    EXPECT_TRUE(ok.ok) << estimator << ": " << ok.summary();
-    std::printf("%s clipped: %s\n", estimator, ok.summary().c_str());
+    EXPECT_TRUE(ok.ok) << to_string(estimator) << ": " << ok.summary();
+    std::printf("%s clipped: %s\n", to_string(estimator), ok.summary().c_str());
     ZTestReport full = test::ztest_against_exact(r, exact_for(false), pooled());
-    EXPECT_FALSE(full.ok) << estimator << ": " << full.summary();
+    EXPECT_FALSE(full.ok) << to_string(estimator) << ": " << full.summary();
   }
 }
 
@@ -136,7 +136,7 @@ TEST(CpuSurface, SurfaceClipsMediumBehindIt) {
 // sky: the plane is lit only through BSDF-sampled paths that find the sphere.
 // Plane pixels must be > 0 and finite, and both emission estimators must
 // converge to the same image.
-Scene lit_plane_scene(const char* estimator, uint32_t seed) {
+Scene lit_plane_scene(EmissionEstimator estimator, uint32_t seed) {
   Scene s = test::analytic_base_scene(20, 16, 96);
   s.film.seed = seed;
   s.camera.position = {0, 1.5, -5};
@@ -150,7 +150,7 @@ Scene lit_plane_scene(const char* estimator, uint32_t seed) {
 }
 
 TEST(CpuSurface, EmissiveSphereLightsPlane) {
-  Scene s = lit_plane_scene("collision", 3);
+  Scene s = lit_plane_scene(EmissionEstimator::Collision, 3);
   RenderResult r = render(s);
   EXPECT_EQ(r.nonfinite_samples, 0u);
   for (double v : r.sum) ASSERT_TRUE(std::isfinite(v));
@@ -159,13 +159,13 @@ TEST(CpuSurface, EmissiveSphereLightsPlane) {
   for (int x = 0; x < r.width; ++x) near_sum += pixel_mean(r, x, r.height - 1).x;
   EXPECT_GT(near_sum / r.width, 0.0);
 
-  ZTestReport same = test::ztest_images(render(lit_plane_scene("absorption", 4)), r, pooled(0.03));
+  ZTestReport same = test::ztest_images(render(lit_plane_scene(EmissionEstimator::Absorption, 4)), r, pooled(0.03));
   EXPECT_TRUE(same.ok) << same.summary();
   std::printf("absorption vs collision: %s\n", same.summary().c_str());
 }
 
 TEST(CpuSurface, DeterministicAcrossThreadCounts) {
-  Scene s = lit_plane_scene("absorption", 9);
+  Scene s = lit_plane_scene(EmissionEstimator::Absorption, 9);
   s.film.spp = 8;
   RenderResult a = render(s, 1), b = render(s, 3);
   EXPECT_EQ(a.sum, b.sum);

@@ -49,7 +49,7 @@ TEST_F(CpuVdb, AbsorptionAndCollisionEstimatorsAgreeWithScattering) {
   for (int i = 0; i < 2; ++i) {
     s.integrator.emission_estimator = kVdbEstimators[i];
     r[i] = render(s);
-    std::printf("%s: %.2f s, lookups/sample %.2f, events/sample %.3f\n", kVdbEstimators[i], r[i].seconds,
+    std::printf("%s: %.2f s, lookups/sample %.2f, events/sample %.3f\n", to_string(kVdbEstimators[i]), r[i].seconds,
                 r[i].density_lookups / (24.0 * 24 * 512), r[i].events / (24.0 * 24 * 512));
   }
   ZTestReport rep = test::ztest_images(r[1], r[0], pooled(0.01));
@@ -70,7 +70,7 @@ TEST_F(CpuVdb, EstimatorsAgreeWithTemperatureEmission) {
   for (int i = 0; i < 2; ++i) {
     s.integrator.emission_estimator = kVdbEstimators[i];
     r[i] = render(s);
-    std::printf("%s: %.2f s\n", kVdbEstimators[i], r[i].seconds);
+    std::printf("%s: %.2f s\n", to_string(kVdbEstimators[i]), r[i].seconds);
   }
   ZTestReport rep = test::ztest_images(r[1], r[0], pooled(0.02));
   EXPECT_TRUE(rep.ok) << rep.summary();
@@ -88,11 +88,11 @@ TEST_F(CpuVdb, ScatteringCheckerboardWhiteFurnace) {
   s.media.push_back(test::vdb_medium(
       "checker", test::write_checkerboard_vdb(dir / "checker.vdb", lat, box, 0.25f, 2.0f, 2), {0, 0, 0},
       {0.5, 1.0, 2.0}, 0.6));
-  for (const char* est : kVdbEstimators) {
+  for (const EmissionEstimator est : kVdbEstimators) {
     s.integrator.emission_estimator = est;
     RenderResult r = render(s);
     for (size_t i = 0; i < r.sum.size(); ++i)
-      ASSERT_NEAR(r.sum[i] / r.spp, s.background[i % 3], 1e-12 * s.background[i % 3]) << est << " at " << i;
+      ASSERT_NEAR(r.sum[i] / r.spp, s.background[i % 3], 1e-12 * s.background[i % 3]) << to_string(est) << " at " << i;
     EXPECT_GT(r.events, 0.0);
   }
 }

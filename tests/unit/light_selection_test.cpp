@@ -56,7 +56,7 @@ void expect_resolution(const LightSelection& l, LightStrategy strategy, Emission
 void file_defaults(Scene& s) {
   s.integrator.mis.reset();
   s.integrator.light_only = false;
-  s.integrator.emission_estimator = "auto";
+  s.integrator.emission_estimator = std::nullopt;  // "auto"
 }
 
 std::string parse_error(const std::string& integrator) {
@@ -96,10 +96,10 @@ TEST(LightDefaults, FileWithoutIntegratorKeysIsAutomatic) {
   const Scene s = parse_scene(R"({"media": [{"type": "vdb", "file": "f.vdb"}]})", "s.json");
   EXPECT_FALSE(s.integrator.mis.has_value());
   EXPECT_FALSE(s.integrator.light_only);
-  EXPECT_EQ(s.integrator.emission_estimator, "auto");
+  EXPECT_FALSE(s.integrator.emission_estimator.has_value());  // "auto"
   const Scene t = parse_scene(R"({"integrator": {"mis": false, "emission_estimator": "collision"}})", "t.json");
   EXPECT_EQ(t.integrator.mis, std::optional<bool>(false));
-  EXPECT_EQ(t.integrator.emission_estimator, "collision");
+  EXPECT_EQ(t.integrator.emission_estimator, EmissionEstimator::Collision);
   EXPECT_EQ(parse_scene(R"({"integrator": {"mis": true}})", "u.json").integrator.mis, std::optional<bool>(true));
 }
 
@@ -162,7 +162,7 @@ TEST_F(LightResolution, FireAlone) {
 
   // The collision estimator written out keeps the automatic rule.
   Scene collision = fire_alone();
-  collision.integrator.emission_estimator = "collision";
+  collision.integrator.emission_estimator = EmissionEstimator::Collision;
   expect_resolution(resolve(collision), LightStrategy::Bsdf, EmissionEstimator::Collision, 0.0, "collision");
 }
 
@@ -178,11 +178,11 @@ TEST_F(LightResolution, FireOverPlane) {
   Scene off = fire_over_plane();
   off.integrator.mis = false;
   expect_resolution(resolve(off), LightStrategy::Bsdf, EmissionEstimator::Absorption, 0.0, "mis false");
-  off.integrator.emission_estimator = "collision";
+  off.integrator.emission_estimator = EmissionEstimator::Collision;
   EXPECT_EQ(resolve(off).estimator, EmissionEstimator::Collision);
 
   Scene absorption = fire_over_plane();
-  absorption.integrator.emission_estimator = "absorption";
+  absorption.integrator.emission_estimator = EmissionEstimator::Absorption;
   const LightSelection ab = resolve(absorption);
   EXPECT_EQ(ab.strategy, LightStrategy::Bsdf);
   EXPECT_EQ(ab.estimator, EmissionEstimator::Absorption);
@@ -255,9 +255,9 @@ TEST_F(LightResolution, ContradictionsAreRefused) {
 
   Scene s = fire_over_plane();
   s.integrator.mis = true;
-  s.integrator.emission_estimator = "absorption";
+  s.integrator.emission_estimator = EmissionEstimator::Absorption;
   EXPECT_THROW(select_lights(s, nullptr, {nullptr}), std::invalid_argument);
-  s.integrator.emission_estimator = "auto";
+  s.integrator.emission_estimator = std::nullopt;  // "auto"
   s.integrator.mis = false;
   s.integrator.light_only = true;
   EXPECT_THROW(select_lights(s, nullptr, {nullptr}), std::invalid_argument);
@@ -271,7 +271,7 @@ TEST_F(LightResolution, FireAloneRendersAsBefore) {
   const Scene a = fire_alone();
   Scene before = a;
   before.integrator.mis = false;
-  before.integrator.emission_estimator = "absorption";
+  before.integrator.emission_estimator = EmissionEstimator::Absorption;
   const RenderResult ra = cpu.render(a, test::settings_for(a), {});
   const RenderResult rb = cpu.render(before, test::settings_for(before), {});
   EXPECT_EQ(ra.light_strategy, "bsdf");
@@ -279,7 +279,7 @@ TEST_F(LightResolution, FireAloneRendersAsBefore) {
   EXPECT_EQ(ra.sum, rb.sum);
   // And it can differ: the collision estimator does not give these samples.
   Scene collision = a;
-  collision.integrator.emission_estimator = "collision";
+  collision.integrator.emission_estimator = EmissionEstimator::Collision;
   const RenderResult rc = cpu.render(collision, test::settings_for(collision), {});
   EXPECT_EQ(rc.emission_estimator, "collision");
   EXPECT_NE(rc.sum, ra.sum);
@@ -485,9 +485,9 @@ TEST_F(LightSelectionLights, ContradictionsWithLights) {
   s.integrator.mis = false;
   EXPECT_THROW(resolve(s), std::invalid_argument);
   s.integrator.mis.reset();
-  s.integrator.emission_estimator = "absorption";
+  s.integrator.emission_estimator = EmissionEstimator::Absorption;
   EXPECT_THROW(resolve(s), std::invalid_argument);
-  s.integrator.emission_estimator = "collision";
+  s.integrator.emission_estimator = EmissionEstimator::Collision;
   EXPECT_EQ(resolve(s).strategy, LightStrategy::Mis);
 }
 

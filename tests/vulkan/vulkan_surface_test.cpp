@@ -155,7 +155,7 @@ Scene emissive_medium_over_plane(const std::filesystem::path& dir, int spp, uint
   s.camera.look_at = {0.0, 0.0, 0.6};
   s.camera.up = {0, 0, 1};
   s.integrator.max_depth = 6;
-  s.integrator.emission_estimator = "collision";
+  s.integrator.emission_estimator = EmissionEstimator::Collision;
   s.background = glm::dvec3(5.0);  // hidden by the environment
   s.environment = Environment{exr, 0.5, env_rotation};
   Shape plane = test::plane_shape({0, 0, 0}, {0, 0, 1}, {6, 6}, {0.9, 0.85, 0.8});

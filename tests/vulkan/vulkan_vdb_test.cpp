@@ -52,7 +52,7 @@ class VulkanVdb : public test::VdbFixture {
   static Scene lookup_bound_fire(int width, int height, int spp) {
     Scene s = shipped_fire(width, height, spp);
     s.integrator.max_depth = 16;
-    s.integrator.emission_estimator = "absorption";
+    s.integrator.emission_estimator = EmissionEstimator::Absorption;
     s.media[0].density_scale = 8.0;
     s.media[0].sigma_a = glm::dvec3(0.5);
     s.media[0].sigma_s = glm::dvec3(4.0);
@@ -83,7 +83,7 @@ TEST_F(VulkanVdb, ZeroMajorantRegionsAreSkipped) {
     return test::uniform_albedo_radiance(s, f.optical_depth(o, d));
   });
   RenderResult grid = expect_closed_form(s, exact, "zero gap (grid)");
-  s.integrator.majorant = "global";
+  s.integrator.majorant = Majorant::Global;
   RenderResult global = expect_closed_form(s, exact, "zero gap (global)");
   std::printf("zero gap: lookups/sample grid %.3f, global %.3f (ratio %.2f)\n", per_sample(grid.density_lookups, grid),
               per_sample(global.density_lookups, global), global.density_lookups / grid.density_lookups);
@@ -110,7 +110,7 @@ TEST_F(VulkanVdb, EstimatorsAgreeOnScatteringChromaticTemperatureScene) {
     s.integrator.emission_estimator = kVdbEstimators[i];
     s.film.seed = 11 + 13 * i;
     r[i] = render(s);
-    std::printf("%s: %.2f s, lookups/sample %.2f, events/sample %.3f\n", kVdbEstimators[i], r[i].seconds,
+    std::printf("%s: %.2f s, lookups/sample %.2f, events/sample %.3f\n", to_string(kVdbEstimators[i]), r[i].seconds,
                 per_sample(r[i].density_lookups, r[i]), per_sample(r[i].events, r[i]));
   }
   ZTestReport rep = test::ztest_images(r[1], r[0], pooled(0.01));
@@ -119,7 +119,7 @@ TEST_F(VulkanVdb, EstimatorsAgreeOnScatteringChromaticTemperatureScene) {
   // The comparison can fail: 3 % more emission in one image is rejected.
   Scene brighter = s;
   for (Medium& m : brighter.media) m.emission.scale *= 1.03;
-  brighter.integrator.emission_estimator = "collision";
+  brighter.integrator.emission_estimator = EmissionEstimator::Collision;
   ZTestReport wrong = test::ztest_images(render(brighter), r[0], pooled(0.01));
   EXPECT_FALSE(wrong.ok) << "3 % more emission was accepted: " << wrong.summary();
   std::printf("deliberately wrong (3 %% brighter): %s\n", wrong.summary().c_str());
@@ -131,16 +131,16 @@ TEST_F(VulkanVdb, EstimatorsAgreeOnScatteringChromaticTemperatureScene) {
 TEST_F(VulkanVdb, MajorantGridMatchesGlobalWithFewerLookups) {
   const test::Lattice shell_lat{0.05, {0.0, 0.0, 0.0}};
   Scene s = shell_view(32, 32, 512, {0.1, 0.15, 0.3}, 4, -4.0);
-  s.integrator.emission_estimator = "collision";
+  s.integrator.emission_estimator = EmissionEstimator::Collision;
   s.media.push_back(test::vdb_medium("shell",
                                      test::write_explosion_shell_vdb(dir / "shell.vdb", shell_lat, 20.0, 30.0, 1.0f),
                                      {2.0, 2.5, 3.0}, {1.0, 1.0, 1.0}, 0.3, std::nullopt, 2.0, true));
   s.media[0].density_scale = 3.0;
   s.media[0].temperature.cutoff_k = 800.0;
-  s.integrator.majorant = "global";
+  s.integrator.majorant = Majorant::Global;
   s.film.seed = 5;
   const RenderResult global = render(s);
-  s.integrator.majorant = "grid";
+  s.integrator.majorant = Majorant::Grid;
   s.film.seed = 6;
   const RenderResult grid_default = render(s);
   s.integrator.majorant_grid = glm::ivec3(16);
@@ -280,7 +280,7 @@ TEST_F(VulkanVdb, TemperatureOnTheDensityLatticeSharesItsTexture) {
   Scene same = hot_box_scene("same.vdb", test::TemperatureBox{lat, box, 1.0f});
   same.film.spp = 64;
   same.integrator.max_depth = 4;
-  same.integrator.emission_estimator = "collision";
+  same.integrator.emission_estimator = EmissionEstimator::Collision;
   RenderSettings apart = settings_for(same);
   apart.temperature_in_density = false;
   const RenderResult shared = render(same), own = render(same, apart);

@@ -758,7 +758,7 @@ std::string CpuRenderer::device_name() const {
 RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& settings, const RenderControl& control) {
   using namespace cpu;
   auto load_start = Clock::now();
-  if (settings.width <= 0 || settings.height <= 0 || settings.spp <= 0 || settings.spp > kMaxSpp)
+  if (settings.width <= 0 || settings.height <= 0 || !spp_in_range(settings.spp))
     throw std::invalid_argument("cpu reference: width, height and spp must be positive (spp at most 2^24)");
   {
     glm::dvec3 f = scene.camera.look_at - scene.camera.position;
@@ -817,7 +817,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   res.backend = name();
   res.device = device_name();
   res.light_strategy = strategy_name(lights.selection.strategy);
-  res.emission_estimator = estimator_name(lights.selection.estimator);
+  res.emission_estimator = to_string(lights.selection.estimator);
   res.spp_target = settings.spp;
   res.sum.assign(size_t(W) * H * 3, 0.0);
   res.sum_sq.assign(size_t(W) * H * 3, 0.0);

@@ -196,7 +196,7 @@ void add_majorant_cells(const Scene& scene, GpuScene& g) {
   for (size_t slot = 0; slot < g.grids.size(); ++slot) {
     // Majorant cells over the stored (rounded) density.
     const DenseGrid& density = g.grid_sources[slot].density->grid;
-    const glm::ivec3 res = scene.integrator.majorant == "global"
+    const glm::ivec3 res = scene.integrator.majorant == Majorant::Global
                                ? glm::ivec3(1)
                                : scene.integrator.majorant_grid.value_or(default_majorant_resolution(density.dims));
     const MajorantGrid mg = build_majorant_grid(density, res);

@@ -68,12 +68,12 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
   result.backend = name();
   result.device = device_name();
   result.light_strategy = strategy_name(session.light_selection().strategy);
-  result.emission_estimator = estimator_name(session.light_selection().estimator);
+  result.emission_estimator = to_string(session.light_selection().estimator);
   result.warnings = session.warnings();
   result.load_seconds = since(load_start) + context_seconds_;
   context_seconds_ = 0.0;
 
-  if (settings.spp <= 0 || settings.spp > kMaxSpp)
+  if (!spp_in_range(settings.spp))
     throw std::invalid_argument("vulkan: spp must be in 1..2^24, not " + std::to_string(settings.spp));
   result.spp_target = settings.spp;
   if (control.resume) {
