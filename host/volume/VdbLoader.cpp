@@ -273,6 +273,17 @@ void report_counts(const DenseBuilder& b, const std::string& file, Role role, co
                        " negative density voxels clamped to 0");
 }
 
+// A filled grid: its counts reported, its index maps set and checked.
+DenseGrid finish_grid(DenseBuilder& b, DenseGrid& out, const glm::dmat4& grid_to_world, const VolumeOptions& m,
+                      Role role, const std::string& file, std::vector<std::string>& warnings) {
+  b.finish();
+  report_counts(b, file, role, out.name, warnings);
+  out.index_to_world = m.transform * grid_to_world * b.index_map();
+  out.world_to_index = glm::inverse(out.index_to_world);
+  check_index_maps(out, file, role);
+  return std::move(out);
+}
+
 // A grid with no active voxels: no texels, only its index maps, and a warning.
 DenseGrid empty_grid(std::string name, const glm::dmat4& grid_to_world, const VolumeOptions& m, Role role,
                      const std::string& file, std::vector<std::string>& warnings) {
@@ -311,12 +322,7 @@ DenseGrid dense_from_openvdb(const GridT& grid, const VolumeOptions& m, Role rol
       b.add_box(box, double(*it));
     }
   }
-  b.finish();
-  report_counts(b, file, role, out.name, warnings);
-  out.index_to_world = m.transform * grid_to_world * b.index_map();
-  out.world_to_index = glm::inverse(out.index_to_world);
-  check_index_maps(out, file, role);
-  return out;
+  return finish_grid(b, out, grid_to_world, m, role, file, warnings);
 }
 
 std::vector<GridEntry> openvdb_grid_entries(openvdb::io::File& f) {
@@ -397,12 +403,7 @@ DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Volume
         const nanovdb::Coord ijk{int32_t(i), int32_t(j), int32_t(k)};
         if (acc.isActive(ijk)) b.add(i, j, k, double(acc.getValue(ijk)));
       }
-  b.finish();
-  report_counts(b, file, role, out.name, warnings);
-  out.index_to_world = m.transform * grid_to_world * b.index_map();
-  out.world_to_index = glm::inverse(out.index_to_world);
-  check_index_maps(out, file, role);
-  return out;
+  return finish_grid(b, out, grid_to_world, m, role, file, warnings);
 }
 
 VolumeGrids load_nanovdb(const VolumeOptions& m, bool need_temperature, const DenseLimits& limits) {
