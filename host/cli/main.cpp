@@ -46,8 +46,8 @@ int main(int argc, char** argv) {
   render->add_option("--backend", render_args.backend, "vulkan (default) or cpu")->check(CLI::IsMember({"vulkan", "cpu"}));
   render->add_option("--spp", render_args.spp, "Samples per pixel (overrides film.spp), at most 2^24")
       ->check(CLI::Range(pyrolume::kMinSpp, pyrolume::kMaxSpp));
-  render->add_option("--width", render_args.width, "Image width (overrides film.width)")->check(CLI::Range(1, 16384));
-  render->add_option("--height", render_args.height, "Image height (overrides film.height)")->check(CLI::Range(1, 16384));
+  render->add_option("--width", render_args.width, "Image width (overrides film.width)")->check(CLI::Range(1, pyrolume::kMaxFilmSide));
+  render->add_option("--height", render_args.height, "Image height (overrides film.height)")->check(CLI::Range(1, pyrolume::kMaxFilmSide));
   render->add_option("--seed", render_args.seed, "Random seed (overrides film.seed)");
   render->add_option("--time-limit", render_args.time_limit, "Stop after the pass that crosses SEC seconds")
       ->check(CLI::NonNegativeNumber);
@@ -76,8 +76,8 @@ int main(int argc, char** argv) {
   preview->add_option("--frames", pv.frames, "Show N display frames, save --screenshot, exit")->check(CLI::PositiveNumber);
   preview->add_option("--screenshot", pv.screenshot, "PNG of what the window shows (with --frames)");
   preview->add_option("--device", pv.device, "Vulkan device index")->check(CLI::NonNegativeNumber);
-  preview->add_option("--width", pv.width, "Window width (overrides film.width)")->check(CLI::Range(16, 16384));
-  preview->add_option("--height", pv.height, "Window height (overrides film.height)")->check(CLI::Range(16, 16384));
+  preview->add_option("--width", pv.width, "Window width (overrides film.width)")->check(CLI::Range(16, pyrolume::kMaxFilmSide));
+  preview->add_option("--height", pv.height, "Window height (overrides film.height)")->check(CLI::Range(16, pyrolume::kMaxFilmSide));
   preview->add_option("--exposure", pv.exposure, "Starting exposure in stops, or auto (overrides film.exposure)");
 
   std::string info_file;

@@ -133,7 +133,7 @@ Checkpoint read_checkpoint(const fs::path& file, const PayloadBytes& payload_byt
   }
   const CheckpointIdentity& id = c.identity;
   // spp 0: saved before the first pass ended.
-  if (id.width < 1 || id.height < 1 || id.width > 16384 || id.height > 16384 ||
+  if (id.width < 1 || id.height < 1 || id.width > kMaxFilmSide || id.height > kMaxFilmSide ||
       (c.state.spp != 0 && !spp_in_range(c.state.spp)))
     throw input_error(name, "", "corrupt checkpoint header: impossible width, height or spp");
   if (payload_bytes(id.backend, id.width, id.height) == 0)

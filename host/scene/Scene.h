@@ -60,6 +60,9 @@ enum class ViewTransform { AgX, Standard };
 // to their range checks, whose messages users see.
 inline constexpr int kMinSpp = 1, kMaxSpp = 1 << 24;
 inline constexpr bool spp_in_range(long long spp) { return spp >= kMinSpp && spp <= kMaxSpp; }
+// A film side is 1..16384 pixels everywhere (film keys, --width/--height,
+// checkpoints): 16384² pixels is also the largest EXR that is read.
+inline constexpr int kMaxFilmSide = 16384;
 
 struct Film {
   int width = 640;

@@ -482,8 +482,8 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
   if (r.has("film")) {
     Reader f = r.child("film");
     s.film.size_given = f.has("width") || f.has("height");
-    s.film.width = f.integer("width", s.film.width, 1, 16384);
-    s.film.height = f.integer("height", s.film.height, 1, 16384);
+    s.film.width = f.integer("width", s.film.width, 1, kMaxFilmSide);
+    s.film.height = f.integer("height", s.film.height, 1, kMaxFilmSide);
     s.film.spp = f.integer("spp", s.film.spp, kMinSpp, kMaxSpp);
     if (f.has("exposure") && f.raw("exposure").is_string()) {
       const std::string e = f.string("exposure", "");
