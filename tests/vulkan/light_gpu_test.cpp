@@ -19,6 +19,7 @@
 #include "scene/Scene.h"
 #include "shared/light_types.h"
 #include "support/GpuCompute.h"
+#include "support/LightScenes.h"
 #include "volume/StoredVolume.h"
 
 using namespace pyrolume;
@@ -38,20 +39,11 @@ struct Query {
 };
 static_assert(sizeof(Query) == 160);
 
+// A sky gradient, a black band at the bottom and a small bright sun.
 Image sky(int W, int H) {
-  Image img = make_image(W, H);
-  for (int j = 0; j < H; ++j)
-    for (int i = 0; i < W; ++i) {
-      const double v = (j + 0.5) / H, u = (i + 0.5) / W;
-      double r = 0.1 + 0.5 * (1 - v), g = 0.2 + 0.3 * u, b = 0.9 - 0.6 * v;
-      if (j > H * 3 / 4) r = g = b = 0.0;
-      const double du = u - 0.62, dv = v - 0.21;
-      if (du * du + dv * dv < 0.002) r += 50, g += 45, b += 30;
-      img.at(i, j, 0) = float(r);
-      img.at(i, j, 1) = float(g);
-      img.at(i, j, 2) = float(b);
-    }
-  return img;
+  return test::sky_image(
+      W, H, [](double u, double v) { return glm::dvec3(0.1 + 0.5 * (1 - v), 0.2 + 0.3 * u, 0.9 - 0.6 * v); },
+      [&](int, int j) { return j > H * 3 / 4; }, {{0.62, 0.21}, 0.002, {50.0, 45.0, 30.0}});
 }
 
 // A small emissive grid with a rotated, sheared, anisotropic map and its own
@@ -79,14 +71,7 @@ EmissionCdf skewed_fire() {
                      glm::scale(glm::dmat4(1.0), glm::dvec3(1.5));
   t.world_to_index = glm::inverse(t.index_to_world);
   for (float& v : t.values) v = 2.0f * U(rng);
-  EmissionParams p;
-  p.sigma_a = {1.0, 1.5, 2.0};
-  p.emits_temperature = true;
-  p.temperature.scale = 1000.0;
-  p.temperature.cutoff_k = 700.0;
-  p.emission.scale = 2.0;
-  p.emission.is_grid = true;
-  return EmissionCdf::build(d, &t, p);
+  return EmissionCdf::build(d, &t, test::temperature_emission({1.0, 1.5, 2.0}, 700.0, 2.0));
 }
 
 void run_queries(Context& ctx, const EnvironmentMap& env, const EmissionCdf& cdf, std::vector<Query>& queries) {
