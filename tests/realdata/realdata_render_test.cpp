@@ -17,6 +17,7 @@
 #include "support/LightScenes.h"
 #include "support/Stats.h"
 #include "support/TestSupport.h"
+#include "support/VdbScenes.h"
 #include "volume/StoredVolume.h"
 
 namespace pyrolume {
@@ -109,15 +110,7 @@ std::unique_ptr<Backend> RealRender::backend_;
 
 // The medium of `file`'s "density" grid.
 Medium vdb(const fs::path& file, glm::dvec3 sigma_a, glm::dvec3 sigma_s, double g) {
-  Medium m;
-  m.name = file.stem().string();
-  m.type = Medium::Type::Vdb;
-  m.file = file;
-  m.density_grid = "density";
-  m.sigma_a = sigma_a;
-  m.sigma_s = sigma_s;
-  m.g = g;
-  return m;
+  return test::vdb_density_medium(file.stem().string(), file, sigma_a, sigma_s, g);
 }
 
 // Blackbody emission (seed normalisation) times `scale` from the grid
