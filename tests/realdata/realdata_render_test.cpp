@@ -14,8 +14,10 @@
 #include "render/cpu/CpuRenderer.h"
 #include "scene/MediumVolume.h"
 #include "support/AnalyticScenes.h"
+#include "support/LightScenes.h"
 #include "support/Stats.h"
 #include "support/TestSupport.h"
+#include "support/VdbScenes.h"
 #include "volume/StoredVolume.h"
 
 namespace pyrolume {
@@ -106,22 +108,27 @@ class RealRender : public ::testing::Test {
 };
 std::unique_ptr<Backend> RealRender::backend_;
 
+// The medium of `file`'s "density" grid.
 Medium vdb(const fs::path& file, glm::dvec3 sigma_a, glm::dvec3 sigma_s, double g) {
-  Medium m;
-  m.name = file.stem().string();
-  m.type = Medium::Type::Vdb;
-  m.file = file;
-  m.sigma_a = sigma_a;
-  m.sigma_s = sigma_s;
-  m.g = g;
-  return m;
+  return test::vdb_density_medium(file.stem().string(), file, sigma_a, sigma_s, g);
+}
+
+// Blackbody emission (seed normalisation) times `scale` from the grid
+// `temperature_grid`, its values mapped to kelvin by temperature_scale with
+// a cutoff of 600 K.
+void emit_blackbody(Medium& m, const char* temperature_grid, double scale, double temperature_scale) {
+  m.temperature_grid = temperature_grid;
+  m.emission.is_grid = true;
+  m.emission.scale = scale;
+  m.emission.blackbody = BlackbodyMode::Seed;
+  m.temperature.scale = temperature_scale;
+  m.temperature.cutoff_k = 600.0;
 }
 
 // Houdini smoke plume: density only (max 5.71), y up. No temperature grid, so
 // it is lit by the background (rgb 1) through scattering.
 TEST_F(RealRender, HoudiniSmokeLitByBackground) {
   Medium m = vdb(dir / "openvdb_smoke1_houdini.vdb", {0.15, 0.2, 0.25}, {0.45, 0.45, 0.45}, 0.3);
-  m.density_grid = "density";
   m.emission.scale = 0.0;
   Scene s = framed(m, {0, 0, 1}, {0, 1, 0}, 24, 32);
   s.background = {1.0, 1.0, 1.0};
@@ -135,17 +142,11 @@ TEST_F(RealRender, HoudiniSmokeLitByBackground) {
 // escape inside its disc add its radiance, MIS-weighted.
 TEST_F(RealRender, HoudiniSmokeLitBySun) {
   Medium m = vdb(dir / "openvdb_smoke1_houdini.vdb", {0.1, 0.1, 0.1}, {1.2, 1.2, 1.2}, 0.4);
-  m.density_grid = "density";
   m.emission.scale = 0.0;
   Scene s = framed(m, {0, 0, 1}, {0, 1, 0}, 24, 32);
   s.background = {0.05, 0.07, 0.1};
   s.integrator.max_depth = 4;
-  Light sun;
-  sun.type = Light::Type::Distant;
-  sun.direction = glm::normalize(glm::dvec3(-1.0, 0.3, 0.5));
-  sun.angle_deg = 0.53;
-  sun.rgb = glm::dvec3(3.0, 2.8, 2.5);
-  s.lights.push_back(sun);
+  s.lights.push_back(test::distant_light({-1.0, 0.3, 0.5}, {3.0, 2.8, 2.5}, 0.53));
   // The per-pixel criterion at 32 spp (issue 24); the image mean's bias
   // needs more samples to say anything (SE 0.4 % at 32 spp).
   compare(s, 32, 32, "houdini smoke under a sun, 32 spp", false);
@@ -156,13 +157,7 @@ TEST_F(RealRender, HoudiniSmokeLitBySun) {
 // mapped to kelvin by scale 1500 with cutoff 600 K; z up, non-uniform voxels.
 TEST_F(RealRender, Blender279FireWithHeat) {
   Medium m = vdb(dir / "blender279_fire_frame075.vdb", {1.0, 1.0, 1.0}, {0.5, 0.5, 0.5}, 0.2);
-  m.density_grid = "density";
-  m.temperature_grid = "heat";
-  m.emission.is_grid = true;
-  m.emission.scale = 4.0;
-  m.emission.blackbody = BlackbodyMode::Seed;
-  m.temperature.scale = 1500.0;
-  m.temperature.cutoff_k = 600.0;
+  emit_blackbody(m, "heat", 4.0, 1500.0);
   Scene s = framed(m, {0, 1, 0}, {0, 0, 1}, 20, 32);
   s.background = {0.05, 0.05, 0.08};
   s.integrator.max_depth = 4;
@@ -175,13 +170,7 @@ TEST_F(RealRender, Blender279FireWithHeat) {
 // gives ~1975 K emission.
 TEST_F(RealRender, MantaflowSmokeWithTemperature) {
   Medium m = vdb(dir / "blender50_mantaflow_smoke_frame0001.vdb", {2.0, 2.0, 2.0}, {1.5, 1.5, 1.5}, 0.0);
-  m.density_grid = "density";
-  m.temperature_grid = "temperature";
-  m.emission.is_grid = true;
-  m.emission.scale = 3.0;
-  m.emission.blackbody = BlackbodyMode::Seed;
-  m.temperature.scale = 1000.0;
-  m.temperature.cutoff_k = 600.0;
+  emit_blackbody(m, "temperature", 3.0, 1000.0);
   Scene s = framed(m, {0, 1, 0}, {0, 0, 1}, 32, 32);
   s.background = {0.1, 0.1, 0.15};
   s.integrator.max_depth = 4;

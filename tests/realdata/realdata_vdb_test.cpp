@@ -14,6 +14,7 @@
 
 #include "scene/MediumVolume.h"
 #include "support/TestSupport.h"
+#include "support/VdbScenes.h"
 #include "util/Error.h"
 #include "volume/VdbInfo.h"
 #include "volume/VdbLoader.h"
@@ -108,9 +109,7 @@ TEST_F(RealVdb, HoudiniSmokeInfo) {
 
 TEST_F(RealVdb, HoudiniSmokeLoadsDensityOnly) {
   const fs::path p = file("openvdb_smoke1_houdini.vdb");
-  Medium m;
-  m.type = Medium::Type::Vdb;
-  m.file = p;
+  Medium m = test::vdb_file_medium(p);
   const VolumeGrids v = load_volume(m, true);
   EXPECT_FALSE(v.temperature);  // no temperature, heat or flame grid
   ASSERT_EQ(v.warnings.size(), 1u);
@@ -153,9 +152,7 @@ TEST_F(RealVdb, Blender279FireInfo) {
 
 TEST_F(RealVdb, Blender279FireLoadsDensityAndHeat) {
   const fs::path p = file("blender279_fire_frame075.vdb");
-  Medium m;
-  m.type = Medium::Type::Vdb;
-  m.file = p;
+  Medium m = test::vdb_file_medium(p);
   const VolumeGrids v = load_volume(m, true);
   EXPECT_TRUE(v.warnings.empty());
   ASSERT_TRUE(v.temperature);
@@ -209,9 +206,7 @@ TEST_F(RealVdb, MantaflowSmokeInfoAndEmptyGrids) {
 
 TEST_F(RealVdb, MantaflowSmokeLoadsAndWarnsOnEmptyGrid) {
   const fs::path p = file("blender50_mantaflow_smoke_frame0001.vdb");
-  Medium m;
-  m.type = Medium::Type::Vdb;
-  m.file = p;
+  Medium m = test::vdb_file_medium(p);
   VolumeGrids v = load_volume(m, true);
   EXPECT_TRUE(v.warnings.empty());
   ASSERT_TRUE(v.temperature);

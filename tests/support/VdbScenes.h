@@ -167,20 +167,34 @@ std::filesystem::path write_explosion_shell_vdb(const std::filesystem::path& fil
 // Camera at (0, 0, −5) looking at the origin (AnalyticScenes' base), background 0.
 inline Scene vdb_base_scene(int width, int height, int spp) { return analytic_base_scene(width, height, spp); }
 
+// A `type: vdb` medium reading `file`, every other key at the scene format's
+// default (the loader picks the grids by their default names).
+inline Medium vdb_file_medium(const std::filesystem::path& file) {
+  Medium m;
+  m.type = Medium::Type::Vdb;
+  m.file = file;
+  return m;
+}
+
+// The same reading the grid "density", with the emission left at the default.
+inline Medium vdb_density_medium(const std::string& name, const std::filesystem::path& file, glm::dvec3 sigma_a,
+                                 glm::dvec3 sigma_s, double g = 0.0) {
+  Medium m = vdb_file_medium(file);
+  m.name = name;
+  m.density_grid = "density";
+  m.sigma_a = sigma_a;
+  m.sigma_s = sigma_s;
+  m.g = g;
+  return m;
+}
+
 // A `type: vdb` medium reading `file` ("density"; "temperature" when it emits
 // from a grid). Le_rgb set: constant emission scale · rgb × density; unset and
 // temperature_emission: blackbody of the grid temperature; else no emission.
 inline Medium vdb_medium(const std::string& name, const std::filesystem::path& file, glm::dvec3 sigma_a,
                          glm::dvec3 sigma_s, double g = 0.0, std::optional<glm::dvec3> Le_rgb = std::nullopt,
                          double emission_scale = 1.0, bool temperature_emission = false) {
-  Medium m;
-  m.name = name;
-  m.type = Medium::Type::Vdb;
-  m.file = file;
-  m.density_grid = "density";
-  m.sigma_a = sigma_a;
-  m.sigma_s = sigma_s;
-  m.g = g;
+  Medium m = vdb_density_medium(name, file, sigma_a, sigma_s, g);
   m.emission.scale = emission_scale;
   m.emission.rgb = Le_rgb;
   m.emission.is_grid = !Le_rgb && temperature_emission;
@@ -250,17 +264,15 @@ struct ConstantBoxField {
   }
 };
 
-// Radiance along a ray through one vdb medium whose density is `field`, with
-// constant emission Le = scale · rgb, when no path scatters (σs = 0 or
-// max_depth = 0): the absorbed fraction σa/σt of the extinction emits, since
-// σa(x)/σt(x) is the same at every x:
-//   L = (σa/σt) · Le · (1 − e^{−σt τ}) + background · e^{−σt τ},  σ = sigma · density_scale
-inline glm::dvec3 constant_box_radiance(const Scene& s, const ConstantBoxField& field, const glm::dvec3& o,
-                                        const glm::dvec3& d, int* sig = nullptr) {
+// Radiance of a single-medium grid scene with constant emission Le = scale ·
+// rgb and σa/σt the same everywhere, when no path scatters (σs = 0 or
+// max_depth 0), from the optical depth τ = ∫ρ along the ray: the absorbed
+// fraction σa/σt of the extinction emits, since σa(x)/σt(x) is the same at
+// every x:
+//   L = (σa/σt)·Le·(1 − e^{−σt τ}) + bg·e^{−σt τ},  σ = sigma · density_scale.
+inline glm::dvec3 uniform_albedo_radiance(const Scene& s, double tau) {
   const Medium& m = s.media.at(0);
   const glm::dvec3 Le = m.emission.emits() && m.emission.rgb ? m.emission.scale * *m.emission.rgb : glm::dvec3(0.0);
-  const double tau = field.optical_depth(o, d);
-  if (sig) *sig = field.signature(o, d);
   glm::dvec3 L;
   for (int c = 0; c < 3; ++c) {
     const double sa = m.sigma_a[c] * m.density_scale, st = (m.sigma_a[c] + m.sigma_s[c]) * m.density_scale;
@@ -268,6 +280,13 @@ inline glm::dvec3 constant_box_radiance(const Scene& s, const ConstantBoxField& 
     L[c] = (st > 0.0 ? sa / st * Le[c] * (1.0 - T) : 0.0) + s.background[c] * T;
   }
   return L;
+}
+
+// The same along a ray through one vdb medium whose density is `field`.
+inline glm::dvec3 constant_box_radiance(const Scene& s, const ConstantBoxField& field, const glm::dvec3& o,
+                                        const glm::dvec3& d, int* sig = nullptr) {
+  if (sig) *sig = field.signature(o, d);
+  return uniform_albedo_radiance(s, field.optical_depth(o, d));
 }
 
 // Pixel means of any per-ray closed form (jittered box filter), for
@@ -384,22 +403,6 @@ struct TrilinearVoxelField {
     return chord(support_box(lattice, box), o, d).signature * 1000 + chord(centre_box(lattice, box), o, d).signature;
   }
 };
-
-// Radiance of a single-medium grid scene with constant emission and σa/σt the
-// same everywhere, when no path scatters (σs = 0 or max_depth 0), from the
-// optical depth τ = ∫ρ along the ray (constant_box_radiance for any field):
-//   L = (σa/σt)·Le·(1 − e^{−σt τ}) + bg·e^{−σt τ},  σ = sigma · density_scale.
-inline glm::dvec3 uniform_albedo_radiance(const Scene& s, double tau) {
-  const Medium& m = s.media.at(0);
-  const glm::dvec3 Le = m.emission.emits() && m.emission.rgb ? m.emission.scale * *m.emission.rgb : glm::dvec3(0.0);
-  glm::dvec3 L;
-  for (int c = 0; c < 3; ++c) {
-    const double sa = m.sigma_a[c] * m.density_scale, st = (m.sigma_a[c] + m.sigma_s[c]) * m.density_scale;
-    const double T = std::exp(-st * tau);
-    L[c] = (st > 0.0 ? sa / st * Le[c] * (1.0 - T) : 0.0) + s.background[c] * T;
-  }
-  return L;
-}
 
 // Per-channel transmittance exp(−σt_c·density_scale·τ) along each camera ray
 // to infinity, pixel-averaged (what RenderSettings::debug_mode 1/2 estimates)

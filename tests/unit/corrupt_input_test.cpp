@@ -29,6 +29,7 @@
 #include "light/EnvironmentMap.h"
 #include "scene/MediumVolume.h"
 #include "support/TestSupport.h"
+#include "support/VdbScenes.h"
 #include "util/Error.h"
 #include "volume/VdbInfo.h"
 #include "volume/VdbLoader.h"
@@ -117,9 +118,7 @@ std::string vdb_outcome(const fs::path& p) {
     std::ostringstream out;
     msg += outcome(p, [&] { run_info_command(p, values, out); });
   }
-  Medium m;
-  m.type = Medium::Type::Vdb;
-  m.file = p;
+  Medium m = test::vdb_file_medium(p);
   return msg + outcome(p, [&] { load_volume(m, true); });
 }
 
@@ -152,9 +151,7 @@ TEST(CorruptVdb, EveryTruncationIsAnInputError) {
     const fs::path p = dir / "cut.vdb";
     for (size_t n : sample_positions(b.size())) {
       write_bytes(p, b, n);
-      Medium m;
-      m.type = Medium::Type::Vdb;
-      m.file = p;
+      Medium m = test::vdb_file_medium(p);
       EXPECT_NE(outcome(p, [&] { load_volume(m, true); }), "") << "cut at " << n << " of " << b.size();
       std::ostringstream out;
       EXPECT_NE(outcome(p, [&] { run_info_command(p, false, out); }), "") << "cut at " << n;

@@ -19,6 +19,7 @@
 
 #include "render/cpu/CpuRenderer.h"
 #include "support/AnalyticScenes.h"
+#include "support/LightScenes.h"
 #include "support/MisScenes.h"
 #include "support/Stats.h"
 #include "support/SurfaceScenes.h"
@@ -43,43 +44,10 @@ RenderResult render(const Scene& s, const char* strategy = "mis") {
   return res;
 }
 
-// ------------------------------------------------------------------ lights ----
-
-Light point_light(glm::dvec3 position, glm::dvec3 intensity) {
-  Light l;
-  l.type = Light::Type::Point;
-  l.position = position;
-  l.rgb = intensity;
-  return l;
-}
-
-Light spot_light(glm::dvec3 position, glm::dvec3 direction, glm::dvec3 intensity, double cone_deg,
-                 double falloff_deg) {
-  Light l = point_light(position, intensity);
-  l.type = Light::Type::Spot;
-  l.direction = glm::normalize(direction);
-  l.cone_deg = cone_deg;
-  l.falloff_deg = falloff_deg;
-  return l;
-}
-
-Light sun(glm::dvec3 direction, glm::dvec3 irradiance, double angle_deg) {
-  Light l;
-  l.type = Light::Type::Distant;
-  l.direction = glm::normalize(direction);
-  l.rgb = irradiance;
-  l.angle_deg = angle_deg;
-  return l;
-}
-
-Light sphere_light(glm::dvec3 center, double radius, glm::dvec3 radiance) {
-  Light l;
-  l.type = Light::Type::Sphere;
-  l.center = center;
-  l.radius = radius;
-  l.rgb = radiance;
-  return l;
-}
+using test::distant_light;
+using test::point_light;
+using test::sphere_light;
+using test::spot_light;
 
 // --------------------------------------------------------- closed forms ----
 
@@ -246,7 +214,7 @@ TEST(CpuLights, PointLightOnPlane) {
 // L = ρ/π · E cos θ, the same for every sample of every pixel.
 TEST(CpuLights, DeltaSunOnPlane) {
   Scene s = plane_scene(64);
-  s.lights.push_back(sun({0.3, 1, -0.4}, {1.5, 2, 2.5}, 0.0));
+  s.lights.push_back(distant_light({0.3, 1, -0.4}, {1.5, 2, 2.5}, 0.0));
   const RenderResult r = render(s);
   expect_matches(r, expected_image(s), 0.005, false, "delta sun");
   const glm::dvec3 L = kAlbedo / kPi * glm::dvec3(1.5, 2, 2.5) * s.lights[0].direction.y;
@@ -293,7 +261,7 @@ TEST(CpuLights, SphereLightOnAxis) {
 // for the real sun's 0.53°, where 1 − cos θ ≈ 1e-5.
 TEST(CpuLights, DiscSunMatchesDeltaSun) {
   Scene delta = plane_scene(64);
-  delta.lights.push_back(sun({0.3, 1, -0.2}, {2, 1.5, 1}, 0.0));
+  delta.lights.push_back(distant_light({0.3, 1, -0.2}, {2, 1.5, 1}, 0.0));
   const RenderResult rd = render(delta);
   for (double angle : {20.0, 0.53}) {
     Scene disc = delta;
@@ -358,7 +326,7 @@ TEST(CpuLights, SurfaceBlocksPointLight) {
 TEST(CpuLights, SphereLightBlocksSun) {
   Scene s = plane_scene(256);
   // The sphere just outside the view, its shadow in it.
-  s.lights.push_back(sun({1.1, 1.2, -0.2}, {1, 1.2, 1.4}, 0.0));
+  s.lights.push_back(distant_light({1.1, 1.2, -0.2}, {1, 1.2, 1.4}, 0.0));
   s.lights.push_back(sphere_light({1.6, 1.2, -0.2}, 0.35, {2, 1.5, 1}));
   expect_matches(render(s), expected_image(s), 0.005, true, "sun and sphere light");
 }
@@ -373,7 +341,7 @@ TEST(CpuLights, CameraSeesDiscSun) {
   s.camera.up = {0, 0, 1};
   s.camera.fov_deg = 10.0;
   s.background = {0.1, 0.2, 0.3};
-  s.lights.push_back(sun(a, {1, 2, 3}, 5.0));
+  s.lights.push_back(distant_light(a, {1, 2, 3}, 5.0));
   const double theta = 2.5 * kPi / 180.0;
   const glm::dvec3 L = glm::dvec3(1, 2, 3) / (kPi * std::sin(theta) * std::sin(theta));
   const auto exact = test::exact_image(16, 16, [&](double fx, double fy, int* sig) {
@@ -495,9 +463,9 @@ TEST(CpuLights, EveryLightUnderSkyWithEachStrategy) {
   s.lights.push_back(point_light({-0.5, 1.8, -0.4}, {1, 1.5, 2}));
   s.lights.push_back(spot_light({0.4, 1.6, 0.6}, {0.2, -1, -0.3}, {3, 2, 1}, 35.0, 15.0));
   // Its shadow from the sphere light falls outside the image (checked below).
-  s.lights.push_back(sun({-0.8, 1, 0}, {1.2, 1, 0.8}, 10.0));
+  s.lights.push_back(distant_light({-0.8, 1, 0}, {1.2, 1, 0.8}, 10.0));
   s.lights.push_back(sphere_light({1.5, 1.5, 0.3}, 0.25, {4, 3, 2}));  // just outside the view
-  s.lights.push_back(sun({0.2, 1, 0.5}, {0.3, 0.3, 0.3}, 0.0));
+  s.lights.push_back(distant_light({0.2, 1, 0.5}, {0.3, 0.3, 0.3}, 0.0));
   // The disc sun's cone never meets the sphere light from the plane in view.
   for (int y = 0; y <= 16; ++y)
     for (int x = 0; x <= 16; ++x) {

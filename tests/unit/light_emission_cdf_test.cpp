@@ -20,6 +20,7 @@
 #include "render/vulkan/LightPacking.h"
 #include "scene/MediumVolume.h"
 #include "scene/Scene.h"
+#include "support/LightScenes.h"
 #include "support/Stats.h"
 #include "volume/StoredVolume.h"
 
@@ -75,15 +76,9 @@ DenseGrid random_temperature(const DenseGrid& density, uint32_t seed) {
 }
 
 EmissionParams temperature_params() {
-  EmissionParams p;
-  p.sigma_a = {1.0, 2.0, 0.5};
-  p.emits_temperature = true;
-  p.temperature.scale = 1000.0;
+  EmissionParams p = test::temperature_emission({1.0, 2.0, 0.5}, 800.0, 3.0);
   p.temperature.offset = 0.0;
-  p.temperature.cutoff_k = 800.0;
-  p.emission.scale = 3.0;
   p.emission.blackbody = BlackbodyMode::Seed;
-  p.emission.is_grid = true;
   return p;
 }
 
@@ -93,6 +88,13 @@ EmissionParams rgb_params() {
   p.emits_rgb = true;
   p.Le_rgb = {2.0, 1.0, 0.25};
   return p;
+}
+
+// The emission CDF of `density` with a random temperature grid (seed
+// temperature_seed) under temperature_params().
+EmissionCdf random_fire_cdf(const DenseGrid& density, uint32_t temperature_seed) {
+  const DenseGrid t = random_temperature(density, temperature_seed);
+  return EmissionCdf::build(density, &t, temperature_params());
 }
 
 // The emitted radiance per unit length at p, as the renderers compute it
@@ -176,9 +178,8 @@ TEST(EmissionCdf, ConstantEmissionWeightsAreTheCornerMaximaTimesLuminance) {
 }
 
 TEST(EmissionCdf, PointsFollowTheCellWeightsChiSquare) {
-  DenseGrid d = random_density(2);
-  DenseGrid t = random_temperature(d, 3);
-  EmissionCdf cdf = EmissionCdf::build(d, &t, temperature_params());
+  const DenseGrid d = random_density(2);
+  const EmissionCdf cdf = random_fire_cdf(d, 3);
   ASSERT_FALSE(cdf.empty());
   auto w = [&](glm::ivec3 c) { return cdf.cell_weight(c); };
   test::ChiSquareResult r = chi_square_cells(cdf, d, w, 400000, 5);
@@ -197,9 +198,8 @@ TEST(EmissionCdf, PointsFollowTheCellWeightsChiSquare) {
 }
 
 TEST(EmissionCdf, PdfOfAPointEqualsTheSampledPdf) {
-  DenseGrid d = random_density(4);
-  DenseGrid t = random_temperature(d, 5);
-  EmissionCdf cdf = EmissionCdf::build(d, &t, temperature_params());
+  const DenseGrid d = random_density(4);
+  const EmissionCdf cdf = random_fire_cdf(d, 5);
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> U(0.0, 1.0);
   for (int k = 0; k < 20000; ++k) {
@@ -417,9 +417,8 @@ glm::dvec3 uniform_direction(std::mt19937_64& rng) {
 }  // namespace
 
 TEST(EmissionCdf, BlocksSumTheirCellsAndSampleUniformlyInside) {
-  DenseGrid d = random_density(11);
-  DenseGrid t = random_temperature(d, 12);
-  const EmissionCdf cells = EmissionCdf::build(d, &t, temperature_params());
+  const DenseGrid d = random_density(11);
+  const EmissionCdf cells = random_fire_cdf(d, 12);
   const EmissionCdf blocks = cells.blocks(3);
   ASSERT_FALSE(blocks.empty());
   EXPECT_EQ(blocks.cells(), (cells.cells() + 2) / 3);
@@ -460,9 +459,8 @@ TEST(EmissionCdf, BlocksSumTheirCellsAndSampleUniformlyInside) {
 }
 
 TEST(EmissionCdf, DirectionPdfIsTheIntegralAlongTheRay) {
-  DenseGrid d = random_density(14);
-  DenseGrid t = random_temperature(d, 15);
-  const EmissionCdf fine = EmissionCdf::build(d, &t, temperature_params());
+  const DenseGrid d = random_density(14);
+  const EmissionCdf fine = random_fire_cdf(d, 15);
   for (const EmissionCdf& cdf : {fine, fine.blocks(2), fine.blocks(2).clustered(2)}) {
     std::mt19937_64 rng(16);
     std::uniform_real_distribution<double> U(0.0, 1.0);
@@ -487,9 +485,8 @@ TEST(EmissionCdf, DirectionPdfIsTheIntegralAlongTheRay) {
 }
 
 TEST(EmissionCdf, DirectionPdfIntegratesToOneOverTheSphere) {
-  DenseGrid d = random_density(17);
-  DenseGrid t = random_temperature(d, 18);
-  const EmissionCdf fine = EmissionCdf::build(d, &t, temperature_params());
+  const DenseGrid d = random_density(17);
+  const EmissionCdf fine = random_fire_cdf(d, 18);
   const EmissionCdf blocks = fine.blocks(3);
   const EmissionCdf clusters = fine.clustered(3);
   for (const EmissionCdf* cdf : {&fine, &blocks, &clusters}) {
@@ -534,9 +531,8 @@ TEST(EmissionCdf, DirectionPdfIntegratesToOneOverTheSphere) {
 // away the distribution tends to the static one (all clusters at about the
 // same distance).
 TEST(EmissionCdf, ClustersSeenFromAReceiver) {
-  DenseGrid d = random_density(21);
-  DenseGrid t = random_temperature(d, 22);
-  const EmissionCdf fine = EmissionCdf::build(d, &t, temperature_params());
+  const DenseGrid d = random_density(21);
+  const EmissionCdf fine = random_fire_cdf(d, 22);
   const EmissionCdf cdf = fine.clustered(3);
   ASSERT_TRUE(cdf.is_clustered());
   ASSERT_FALSE(fine.is_clustered());

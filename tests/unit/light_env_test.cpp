@@ -13,6 +13,7 @@
 #include "image/ImageIo.h"
 #include "light/EnvironmentMap.h"
 #include "render/vulkan/LightPacking.h"
+#include "support/LightScenes.h"
 #include "support/Stats.h"
 #include "support/TestSupport.h"
 #include "util/Error.h"
@@ -26,20 +27,13 @@ constexpr double kPi = 3.14159265358979323846;
 // A map with structure everywhere the sampler must get right: a sky gradient,
 // a bright small "sun", a black band (zero rows' neighbours) and black columns.
 Image test_map(int W, int H) {
-  Image img = make_image(W, H);
-  for (int j = 0; j < H; ++j)
-    for (int i = 0; i < W; ++i) {
-      const double v = (j + 0.5) / H, u = (i + 0.5) / W;
-      double r = 0.2 + 0.8 * (1.0 - v), g = 0.3 + 0.5 * u, b = 1.0 - 0.5 * v;
-      if (j >= H * 5 / 8 && j < H * 6 / 8) r = g = b = 0.0;  // black band
-      if (i == W / 3 || i == W / 3 + 1) r = g = b = 0.0;     // black columns
-      const double du = u - 0.7, dv = v - 0.3;
-      if (du * du + dv * dv < 0.004) r += 40.0, g += 30.0, b += 20.0;  // the sun
-      img.at(i, j, 0) = float(r);
-      img.at(i, j, 1) = float(g);
-      img.at(i, j, 2) = float(b);
-    }
-  return img;
+  return pyrolume::test::sky_image(
+      W, H, [](double u, double v) { return glm::dvec3(0.2 + 0.8 * (1.0 - v), 0.3 + 0.5 * u, 1.0 - 0.5 * v); },
+      [&](int i, int j) {
+        return (j >= H * 5 / 8 && j < H * 6 / 8)     // black band
+               || i == W / 3 || i == W / 3 + 1;  // black columns
+      },
+      {{0.7, 0.3}, 0.004, {40.0, 30.0, 20.0}});  // the sun
 }
 
 glm::dvec3 dir_from(double cos_theta, double phi) {

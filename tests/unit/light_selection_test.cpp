@@ -17,6 +17,7 @@
 #include "render/cpu/CpuRenderer.h"
 #include "scene/MediumVolume.h"
 #include "scene/Scene.h"
+#include "support/LightScenes.h"
 #include "support/MisScenes.h"
 #include "util/Error.h"
 #include "volume/StoredVolume.h"
@@ -294,40 +295,16 @@ TEST_F(LightResolution, FireAloneRendersAsBefore) {
 double luminance(glm::dvec3 c) { return 0.2126729 * c.r + 0.7151522 * c.g + 0.0721750 * c.b; }
 constexpr double kPi = 3.14159265358979323846;
 
-Light point_light(glm::dvec3 intensity) {
-  Light l;
-  l.type = Light::Type::Point;
-  l.position = {0, 1, 0};
-  l.rgb = intensity;
-  return l;
-}
-
+// Every light at (0, 1, 0), the spot shining down and the sun overhead:
+// where they are does not change their power.
+Light point_light(glm::dvec3 intensity) { return test::point_light({0, 1, 0}, intensity); }
 Light distant_light(glm::dvec3 irradiance, double angle_deg) {
-  Light l;
-  l.type = Light::Type::Distant;
-  l.direction = {0, 1, 0};
-  l.rgb = irradiance;
-  l.angle_deg = angle_deg;
-  return l;
+  return test::distant_light({0, 1, 0}, irradiance, angle_deg);
 }
-
 Light spot_light(glm::dvec3 intensity, double cone_deg, double falloff_deg) {
-  Light l = point_light(intensity);
-  l.type = Light::Type::Spot;
-  l.direction = {0, -1, 0};
-  l.cone_deg = cone_deg;
-  l.falloff_deg = falloff_deg;
-  return l;
+  return test::spot_light({0, 1, 0}, {0, -1, 0}, intensity, cone_deg, falloff_deg);
 }
-
-Light sphere_light(glm::dvec3 radiance, double radius) {
-  Light l;
-  l.type = Light::Type::Sphere;
-  l.center = {0, 1, 0};
-  l.radius = radius;
-  l.rgb = radiance;
-  return l;
-}
+Light sphere_light(glm::dvec3 radiance, double radius) { return test::sphere_light({0, 1, 0}, radius, radiance); }
 
 class LightSelectionLights : public LightResolution {
  protected:

@@ -6,6 +6,7 @@
 
 #include "scene/MediumVolume.h"
 #include "scene/Scene.h"
+#include "support/VdbScenes.h"
 #include "volume/VdbLoader.h"
 
 namespace pyrolume {
@@ -18,9 +19,7 @@ TEST(FireAsset, IsSmallAndLaidOutLikeABlenderExport) {
   const fs::path vdb = kSource / "assets/volumes/fire.vdb";
   ASSERT_TRUE(fs::exists(vdb)) << "regenerate it: see docs/volumes.md";
   EXPECT_LT(fs::file_size(vdb), 1500u * 1000u);
-  Medium m;
-  m.type = Medium::Type::Vdb;
-  m.file = vdb;
+  Medium m = test::vdb_file_medium(vdb);
   const VolumeGrids v = load_volume(m, true);
   EXPECT_TRUE(v.warnings.empty());
   ASSERT_TRUE(v.temperature);

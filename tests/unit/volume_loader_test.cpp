@@ -63,12 +63,7 @@ void write_vdb(const fs::path& p, const openvdb::GridPtrVec& grids) {
   f.close();
 }
 
-Medium vdb_medium(const fs::path& file) {
-  Medium m;
-  m.type = Medium::Type::Vdb;
-  m.file = file;
-  return m;
-}
+using test::vdb_file_medium;
 
 std::string joined(const std::vector<std::string>& w) {
   std::string s;
@@ -95,7 +90,7 @@ class VolumeLoader : public ::testing::Test {
 };
 
 TEST_F(VolumeLoader, MismatchedGridsSampleTheirOwnFieldAtEveryWorldPoint) {
-  const VolumeGrids v = load_volume(vdb_medium(write_mismatched_pair()), true);
+  const VolumeGrids v = load_volume(vdb_file_medium(write_mismatched_pair()), true);
   ASSERT_TRUE(v.temperature.has_value());
   EXPECT_TRUE(v.warnings.empty()) << joined(v.warnings);
   // Dense box = active bbox + one voxel of padding.
@@ -126,7 +121,7 @@ TEST_F(VolumeLoader, MismatchedGridsSampleTheirOwnFieldAtEveryWorldPoint) {
 
 TEST_F(VolumeLoader, MatchesOpenVdbBoxSamplerIncludingEdgeBlendWithBackground) {
   const fs::path p = write_mismatched_pair();
-  const VolumeGrids v = load_volume(vdb_medium(p), true);
+  const VolumeGrids v = load_volume(vdb_file_medium(p), true);
   openvdb::io::File f(p.string());
   f.open(false);
   std::mt19937 rng(11);
@@ -166,7 +161,7 @@ TEST_F(VolumeLoader, IndexToWorldMatchesOpenVdbForRotatedAnisotropicAffineMaps) 
   auto g = make_grid<openvdb::FloatGrid>("density", xf, CoordBBox(Coord(-4, -3, -5), Coord(6, 5, 4)), f_density);
   const fs::path p = dir / "affine.vdb";
   write_vdb(p, {g});
-  const VolumeGrids v = load_volume(vdb_medium(p), false);
+  const VolumeGrids v = load_volume(vdb_file_medium(p), false);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-5, 5);
   for (int n = 0; n < 200; ++n) {
@@ -194,7 +189,7 @@ TEST_F(VolumeLoader, HalfAndDoubleGrids) {
                                           CoordBBox(Coord(0, 0, 0), Coord(5, 5, 5)), f_temperature);
   const fs::path p = dir / "half_double.vdb";
   write_vdb(p, {h, d});
-  const VolumeGrids v = load_volume(vdb_medium(p), true);
+  const VolumeGrids v = load_volume(vdb_file_medium(p), true);
   ASSERT_TRUE(v.temperature);
   EXPECT_EQ(v.temperature->name, "heat");  // default: first of temperature, heat, flame
   // Stored as half: 11-bit mantissa, so ~5e-4 relative.
@@ -222,7 +217,7 @@ TEST_F(VolumeLoader, VectorGridNamedAsDensityIsAnError) {
   const fs::path p = dir / "vec.vdb";
   write_vdb(p, {vel});
   try {
-    load_volume(vdb_medium(p), false);
+    load_volume(vdb_file_medium(p), false);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     const std::string msg = e.what();
@@ -235,7 +230,7 @@ TEST_F(VolumeLoader, VectorGridNamedAsDensityIsAnError) {
 
 TEST_F(VolumeLoader, MissingGridListsTheGridsThatExist) {
   const fs::path p = write_mismatched_pair();
-  Medium m = vdb_medium(p);
+  Medium m = vdb_file_medium(p);
   m.density_grid = "smoke";
   try {
     load_volume(m, true);
@@ -247,7 +242,7 @@ TEST_F(VolumeLoader, MissingGridListsTheGridsThatExist) {
     EXPECT_NE(msg.find("\"density\""), std::string::npos) << msg;
     EXPECT_NE(msg.find("\"temperature\""), std::string::npos) << msg;
   }
-  m = vdb_medium(p);
+  m = vdb_file_medium(p);
   m.temperature_grid = "flame";
   EXPECT_THROW(load_volume(m, true), InputError);
   EXPECT_NO_THROW(load_volume(m, false));  // not needed: not read, not checked
@@ -255,14 +250,14 @@ TEST_F(VolumeLoader, MissingGridListsTheGridsThatExist) {
 
 TEST_F(VolumeLoader, MissingFileAndNonVdbFileAreInputErrors) {
   try {
-    load_volume(vdb_medium(dir / "nope.vdb"), true);
+    load_volume(vdb_file_medium(dir / "nope.vdb"), true);
     FAIL();
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("not found"), std::string::npos) << e.what();
   }
   test::write_file(dir / "text.vdb", "this is not a volume\n");
   try {
-    load_volume(vdb_medium(dir / "text.vdb"), true);
+    load_volume(vdb_file_medium(dir / "text.vdb"), true);
     FAIL();
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("not an OpenVDB"), std::string::npos) << e.what();
@@ -271,7 +266,7 @@ TEST_F(VolumeLoader, MissingFileAndNonVdbFileAreInputErrors) {
   const fs::path p = write_mismatched_pair();
   std::string bytes = test::read_file(p);
   test::write_file(dir / "truncated.vdb", bytes.substr(0, 40));
-  EXPECT_THROW(load_volume(vdb_medium(dir / "truncated.vdb"), true), InputError);
+  EXPECT_THROW(load_volume(vdb_file_medium(dir / "truncated.vdb"), true), InputError);
   EXPECT_THROW(run_info_command(dir / "text.vdb", false, std::cout), InputError);
 }
 
@@ -280,7 +275,7 @@ TEST_F(VolumeLoader, EmptyGridWarnsAndRendersAsNoMedium) {
   d->setName("density");
   const fs::path p = dir / "empty.vdb";
   write_vdb(p, {d});
-  const VolumeGrids v = load_volume(vdb_medium(p), true);
+  const VolumeGrids v = load_volume(vdb_file_medium(p), true);
   EXPECT_TRUE(v.density.empty());
   EXPECT_EQ(v.density.sample_world({0, 0, 0}), 0.0);
   const std::string w = joined(v.warnings);
@@ -297,7 +292,7 @@ TEST_F(VolumeLoader, NanVoxelsBecomeZeroWithACount) {
   d->tree().setValue(Coord(2, 2, 1), -std::numeric_limits<float>::infinity());
   const fs::path p = dir / "nan.vdb";
   write_vdb(p, {d});
-  const VolumeGrids v = load_volume(vdb_medium(p), false);
+  const VolumeGrids v = load_volume(vdb_file_medium(p), false);
   const std::string w = joined(v.warnings);
   EXPECT_NE(w.find("3 NaN/Inf voxels treated as 0"), std::string::npos) << w;
   EXPECT_EQ(v.density.sample_world({1, 1, 1}), 0.0);
@@ -315,7 +310,7 @@ TEST_F(VolumeLoader, NegativeDensityIsClampedTemperatureIsNot) {
                                          CoordBBox(Coord(0, 0, 0), Coord(2, 2, 2)), [](auto p) { return p.x - 1.0; });
   const fs::path p = dir / "neg.vdb";
   write_vdb(p, {d, t});
-  const VolumeGrids v = load_volume(vdb_medium(p), true);
+  const VolumeGrids v = load_volume(vdb_file_medium(p), true);
   const std::string w = joined(v.warnings);
   EXPECT_NE(w.find("9 negative density voxels clamped to 0"), std::string::npos) << w;
   EXPECT_EQ(v.density.sample_world({0, 1, 1}), 0.0);
@@ -342,18 +337,18 @@ TEST_F(VolumeLoader, UnusedGridTypesAreSkippedSilently) {
   vel->tree().setValue(Coord(0, 0, 0), openvdb::Vec3s(0, 1, 0));
   const fs::path p = dir / "blenderish.vdb";
   write_vdb(p, {obstacles, vel, d, flame, heat});
-  VolumeGrids v = load_volume(vdb_medium(p), true);
+  VolumeGrids v = load_volume(vdb_file_medium(p), true);
   EXPECT_TRUE(v.warnings.empty()) << joined(v.warnings);
   ASSERT_TRUE(v.temperature);
   EXPECT_EQ(v.temperature->name, "heat");  // heat before flame, whatever the file order
-  Medium m = vdb_medium(p);
+  Medium m = vdb_file_medium(p);
   m.temperature_grid = "flame";
   v = load_volume(m, true);
   EXPECT_EQ(v.temperature->name, "flame");
   EXPECT_EQ(v.temperature->max_value, 0.5f);
-  v = load_volume(vdb_medium(p), false);
+  v = load_volume(vdb_file_medium(p), false);
   EXPECT_FALSE(v.temperature);
-  m = vdb_medium(p);
+  m = vdb_file_medium(p);
   m.temperature_grid = "obstacles";
   EXPECT_THROW(load_volume(m, true), InputError);
 }
@@ -365,7 +360,7 @@ TEST_F(VolumeLoader, DownsampleBoxFiltersALinearFieldExactly) {
                                          CoordBBox(Coord(0, 0, 0), Coord(15, 15, 15)), f_density);
   const fs::path p = dir / "ds.vdb";
   write_vdb(p, {d});
-  Medium m = vdb_medium(p);
+  Medium m = vdb_file_medium(p);
   m.downsample = 2;
   const VolumeGrids v = load_volume(m, false);
   EXPECT_EQ(v.density.dims, glm::ivec3(10, 10, 10));  // 8 coarse + 2 padding
@@ -408,7 +403,7 @@ TEST_F(VolumeLoader, MediumTransformGoesOnTopOfTheGridMap) {
   d->tree().setValue(Coord(2, 0, 0), 3.0f);
   const fs::path p = dir / "xf.vdb";
   write_vdb(p, {d});
-  Medium m = vdb_medium(p);
+  Medium m = vdb_file_medium(p);
   m.transform.rotate_deg = {0, 0, 90};
   m.transform.translate = {10, 0, -1};
   const VolumeGrids v = load_volume(m, false);
@@ -429,7 +424,7 @@ TEST_F(VolumeLoader, NanoVdbLoadsToTheSameTexturesAsOpenVdb) {
   const fs::path nvdb = dir / "pair.nvdb";
   test::write_nanovdb_copy(vdb, nvdb);  // both grids, density and temperature
 
-  Medium mv = vdb_medium(vdb), mn = vdb_medium(nvdb);
+  Medium mv = vdb_file_medium(vdb), mn = vdb_file_medium(nvdb);
   mv.transform.translate = mn.transform.translate = {0.5, 1, 2};
   const VolumeGrids a = load_volume(mv, true), b = load_volume(mn, true);
   ASSERT_TRUE(b.temperature);

@@ -8,6 +8,7 @@
 #include "scene/MediumVolume.h"
 #include "scene/Scene.h"
 #include "support/TestSupport.h"
+#include "support/VdbScenes.h"
 #include "volume/MajorantGrid.h"
 #include "volume/StoredVolume.h"
 
@@ -49,9 +50,7 @@ void check_bound(const DenseGrid& g, const MajorantGrid& m, int samples, uint32_
 }
 
 TEST(MajorantGrid, BoundsEveryTrilinearLookupOfTheProceduralFire) {
-  Medium m;
-  m.type = Medium::Type::Vdb;
-  m.file = std::filesystem::path(PYROLUME_SOURCE_DIR) / "assets/volumes/fire.vdb";
+  Medium m = test::vdb_file_medium(std::filesystem::path(PYROLUME_SOURCE_DIR) / "assets/volumes/fire.vdb");
   StoredVolume v = load_stored_volume(m);
   ASSERT_EQ(v.density.format, TextureFormat::R16F);
   for (glm::ivec3 res : {default_majorant_resolution(v.density.grid.dims), glm::ivec3(7, 5, 3), glm::ivec3(64)}) {
@@ -64,9 +63,7 @@ TEST(MajorantGrid, BoundsEveryTrilinearLookupOfARealVdb) {
   auto data = test::shared_data_dir();
   if (data.empty() || !std::filesystem::exists(data / "vdb/openvdb_smoke1_houdini.vdb"))
     GTEST_SKIP() << "../shared/data/vdb is absent: real-data majorant check skipped";
-  Medium m;
-  m.type = Medium::Type::Vdb;
-  m.file = data / "vdb/openvdb_smoke1_houdini.vdb";
+  Medium m = test::vdb_file_medium(data / "vdb/openvdb_smoke1_houdini.vdb");
   StoredVolume v = load_stored_volume(m);
   MajorantGrid grid = build_majorant_grid(v.density.grid, default_majorant_resolution(v.density.grid.dims));
   check_bound(v.density.grid, grid, 300000, 42);

@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
 #include <random>
 #include <sstream>
 #include <string>
@@ -16,10 +15,9 @@
 #include "geometry/Surfaces.h"
 #include "render/vulkan/Context.h"
 #include "render/vulkan/Memory.h"
-#include "render/vulkan/Pipeline.h"
-#include "render/vulkan/Spirv.h"
 #include "render/vulkan/SurfacePacking.h"
 #include "shared/geometry_types.h"
+#include "support/GpuCompute.h"
 #include "support/RandomDirections.h"
 
 using namespace pyrolume;
@@ -92,14 +90,32 @@ std::vector<geometry::Ray> test_rays(size_t count, std::vector<double>& t_max) {
 
 double min_bary(double b1, double b2) { return std::min(std::min(b1, b2), 1.0 - b1 - b2); }
 
+// test_bvh.comp's answers for `rays` through the packed surfaces `g`, whose
+// buffers are of memory `kind` with `usage`; `shape_count` specializes
+// SURFACE_SHAPE_COUNT (SURFACE_HAS_TRIANGLES is true).
+std::vector<TestResult> trace_on_gpu(Context& ctx, const GpuSurfaces& g, const std::vector<TestRay>& rays,
+                                     MemoryKind kind, VkBufferUsageFlags usage, uint32_t shape_count,
+                                     const char* name) {
+  Buffer nodes = test::filled_buffer(ctx, g.nodes, "bvh nodes", kind, usage);
+  Buffer tris = test::filled_buffer(ctx, g.triangles, "bvh triangles", kind, usage);
+  Buffer attrs = test::filled_buffer(ctx, g.attributes, "bvh attributes", kind, usage);
+  Buffer shapes = test::filled_buffer(ctx, g.shapes, "surface shapes", kind, usage);
+  Buffer ray_buf = test::filled_buffer(ctx, rays, "test rays", kind, usage);
+  Buffer results(ctx, rays.size() * sizeof(TestResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::Readback,
+                 "test results");
+  test::run_compute(ctx, "test_bvh.comp", {{&nodes}, {&tris}, {&attrs}, {&shapes}, {&ray_buf}, {&results}},
+                    uint32_t(rays.size()), {{0, shape_count}, {1, 1u}}, name);
+  std::vector<TestResult> got(rays.size());
+  test::read_back(results, got);
+  return got;
+}
+
 }  // namespace
 
 TEST(BvhGpu, ClosestHitsAndShadowRaysMatchTheCpu) {
   const uint64_t before = Context::total_validation_messages();
   {
-    Context::Options opt;
-    opt.validation = true;
-    Context ctx(opt);
+    Context ctx(test::validated());
     const Surfaces scene = test_scene();
     ASSERT_LT(scene.bvh.depth, gpu::BVH_STACK_SIZE);
     const GpuSurfaces g = pack_gpu_surfaces(scene);
@@ -110,43 +126,9 @@ TEST(BvhGpu, ClosestHitsAndShadowRaysMatchTheCpu) {
       gpu_rays[i].origin = glm::vec4(glm::vec3(rays[i].origin), float(t_max[i]));
       gpu_rays[i].direction = glm::vec4(glm::vec3(rays[i].direction), 0.0f);
     }
-
-    auto storage = [&](const void* data, size_t bytes, const char* name) {
-      Buffer b(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-               MemoryKind::DeviceLocal, name);
-      b.upload(ctx, data, bytes);
-      return b;
-    };
-    Buffer nodes = storage(g.nodes.data(), g.nodes.size() * sizeof(gpu::GpuBvhNode), "bvh nodes");
-    Buffer tris = storage(g.triangles.data(), g.triangles.size() * sizeof(gpu::GpuTriangle), "bvh triangles");
-    Buffer attrs =
-        storage(g.attributes.data(), g.attributes.size() * sizeof(gpu::GpuTriangleAttributes), "bvh attributes");
-    Buffer shapes = storage(g.shapes.data(), g.shapes.size() * sizeof(gpu::GpuSurfaceShape), "surface shapes");
-    Buffer ray_buf = storage(gpu_rays.data(), gpu_rays.size() * sizeof(TestRay), "test rays");
-    Buffer results(ctx, rays.size() * sizeof(TestResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::Readback,
-                   "test results");
-
-    std::vector<ComputePipeline::Binding> bindings;
-    for (uint32_t b = 0; b < 6; ++b) bindings.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
-    ComputePipeline pipeline(ctx, load_spirv("test_bvh.comp"), bindings, sizeof(uint32_t),
-                             {{0, g.shape_count}, {1, 1u}}, "test_bvh");
-    DescriptorSet set(ctx, pipeline, "test_bvh set");
-    set.write_buffer(0, nodes);
-    set.write_buffer(1, tris);
-    set.write_buffer(2, attrs);
-    set.write_buffer(3, shapes);
-    set.write_buffer(4, ray_buf);
-    set.write_buffer(5, results);
-    const uint32_t count = uint32_t(rays.size());
-    submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
-      pipeline.bind(cmd, set.set());
-      pipeline.push(cmd, count);
-      vkCmdDispatch(cmd, (count + 63) / 64, 1, 1);
-      to_host_read_barrier(cmd);
-    });
-    results.invalidate();
-    std::vector<TestResult> got(rays.size());
-    std::memcpy(got.data(), results.map(), got.size() * sizeof(TestResult));
+    const std::vector<TestResult> got =
+        trace_on_gpu(ctx, g, gpu_rays, MemoryKind::DeviceLocal,
+                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, g.shape_count, "test_bvh");
 
     size_t hits = 0, triangle_hits = 0, shape_hits = 0, explained = 0, wrong = 0, shadow_explained = 0;
     std::ostringstream first;
@@ -229,49 +211,18 @@ TEST(BvhGpu, ClosestHitsAndShadowRaysMatchTheCpu) {
 TEST(BvhGpu, EmptySceneMissesEverything) {
   const uint64_t before = Context::total_validation_messages();
   {
-    Context::Options opt;
-    opt.validation = true;
-    Context ctx(opt);
+    Context ctx(test::validated());
     const GpuSurfaces g = pack_gpu_surfaces(Surfaces{});
     std::vector<TestRay> rays(64);
     for (size_t i = 0; i < rays.size(); ++i) {
       rays[i].origin = glm::vec4(0.0f, 0.0f, 0.0f, 1e30f);
       rays[i].direction = glm::vec4(std::cos(0.1f * float(i)), 0.3f, std::sin(0.1f * float(i)), 0.0f);
     }
-    auto host = [&](const void* data, size_t bytes, const char* name) {
-      Buffer b(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::HostVisible, name);
-      b.upload(ctx, data, bytes);
-      return b;
-    };
-    Buffer nodes = host(g.nodes.data(), g.nodes.size() * sizeof(gpu::GpuBvhNode), "nodes");
-    Buffer tris = host(g.triangles.data(), g.triangles.size() * sizeof(gpu::GpuTriangle), "triangles");
-    Buffer attrs = host(g.attributes.data(), g.attributes.size() * sizeof(gpu::GpuTriangleAttributes), "attributes");
-    Buffer shapes = host(g.shapes.data(), g.shapes.size() * sizeof(gpu::GpuSurfaceShape), "shapes");
-    Buffer ray_buf = host(rays.data(), rays.size() * sizeof(TestRay), "rays");
-    Buffer results(ctx, rays.size() * sizeof(TestResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::Readback,
-                   "results");
-    std::vector<ComputePipeline::Binding> bindings;
-    for (uint32_t b = 0; b < 6; ++b) bindings.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
     // The empty BVH is traversed (SURFACE_HAS_TRIANGLES = true): its one leaf
     // holds nothing.
-    ComputePipeline pipeline(ctx, load_spirv("test_bvh.comp"), bindings, sizeof(uint32_t), {{0, 0u}, {1, 1u}},
-                             "test_bvh empty");
-    DescriptorSet set(ctx, pipeline);
-    set.write_buffer(0, nodes);
-    set.write_buffer(1, tris);
-    set.write_buffer(2, attrs);
-    set.write_buffer(3, shapes);
-    set.write_buffer(4, ray_buf);
-    set.write_buffer(5, results);
+    const std::vector<TestResult> r = trace_on_gpu(ctx, g, rays, MemoryKind::HostVisible,
+                                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 0u, "test_bvh empty");
     const uint32_t count = uint32_t(rays.size());
-    submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
-      pipeline.bind(cmd, set.set());
-      pipeline.push(cmd, count);
-      vkCmdDispatch(cmd, 1, 1, 1);
-      to_host_read_barrier(cmd);
-    });
-    results.invalidate();
-    const TestResult* r = results.data<TestResult>();
     for (uint32_t i = 0; i < count; ++i) {
       EXPECT_EQ(r[i].id.x, 0u) << i;
       EXPECT_EQ(r[i].hit.w, 0.0f) << i;

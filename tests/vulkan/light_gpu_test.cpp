@@ -15,11 +15,11 @@
 #include "render/vulkan/Context.h"
 #include "render/vulkan/LightPacking.h"
 #include "render/vulkan/Memory.h"
-#include "render/vulkan/Pipeline.h"
-#include "render/vulkan/Spirv.h"
 #include "scene/MediumVolume.h"
 #include "scene/Scene.h"
 #include "shared/light_types.h"
+#include "support/GpuCompute.h"
+#include "support/LightScenes.h"
 #include "volume/StoredVolume.h"
 
 using namespace pyrolume;
@@ -39,20 +39,11 @@ struct Query {
 };
 static_assert(sizeof(Query) == 160);
 
+// A sky gradient, a black band at the bottom and a small bright sun.
 Image sky(int W, int H) {
-  Image img = make_image(W, H);
-  for (int j = 0; j < H; ++j)
-    for (int i = 0; i < W; ++i) {
-      const double v = (j + 0.5) / H, u = (i + 0.5) / W;
-      double r = 0.1 + 0.5 * (1 - v), g = 0.2 + 0.3 * u, b = 0.9 - 0.6 * v;
-      if (j > H * 3 / 4) r = g = b = 0.0;
-      const double du = u - 0.62, dv = v - 0.21;
-      if (du * du + dv * dv < 0.002) r += 50, g += 45, b += 30;
-      img.at(i, j, 0) = float(r);
-      img.at(i, j, 1) = float(g);
-      img.at(i, j, 2) = float(b);
-    }
-  return img;
+  return test::sky_image(
+      W, H, [](double u, double v) { return glm::dvec3(0.1 + 0.5 * (1 - v), 0.2 + 0.3 * u, 0.9 - 0.6 * v); },
+      [&](int, int j) { return j > H * 3 / 4; }, {{0.62, 0.21}, 0.002, {50.0, 45.0, 30.0}});
 }
 
 // A small emissive grid with a rotated, sheared, anisotropic map and its own
@@ -80,66 +71,32 @@ EmissionCdf skewed_fire() {
                      glm::scale(glm::dmat4(1.0), glm::dvec3(1.5));
   t.world_to_index = glm::inverse(t.index_to_world);
   for (float& v : t.values) v = 2.0f * U(rng);
-  EmissionParams p;
-  p.sigma_a = {1.0, 1.5, 2.0};
-  p.emits_temperature = true;
-  p.temperature.scale = 1000.0;
-  p.temperature.cutoff_k = 700.0;
-  p.emission.scale = 2.0;
-  p.emission.is_grid = true;
-  return EmissionCdf::build(d, &t, p);
-}
-
-Buffer storage(Context& ctx, const void* data, size_t bytes, const char* name) {
-  Buffer b(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::HostVisible, name);
-  b.upload(ctx, data, bytes);
-  return b;
+  return EmissionCdf::build(d, &t, test::temperature_emission({1.0, 1.5, 2.0}, 700.0, 2.0));
 }
 
 void run_queries(Context& ctx, const EnvironmentMap& env, const EmissionCdf& cdf, std::vector<Query>& queries) {
   LightBlock block{pack_gpu_environment_header(env), pack_gpu_emission_header(cdf)};
-  Buffer ubo(ctx, sizeof block, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, MemoryKind::HostVisible, "light block");
-  ubo.upload(ctx, &block, sizeof block);
-  const std::vector<float> texels = pack_gpu_environment_texels(env);
-  Buffer env_texels = storage(ctx, texels.data(), texels.size() * 4, "env_texels");
-  Buffer env_cdf = storage(ctx, env.cdf().data(), env.cdf().size() * 4, "env_cdf");
-  Buffer em_cdf = storage(ctx, cdf.cluster_cdf().data(), cdf.cluster_cdf().size() * 4, "emission_cdf");
-  Buffer em_cells = storage(ctx, cdf.entry_cells().data(), cdf.entry_cells().size() * 4, "emission_cells");
-  Buffer em_pmf = storage(ctx, cdf.cluster_pmf().data(), cdf.cluster_pmf().size() * 4, "emission_pmf");
-  const std::vector<gpu::GpuEmissionCluster> clusters = pack_gpu_emission_clusters(cdf);
-  Buffer em_clusters = storage(ctx, clusters.data(), clusters.size() * sizeof clusters[0], "emission_clusters");
-  Buffer qbuf(ctx, queries.size() * sizeof(Query), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::Readback, "queries");
-  std::memcpy(qbuf.map(), queries.data(), queries.size() * sizeof(Query));
-  qbuf.flush();
-
-  ComputePipeline pipeline(ctx, load_spirv("test_lights.comp"),
-                           {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
-                            {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                            {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                            {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                            {4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                            {5, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                            {6, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                            {7, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
-                           sizeof(uint32_t), {}, "test_lights");
-  DescriptorSet set(ctx, pipeline);
-  set.write_buffer(0, ubo);
-  set.write_buffer(1, env_texels);
-  set.write_buffer(2, env_cdf);
-  set.write_buffer(3, em_cdf);
-  set.write_buffer(4, em_cells);
-  set.write_buffer(5, em_pmf);
-  set.write_buffer(6, qbuf);
-  set.write_buffer(7, em_clusters);
-  const uint32_t count = uint32_t(queries.size());
-  submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
-    pipeline.bind(cmd, set.set());
-    pipeline.push(cmd, count);
-    vkCmdDispatch(cmd, (count + 63) / 64, 1, 1);
-    to_host_read_barrier(cmd);
-  });
-  qbuf.invalidate();
-  std::memcpy(queries.data(), qbuf.map(), queries.size() * sizeof(Query));
+  Buffer ubo =
+      test::filled_buffer(ctx, &block, sizeof block, "light block", MemoryKind::HostVisible,
+                          VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  Buffer env_texels = test::filled_buffer(ctx, pack_gpu_environment_texels(env), "env_texels");
+  Buffer env_cdf = test::filled_buffer(ctx, env.cdf(), "env_cdf");
+  Buffer em_cdf = test::filled_buffer(ctx, cdf.cluster_cdf(), "emission_cdf");
+  Buffer em_cells = test::filled_buffer(ctx, cdf.entry_cells(), "emission_cells");
+  Buffer em_pmf = test::filled_buffer(ctx, cdf.cluster_pmf(), "emission_pmf");
+  Buffer em_clusters = test::filled_buffer(ctx, pack_gpu_emission_clusters(cdf), "emission_clusters");
+  Buffer qbuf = test::in_out_buffer(ctx, queries, "queries");
+  test::run_compute(ctx, "test_lights.comp",
+                    {{&ubo, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+                     {&env_texels},
+                     {&env_cdf},
+                     {&em_cdf},
+                     {&em_cells},
+                     {&em_pmf},
+                     {&qbuf},
+                     {&em_clusters}},
+                    uint32_t(queries.size()), {}, "test_lights");
+  test::read_back(qbuf, queries);
 }
 
 double rel(double a, double b) { return std::abs(a - b) / std::max({std::abs(a), std::abs(b), 1e-30}); }
@@ -159,9 +116,7 @@ bool pdf_nearby(const EnvironmentMap& env, const glm::dvec3& d, double gpu_pdf) 
 
 void check(const EnvironmentMap& env, const EmissionCdf& cdf, uint32_t seed) {
   const uint64_t before = Context::total_validation_messages();
-  Context::Options o;
-  o.validation = true;
-  Context ctx(o);
+  Context ctx(test::validated());
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> U(0.0f, 1.0f), Uin(0.01f, 0.99f);
   const int n = 4096;

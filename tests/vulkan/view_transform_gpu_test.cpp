@@ -5,15 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
 #include <random>
 #include <vector>
 
 #include "render/vulkan/Context.h"
 #include "render/vulkan/Memory.h"
-#include "render/vulkan/Pipeline.h"
-#include "render/vulkan/Spirv.h"
 #include "shared/view_transform.h"
+#include "support/GpuCompute.h"
 
 using namespace pyrolume;
 using namespace pyrolume::vk;
@@ -26,32 +24,17 @@ struct ViewQuery {
 static_assert(sizeof(ViewQuery) == 32);
 
 void run_queries(Context& ctx, std::vector<ViewQuery>& queries) {
-  const size_t bytes = queries.size() * sizeof(ViewQuery);
-  Buffer qbuf(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::Readback, "view queries");
-  std::memcpy(qbuf.map(), queries.data(), bytes);
-  qbuf.flush();
-  ComputePipeline pipeline(ctx, load_spirv("test_view_transform.comp"), {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
-                           sizeof(uint32_t), {}, "test_view_transform");
-  DescriptorSet set(ctx, pipeline);
-  set.write_buffer(0, qbuf);
-  const uint32_t count = uint32_t(queries.size());
-  submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
-    pipeline.bind(cmd, set.set());
-    pipeline.push(cmd, count);
-    vkCmdDispatch(cmd, (count + 63) / 64, 1, 1);
-    to_host_read_barrier(cmd);
-  });
-  qbuf.invalidate();
-  std::memcpy(queries.data(), qbuf.map(), bytes);
+  Buffer qbuf = test::in_out_buffer(ctx, queries, "view queries");
+  test::run_compute(ctx, "test_view_transform.comp", {{&qbuf}}, uint32_t(queries.size()), {},
+                    "test_view_transform");
+  test::read_back(qbuf, queries);
 }
 
 }  // namespace
 
 TEST(ViewTransformGpu, GlslMatchesCpp) {
   const uint64_t before = Context::total_validation_messages();
-  Context::Options o;
-  o.validation = true;
-  Context ctx(o);
+  Context ctx(test::validated());
 
   // Colours over the whole range the views map: a grey ramp and random
   // chromaticities from 2^-16 to 2^+12 (below the AgX range, through the

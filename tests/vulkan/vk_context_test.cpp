@@ -16,6 +16,7 @@
 #include "render/vulkan/Pipeline.h"
 #include "render/vulkan/Spirv.h"
 #include "render/vulkan/VkCheck.h"
+#include "support/GpuCompute.h"
 #include "util/Error.h"
 
 using namespace pyrolume;
@@ -54,12 +55,6 @@ DeviceInfo fake(uint32_t index, VkPhysicalDeviceType type) {
   d.api_version = VK_API_VERSION_1_3;
   d.device_local_bytes = 1ull << 30;
   return d;
-}
-
-Context::Options validated() {
-  Context::Options o;
-  o.validation = true;
-  return o;
 }
 
 }  // namespace
@@ -198,7 +193,7 @@ TEST(Spirv, MissingShaderNamesBothPlaces) {
 TEST(VulkanContext, BuffersRoundTripAndHugeAllocationsFailClearly) {
   const uint64_t before = Context::total_validation_messages();
   {
-    Context ctx(validated());
+    Context ctx(test::validated());
     EXPECT_TRUE(ctx.validation_enabled());
     std::vector<float> data(1000);
     for (size_t i = 0; i < data.size(); ++i) data[i] = float(i) * 0.25f;
@@ -236,7 +231,7 @@ TEST(VulkanContext, BuffersRoundTripAndHugeAllocationsFailClearly) {
 TEST(VulkanContext, RunsComputeShaderWithImagesUnderValidation) {
   const uint64_t before = Context::total_validation_messages();
   {
-    Context ctx(validated());
+    Context ctx(test::validated());
     EXPECT_TRUE(ctx.validation_enabled());
     EXPECT_GE(ctx.properties().apiVersion, VK_API_VERSION_1_2);
     EXPECT_EQ(ctx.info().name, ctx.properties().deviceName);
@@ -296,12 +291,7 @@ TEST(VulkanContext, RunsComputeShaderWithImagesUnderValidation) {
     struct Push {
       uint32_t count, offset, sample_count;
     } push{count, 7, uint32_t(samples.size())};
-    submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
-      pipeline.bind(cmd, set.set());
-      pipeline.push(cmd, push);
-      vkCmdDispatch(cmd, (count + 63) / 64, 1, 1);
-      to_host_read_barrier(cmd);
-    });
+    test::dispatch_and_wait(ctx, pipeline, set, count, push);
 
     values.invalidate();
     const uint32_t* v = values.data<uint32_t>();

@@ -20,6 +20,7 @@
 #include "render/cpu/CpuRenderer.h"
 #include "scene/Scene.h"
 #include "support/AnalyticScenes.h"
+#include "support/LightScenes.h"
 #include "support/MisScenes.h"
 #include "support/Stats.h"
 #include "support/SurfaceScenes.h"
@@ -85,13 +86,11 @@ class VulkanLights : public test::VulkanFixture {
   }
 };
 
-Light point_light(glm::dvec3 position, double intensity) {
-  Light l;
-  l.type = Light::Type::Point;
-  l.position = position;
-  l.rgb = glm::dvec3(intensity, 0.8 * intensity, 0.6 * intensity);
-  return l;
-}
+// The point and spot lights' colour: red at the intensity given, green and
+// blue 0.8 and 0.6 of it; the suns' blue 0.9 of the rest.
+const glm::dvec3 kPointTint(1.0, 0.8, 0.6), kSunTint(1.0, 1.0, 0.9);
+
+Light point_light(glm::dvec3 position, double intensity) { return test::point_light(position, intensity * kPointTint); }
 
 // E at p from a point light of intensity I (per channel: the red one; the
 // others are 0.8 and 0.6 of it, which exact_image applies below).
@@ -117,11 +116,7 @@ TEST_F(VulkanLights, PointLightOnAPlaneIsTheInverseSquareLaw) {
 TEST_F(VulkanLights, SpotLightIsAPointLightInsideItsConeAndDarkOutside) {
   Scene s = lit_plane_scene(256);
   const glm::dvec3 pos(0.0, 1.5, 0.5);
-  Light l = point_light(pos, 6.0);
-  l.type = Light::Type::Spot;
-  l.direction = glm::normalize(glm::dvec3(0.2, -1.0, 0.1));
-  l.cone_deg = 35.0;
-  l.falloff_deg = 15.0;
+  const Light l = test::spot_light(pos, {0.2, -1.0, 0.1}, 6.0 * kPointTint, 35.0, 15.0);
   s.lights.push_back(l);
   const RenderResult r = render(s);
   const double cos_end = std::cos(35.0 * kPi / 180.0), cos_start = std::cos(20.0 * kPi / 180.0);
@@ -135,12 +130,7 @@ TEST_F(VulkanLights, SpotLightIsAPointLightInsideItsConeAndDarkOutside) {
 }
 
 Light distant_light(glm::dvec3 toward, double E, double angle_deg) {
-  Light l;
-  l.type = Light::Type::Distant;
-  l.direction = glm::normalize(toward);
-  l.rgb = glm::dvec3(E, E, 0.9 * E);
-  l.angle_deg = angle_deg;
-  return l;
+  return test::distant_light(toward, E * kSunTint, angle_deg);
 }
 
 TEST_F(VulkanLights, DeltaSunAndDiscSunGiveTheirIrradianceTimesCosine) {
@@ -160,12 +150,7 @@ TEST_F(VulkanLights, SphereLightIrradianceIsPiLTimesRadiusOverDistanceSquared) {
   Scene s = lit_plane_scene(512);
   const glm::dvec3 c(0.4, 1.0, 1.0);
   const double radius = 0.35, L = 3.0;
-  Light l;
-  l.type = Light::Type::Sphere;
-  l.center = c;
-  l.radius = radius;
-  l.rgb = glm::dvec3(L);
-  s.lights.push_back(l);
+  s.lights.push_back(test::sphere_light(c, radius, glm::dvec3(L)));
   const RenderResult r = render(s);
   auto exact = plane_exact(
       s,
@@ -238,12 +223,7 @@ TEST_F(VulkanLights, EveryKindOfLightWithFireAndSkyMatchesCpu) {
   Scene s = test::fire_over_plane_scene(dir, test::Strategy::Mis, true, true, 24, 18, 512);
   s.lights.push_back(distant_light({-0.5, 1.0, -0.4}, 1.5, 5.0));
   s.lights.push_back(point_light({0.8, 0.6, -0.2}, 0.6));
-  Light spot = point_light({-0.6, 1.2, 0.3}, 2.0);
-  spot.type = Light::Type::Spot;
-  spot.direction = glm::normalize(glm::dvec3(0.3, -1.0, -0.2));
-  spot.cone_deg = 40.0;
-  spot.falloff_deg = 10.0;
-  s.lights.push_back(spot);
+  s.lights.push_back(test::spot_light({-0.6, 1.2, 0.3}, {0.3, -1.0, -0.2}, 2.0 * kPointTint, 40.0, 10.0));
   Light ball;
   ball.type = Light::Type::Sphere;
   ball.center = {0.6, 0.0, 0.5};
