@@ -61,11 +61,7 @@ using test::pooled;
 // The rectangle [x0, x0 + w) × [y0, y0 + h) of a render, as a render of its own
 // (for closed forms that hold on part of the image only).
 inline RenderResult crop(const RenderResult& r, int x0, int y0, int w, int h) {
-  RenderResult c = r;
-  c.width = w;
-  c.height = h;
-  c.sum.assign(size_t(w) * h * 3, 0.0);
-  c.sum_sq.assign(size_t(w) * h * 3, 0.0);
+  RenderResult c = test::zero_render(w, h, r.spp);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
       for (int k = 0; k < 3; ++k) {

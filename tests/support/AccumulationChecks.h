@@ -64,20 +64,29 @@ inline void expect_same_sums(const RenderResult& a, const RenderResult& b) {
 // the last periodic checkpoint, the render is bit-identical to an
 // uninterrupted one: sample streams are indexed by sample number and the
 // state is the backend's own accumulation.
+// A RenderControl that cancels the render in its n-th pass's progress call
+// (the render then stops after that pass); `passes` counts the calls.
+struct CancelAfterPasses {
+  explicit CancelAfterPasses(int n) {
+    control.cancel = &cancel;
+    control.progress = [this, n](int, int) {
+      if (++passes == n) cancel = true;
+    };
+  }
+  CancelAfterPasses(const CancelAfterPasses&) = delete;
+  std::atomic<bool> cancel{false};
+  int passes = 0;
+  RenderControl control;
+};
+
 inline void expect_resume_exact(Backend& backend, const Scene& s) {
   const RenderSettings rs = settings_for(s);
   RenderResult whole = backend.render(s, rs, {});
   ASSERT_EQ(whole.spp, rs.spp);
   EXPECT_TRUE(whole.state.data.empty()) << "a finished render has nothing to checkpoint";
 
-  std::atomic<bool> cancel{false};
-  int passes = 0;
-  RenderControl stop;
-  stop.cancel = &cancel;
-  stop.progress = [&](int, int) {
-    if (++passes == 3) cancel = true;
-  };
-  RenderResult part = backend.render(s, rs, stop);
+  CancelAfterPasses stop(3);
+  RenderResult part = backend.render(s, rs, stop.control);
   ASSERT_TRUE(part.cancelled);
   ASSERT_GT(part.spp, 0);
   ASSERT_LT(part.spp, rs.spp);

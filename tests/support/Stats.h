@@ -251,6 +251,18 @@ inline double pixel_spread(const RenderResult& r, int x, int y) {
   return worst;
 }
 
+// A w×h render of n samples per pixel whose sums are still 0 (test renders
+// built by hand: fakes, crops).
+inline RenderResult zero_render(int w, int h, int n) {
+  RenderResult r;
+  r.width = w;
+  r.height = h;
+  r.spp = n;
+  r.sum.assign(size_t(w) * h * 3, 0.0);
+  r.sum_sq.assign(size_t(w) * h * 3, 0.0);
+  return r;
+}
+
 // The render's alpha (Σα, Σα²) as an image whose three channels all hold it,
 // so that the z-tests below compare alpha (docs/compositing.md).
 inline RenderResult alpha_image(const RenderResult& r) {

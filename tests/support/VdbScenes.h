@@ -206,6 +206,20 @@ inline Medium vdb_medium(const std::string& name, const std::filesystem::path& f
   return m;
 }
 
+// The ramp the transmittance tests share: "density" = a + b·i on voxels
+// i = 0..20 of a 0.1-unit lattice, y and z in −5..5 (a, b and every value
+// exact in half).
+struct RampX {
+  Lattice lat{0.1, {0.0, 0.0, 0.0}};
+  VoxelBox box{{0, -5, -5}, {20, 5, 5}};
+  float a = 0.5f, b = 0.125f;
+  float operator()(int i, int, int) const { return a + b * float(i); }
+  // The ramp as a vdb medium, its file written into dir.
+  Medium medium(const std::filesystem::path& dir, glm::dvec3 sigma_a, glm::dvec3 sigma_s) const {
+    return vdb_medium("ramp", write_ramp_x_vdb(dir / "ramp.vdb", lat, box, a, b), sigma_a, sigma_s);
+  }
+};
+
 // -------------------------------------------------------- closed forms ----
 
 // The trilinear field of a constant box grid as the renderers sample it:

@@ -14,12 +14,7 @@ namespace {
 // A fake render: per pixel-channel, n samples drawn from draw(x, y, c).
 template <class F>
 RenderResult fake_render(int w, int h, int n, F draw) {
-  RenderResult r;
-  r.width = w;
-  r.height = h;
-  r.spp = n;
-  r.sum.assign(size_t(w) * h * 3, 0.0);
-  r.sum_sq.assign(size_t(w) * h * 3, 0.0);
+  RenderResult r = zero_render(w, h, n);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
       for (int c = 0; c < 3; ++c)

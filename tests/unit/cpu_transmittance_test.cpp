@@ -78,12 +78,11 @@ class Transmittance : public ::testing::Test {
 // centre box ρ(p) = a + b·u_x(p) and ∫σt along a segment there is
 //   σt · length · (a + b · (u_x(p0) + u_x(p1))/2)   (mean of a linear function).
 TEST_F(Transmittance, DensityRampMatchesClosedForm) {
-  const test::Lattice lat{0.1, {0.0, 0.0, 0.0}};
-  const test::VoxelBox box{{0, -5, -5}, {20, 5, 5}};
-  const double a = 0.5, b = 0.125;
+  const test::RampX ramp;
+  const double a = ramp.a, b = ramp.b;
+  const test::Lattice& lat = ramp.lat;
   Scene s = test::vdb_base_scene(8, 8, 1);
-  s.media.push_back(test::vdb_medium("ramp", test::write_ramp_x_vdb(dir / "ramp.vdb", lat, box, float(a), float(b)),
-                                     {0.3, 0.8, 1.2}, {0.2, 0.2, 0.3}));
+  s.media.push_back(ramp.medium(dir, {0.3, 0.8, 1.2}, {0.2, 0.2, 0.3}));
   const MediaData md = cpu::prepare_media(s);
   ASSERT_EQ(md.media.size(), 1u);
   ASSERT_DOUBLE_EQ(md.media[0].max_density, a + 20 * b);
@@ -163,12 +162,10 @@ TEST_F(Transmittance, CheckerboardMatchesQuadratureOfTheSameField) {
 // almost every path, so Russian roulette decides most of the result; it must
 // stay unbiased (and actually happen: many estimates are exactly 0).
 TEST_F(Transmittance, RussianRouletteKeepsRatioTrackingUnbiased) {
-  const test::Lattice lat{0.1, {0.0, 0.0, 0.0}};
-  const test::VoxelBox box{{0, -5, -5}, {20, 5, 5}};
-  const double a = 0.5, b = 0.125;
+  const test::RampX ramp;
+  const double a = ramp.a, b = ramp.b;
   Scene s = test::vdb_base_scene(8, 8, 1);
-  s.media.push_back(test::vdb_medium("ramp", test::write_ramp_x_vdb(dir / "ramp.vdb", lat, box, float(a), float(b)),
-                                     {1.2, 1.2, 1.2}, {0.0, 0.0, 0.0}));
+  s.media.push_back(ramp.medium(dir, {1.2, 1.2, 1.2}, {0.0, 0.0, 0.0}));
   const MediaData md = cpu::prepare_media(s);
   const glm::dvec3 p0(0.05, 0.0, 0.0), p1(1.95, 0.0, 0.0);
   const double tau = 1.2 * 1.9 * (a + b * 0.5 * (0.5 + 19.5));  // ≈ 4, T ≈ 0.0185
@@ -183,12 +180,10 @@ TEST_F(Transmittance, RussianRouletteKeepsRatioTrackingUnbiased) {
 // A homogeneous box overlapping the grid: the coefficients add, and so do the
 // majorants of the segment where both are present.
 TEST_F(Transmittance, HomogeneousAndGridMediaAdd) {
-  const test::Lattice lat{0.1, {0.0, 0.0, 0.0}};
-  const test::VoxelBox box{{0, -5, -5}, {20, 5, 5}};
-  const double a = 0.5, b = 0.125;
+  const test::RampX ramp;
+  const double a = ramp.a, b = ramp.b;
   Scene s = test::vdb_base_scene(8, 8, 1);
-  s.media.push_back(test::vdb_medium("ramp", test::write_ramp_x_vdb(dir / "ramp.vdb", lat, box, float(a), float(b)),
-                                     {0.4, 0.4, 0.4}, {0.1, 0.1, 0.1}));
+  s.media.push_back(ramp.medium(dir, {0.4, 0.4, 0.4}, {0.1, 0.1, 0.1}));
   s.media.push_back(test::homogeneous_box("slab", {1.0, -1.0, -1.0}, {3.0, 1.0, 1.0}, {0.7, 0.7, 0.7},
                                           {0.2, 0.2, 0.2}, 0.0, std::nullopt));
   const MediaData md = cpu::prepare_media(s);

@@ -28,16 +28,22 @@ CliResult run_with_fault(const std::string& fault, const std::string& args) {
   return r;
 }
 
+// `args` with the pass failure `fault` (NAME:N): exit 1, one line naming NAME.
+CliResult expect_device_failure(const std::string& fault, const std::string& args) {
+  CliResult r = run_with_fault(fault, args);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find(fault.substr(0, fault.find(':'))), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  return r;
+}
+
 TEST(CliDeviceFailure, OutOfDeviceMemorySavesThePassesBeforeAndExits1) {
   auto dir = temp_dir("cli-oom");
   write_file(dir / "s.json", kSlowBallJson);
   const std::string render = "render " + q(dir / "s.json") + " --variance --spp 1000";
   // Pass 3 fails: the two passes of 64 spp before it are read back and saved.
-  CliResult r = run_with_fault("VK_ERROR_OUT_OF_DEVICE_MEMORY:3", render + " -o " + q(dir / "o.exr"));
-  EXPECT_EQ(r.status, 1) << r.err;
-  EXPECT_NE(r.err.find("VK_ERROR_OUT_OF_DEVICE_MEMORY"), std::string::npos) << r.err;
+  CliResult r = expect_device_failure("VK_ERROR_OUT_OF_DEVICE_MEMORY:3", render + " -o " + q(dir / "o.exr"));
   EXPECT_NE(r.err.find("128 of 1000 spp"), std::string::npos) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   Image part = read_image(dir / "o.exr");
   EXPECT_EQ(part.spp, 128);
   ASSERT_TRUE(std::filesystem::exists(dir / "o.exr.checkpoint"));
@@ -61,10 +67,7 @@ TEST(CliDeviceFailure, DeviceLostSavesTheLastHostCopyAndExits1) {
   const std::string render = "render " + q(dir / "s.json") + " --variance";
   // A lost device cannot be read: what is saved is the host copy taken after
   // pass 1 (or pass 2, if a second copy was due by then).
-  CliResult r = run_with_fault("VK_ERROR_DEVICE_LOST:3", render + " --spp 1000 -o " + q(dir / "o.exr"));
-  EXPECT_EQ(r.status, 1) << r.err;
-  EXPECT_NE(r.err.find("VK_ERROR_DEVICE_LOST"), std::string::npos) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  CliResult r = expect_device_failure("VK_ERROR_DEVICE_LOST:3", render + " --spp 1000 -o " + q(dir / "o.exr"));
   Image part = read_image(dir / "o.exr");
   EXPECT_TRUE(part.spp == 64 || part.spp == 128) << part.spp;
   EXPECT_NE(r.err.find(std::to_string(part.spp) + " of 1000 spp"), std::string::npos) << r.err;

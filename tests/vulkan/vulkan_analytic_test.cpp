@@ -6,6 +6,7 @@
 
 #include "render/Backend.h"
 #include "render/cpu/CpuRenderer.h"
+#include "support/AccumulationChecks.h"
 #include "support/AnalyticSuite.h"
 #include "support/Stats.h"
 
@@ -66,16 +67,10 @@ TEST_F(VulkanAnalytic, RerunIsBitIdentical) {
 TEST_F(VulkanAnalytic, TimeLimitAndCancelStopEarly) {
   Scene s = test::chromatic_scattering_scene(64, 64, 100000);
   RenderSettings rs = settings_for(s);
-  std::atomic<bool> cancel{false};
-  int passes = 0;
-  RenderControl ctl;
-  ctl.cancel = &cancel;
-  ctl.progress = [&](int, int) {
-    if (++passes == 2) cancel = true;
-  };
-  RenderResult r = vulkan_backend().render(s, rs, ctl);
+  test::CancelAfterPasses stop(2);
+  RenderResult r = vulkan_backend().render(s, rs, stop.control);
   EXPECT_TRUE(r.cancelled);
-  EXPECT_EQ(passes, 2);
+  EXPECT_EQ(stop.passes, 2);
   EXPECT_LT(r.spp, rs.spp);
   EXPECT_GT(r.spp, 0);
 }

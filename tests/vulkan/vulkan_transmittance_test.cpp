@@ -80,21 +80,18 @@ class VulkanTransmittance : public test::VulkanFixture {
 // edge ramps of all faces are in view. The check can fail: the closed form of
 // a 2 % larger σt is rejected.
 TEST_F(VulkanTransmittance, DensityRampMatchesClosedForm) {
-  const test::Lattice lat{0.1, {0.0, 0.0, 0.0}};
-  const test::VoxelBox box{{0, -5, -5}, {20, 5, 5}};
-  const float a = 0.5f, b = 0.125f;
-  auto ramp = [a, b](int i, int, int) { return a + b * float(i); };
+  const test::RampX ramp;
+  const float a = ramp.a, b = ramp.b;
   Scene s = test::vdb_base_scene(32, 24, 1024);
   s.camera.position = {-1.0, 1.2, -3.0};
   s.camera.look_at = {1.0, 0.0, 0.0};
   s.camera.fov_deg = 30.0;
-  s.media.push_back(test::vdb_medium("ramp", test::write_ramp_x_vdb(dir / "ramp.vdb", lat, box, a, b),
-                                     {0.3, 0.8, 1.2}, {0.2, 0.2, 0.3}));
+  s.media.push_back(ramp.medium(dir, {0.3, 0.8, 1.2}, {0.2, 0.2, 0.3}));
   s.media[0].density_scale = 1.5;
-  const test::TrilinearVoxelField f(lat, box, ramp);
+  const test::TrilinearVoxelField f(ramp.lat, ramp.box, ramp);
   // The reference field is the closed form inside the centre box: ρ = a + b·u_x.
   for (glm::dvec3 p : {glm::dvec3(0.05, 0.013, -0.021), glm::dvec3(1.234, -0.31, 0.27), glm::dvec3(1.99, 0.49, -0.49)})
-    ASSERT_NEAR(f.density(p), a + b * lat.index(p).x, 1e-12);
+    ASSERT_NEAR(f.density(p), a + b * ramp.lat.index(p).x, 1e-12);
   RenderResult ratio = expect_transmittance(s, test::transmittance_exact(s, f), "ramp");
 
   Scene wrong = s;
@@ -137,17 +134,13 @@ TEST_F(VulkanTransmittance, CheckerboardMatchesQuadrature) {
 // are 0, so E[T²]/E[T]² is of order 1/E[T] (~50 here); without roulette the
 // estimates would all lie near e^{-τ} and the ratio would be close to 1.
 TEST_F(VulkanTransmittance, RussianRouletteKeepsRatioTrackingUnbiased) {
-  const test::Lattice lat{0.1, {0.0, 0.0, 0.0}};
-  const test::VoxelBox box{{0, -5, -5}, {20, 5, 5}};
-  const float a = 0.5f, b = 0.125f;
-  auto ramp = [a, b](int i, int, int) { return a + b * float(i); };
+  const test::RampX ramp;
   Scene s = test::vdb_base_scene(32, 32, 4096);
   s.camera.position = {-3.0, 0.0, 0.0};
   s.camera.look_at = {1.0, 0.0, 0.0};
   s.camera.fov_deg = 8.0;  // every ray runs the ramp's whole length inside the centre box's y/z
-  s.media.push_back(test::vdb_medium("ramp", test::write_ramp_x_vdb(dir / "ramp.vdb", lat, box, a, b),
-                                     {1.2, 1.2, 1.2}, {0.0, 0.0, 0.0}));
-  const test::TrilinearVoxelField f(lat, box, ramp);
+  s.media.push_back(ramp.medium(dir, {1.2, 1.2, 1.2}, {0.0, 0.0, 0.0}));
+  const test::TrilinearVoxelField f(ramp.lat, ramp.box, ramp);
   auto exact = test::transmittance_exact(s, f);
   const glm::dvec3 centre = exact(16, 16);
   std::printf("roulette: exact T at the centre %.5f\n", centre.x);
