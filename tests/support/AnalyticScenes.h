@@ -280,15 +280,23 @@ inline glm::dvec3 pixel_average(const std::function<glm::dvec3(double fx, double
 // Exact expected pixel means of a single-medium, non-scattering (or max_depth 0)
 // scene, precomputed for the scene's film size; returns a lookup for
 // ztest_against_exact.
-inline std::function<glm::dvec3(int, int)> single_collision_exact(const Scene& s, int base = 8, int max_level = 6, double steep_rel = 0.05) {
-  const int W = s.film.width, H = s.film.height;
+// pixel_average of L over every pixel of a W×H film, precomputed; returns a
+// lookup for ztest_against_exact.
+inline std::function<glm::dvec3(int, int)> pixel_average_image(
+    int W, int H, const std::function<glm::dvec3(double fx, double fy, int* sig)>& L, int base = 8,
+    int max_level = 6, double steep_rel = 0.05) {
   auto img = std::make_shared<std::vector<glm::dvec3>>(size_t(W) * H);
-  auto L = [&](double fx, double fy, int* sig) {
-    return single_collision_radiance(s, s.camera.position, film_ray(s.camera, W, H, fx, fy), sig);
-  };
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) (*img)[size_t(y) * W + x] = pixel_average(L, x, y, base, max_level, steep_rel);
   return [img, W](int x, int y) { return (*img)[size_t(y) * W + x]; };
+}
+
+inline std::function<glm::dvec3(int, int)> single_collision_exact(const Scene& s, int base = 8, int max_level = 6, double steep_rel = 0.05) {
+  const int W = s.film.width, H = s.film.height;
+  auto L = [&](double fx, double fy, int* sig) {
+    return single_collision_radiance(s, s.camera.position, film_ray(s.camera, W, H, fx, fy), sig);
+  };
+  return pixel_average_image(W, H, L, base, max_level, steep_rel);
 }
 
 }  // namespace pyrolume::test

@@ -56,17 +56,13 @@ TEST_P(Analytic, TransparentSphereRgbAndAlphaMatchClosedForms) {
   const RenderResult alpha = alpha_image(r);
   const Medium& m = s.media[0];
   auto alpha_exact = [&](glm::dvec3 sigma) {
-    auto a = [&, sigma](double fx, double fy, int* sig) {
+    return pixel_average_image(s.film.width, s.film.height, [&, sigma](double fx, double fy, int* sig) {
       const Chord ch = chord(m.bounds, s.camera.position, film_ray(s.camera, s.film.width, s.film.height, fx, fy));
       if (sig) *sig = ch.signature;
       const double T = (std::exp(-sigma.x * ch.length) + std::exp(-sigma.y * ch.length) +
                         std::exp(-sigma.z * ch.length)) / 3.0;
       return glm::dvec3(1.0 - T);
-    };
-    auto img = std::make_shared<std::vector<glm::dvec3>>(size_t(s.film.width) * s.film.height);
-    for (int y = 0; y < s.film.height; ++y)
-      for (int x = 0; x < s.film.width; ++x) (*img)[size_t(y) * s.film.width + x] = pixel_average(a, x, y);
-    return [img, W = s.film.width](int x, int y) { return (*img)[size_t(y) * W + x]; };
+    });
   };
   ZTestReport rep = ztest_against_exact(alpha, alpha_exact(m.sigma_a), pooled());
   EXPECT_TRUE(rep.ok) << rep.summary();

@@ -202,6 +202,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"duplicate key nested in arrays",
                 R"({"camera": {"position": {"keys": [[0, [0, 0, 1]]], "keys": []}}})",
                 "bad.json: camera.position.keys: duplicate key"},
+        // film.transparent (docs/compositing.md) takes true or false only.
+        BadCase{"transparent not a boolean", R"({"film": {"transparent": 1}})",
+                "film.transparent: expected true or false"},
         // The lights array (docs/scene-format.md "lights").
         BadCase{"lights not an array", R"({"lights": {}})", "lights: expected an array"},
         BadCase{"light type", R"({"lights": [{"type": "area", "radiance": [1, 1, 1]}]})",
