@@ -6,6 +6,27 @@
 
 namespace pyrolume {
 
+// Arbitrary output variables: the beauty split into light layers, and first-hit
+// features. All empty, or all sized like Image::rgb (depth: one per pixel).
+struct Aovs {
+  // Light layers, interleaved RGB: they sum to Image::rgb per sample.
+  //   emission:   light emitted by media that reaches the camera unscattered;
+  //   scatter:    light whose path's first vertex is a scattering in a medium;
+  //   surface:    light whose path's first vertex is on a surface;
+  //   background: the background, environment map, sun discs and sphere
+  //               lights as the camera ray sees them (through the media).
+  std::vector<float> emission, scatter, surface, background;
+  // Features of the camera ray's first event (a surface, or a real collision
+  // in a medium), averaged over the pixel's samples that have one:
+  //   albedo: a surface's albedo; a medium's single-scattering albedo σs/σt;
+  //   normal: a surface's normal, facing the camera (XYZ, world space); 0 in media;
+  //   depth:  the distance from the camera to the event; 0 where no sample has one.
+  std::vector<float> albedo, normal;
+  std::vector<float> depth;  // one per pixel
+
+  bool empty() const { return emission.empty(); }
+};
+
 struct Image {
   int width = 0, height = 0;
   // Interleaved RGB, width*height*3 floats, row 0 = top, linear radiance.
@@ -22,6 +43,8 @@ struct Image {
   std::vector<float> alpha;
   // PNG carries alpha too (film.transparent), as straight alpha.
   bool transparent = false;
+  // Empty, or the render's AOVs (film.aovs; docs/compositing.md "AOVs").
+  Aovs aovs;
 
   size_t pixel_count() const { return size_t(width) * size_t(height); }
   size_t index(int x, int y, int c) const { return (size_t(y) * size_t(width) + size_t(x)) * 3 + size_t(c); }
@@ -31,6 +54,7 @@ struct Image {
   float var_at(int x, int y, int c) const { return variance[index(x, y, c)]; }
   bool has_variance() const { return !variance.empty(); }
   bool has_alpha() const { return !alpha.empty(); }
+  bool has_aovs() const { return !aovs.empty(); }
 };
 
 // A black width×height image; with_variance also allocates zeroed variance.
