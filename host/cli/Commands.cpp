@@ -121,6 +121,7 @@ RenderSettings settings_from(const RenderArgs& args, const Scene& scene) {
   settings.spp = args.spp.value_or(scene.film.spp);
   settings.seed = args.seed.value_or(scene.film.seed);
   settings.time_limit = args.time_limit;
+  settings.aovs = args.aovs || scene.film.aovs;
   return settings;
 }
 
@@ -309,6 +310,18 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   if (ext != ".exr" && ext != ".png")
     throw input_error(output.string(), "", "unknown image type \"" + ext + "\" (use .exr or .png)");
   if (args.variance && ext != ".exr") throw input_error(output.string(), "", "--variance needs an .exr output");
+  if (args.aovs && ext != ".exr") throw input_error(output.string(), "", "--aovs needs an .exr output (PNG has no layers)");
+  if (scene.film.aovs && ext != ".exr")
+    throw input_error(scene.file.string(), "film.aovs", "needs an .exr output (PNG has no layers), not " + output.string());
+  // Checkpoints carry the beauty and alpha, not the AOVs (docs/checkpoints.md).
+  const bool aovs = args.aovs || scene.film.aovs;
+  if (aovs && args.resume)
+    throw input_error("--resume", "", std::string("checkpoints do not carry AOVs (") +
+                                          (args.aovs ? "--aovs" : scene.file.string() + ": film.aovs") +
+                                          "): render again without --resume");
+  if (aovs && args.checkpoint > 0.0)
+    throw input_error("--checkpoint", "", std::string("checkpoints do not carry AOVs (") +
+                                              (args.aovs ? "--aovs" : scene.file.string() + ": film.aovs") + ")");
 
   if (sequence) return run_sequence(args, scene, output, cancel, remarks);
 
@@ -398,7 +411,7 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
       if (const std::string w = film_look_warning(image, stops, scene.film.view, ext == ".png"); !w.empty())
         std::cerr << "pyrolume: warning: " << output.string() << ": " << w << "\n";
     bool checkpointed = false;
-    if (result.spp < settings.spp && keep_checkpoint && !result.state.data.empty())
+    if (result.spp < settings.spp && keep_checkpoint && !settings.aovs && !result.state.data.empty())
       checkpointed = save_checkpoint(result.state);
     if (result.spp >= settings.spp) {
       std::error_code ec;

@@ -53,6 +53,9 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   render->add_option("--stats", render_args.stats, "Write render statistics as JSON");
   render->add_flag("--variance", render_args.variance, "EXR: add the per-pixel variance of the mean (variance.R/G/B)");
+  render->add_flag("--aovs", render_args.aovs,
+                   "EXR: add the light layers (emission, scatter, surface, background) and the features (albedo, "
+                   "normal, depth), as film.aovs does");
   render->add_option("--exposure", render_args.exposure,
                      "PNG: exposure in stops, or auto (overrides film.exposure on every frame; EXR stays linear)");
   render->add_option("--device", render_args.device, "Vulkan device index (see `pyrolume devices`)")->check(CLI::NonNegativeNumber);
