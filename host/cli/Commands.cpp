@@ -12,6 +12,7 @@
 #include "cli/OutputCheck.h"
 #include "cli/Sequence.h"
 #include "color/Blackbody.h"
+#include "denoise/Denoiser.h"
 #include "image/AtomicFile.h"
 #include "image/Compare.h"
 #include "image/DisplayTransform.h"
@@ -473,6 +474,39 @@ int run_blackbody(const BlackbodyArgs& a) {
 
 int run_compare(const CompareArgs& a) {
   return run_compare_command(a.a, a.b, a.max_relmse, a.max_outliers, std::cout, std::cerr);
+}
+
+int run_denoise(const DenoiseArgs& a) {
+  const std::filesystem::path input = a.input, output = a.output;
+  if (output.empty()) throw input_error(input.string(), "", "no output: give -o OUT.exr");
+  const std::string ext = lower_extension(output);
+  if (ext != ".exr" && ext != ".png")
+    throw input_error(output.string(), "", "unknown image extension '" + output.extension().string() + "' (use .exr or .png)");
+  CreatedFolders folders;
+  check_outputs({{"-o", output}}, {}, {{"the input", input}}, folders);
+  const auto t0 = std::chrono::steady_clock::now();
+  const Image noisy = read_image(input);
+  // The filter's edge-stopping is in units of the noise: without the variance
+  // it would have to guess it, so an image without one is refused.
+  if (!noisy.has_variance())
+    throw input_error(input.string(), "",
+                      "has no variance.R/G/B channels; the denoiser needs them (render with --variance)");
+  DenoiseOptions options;
+  options.iterations = a.iterations;
+  options.sigma_l = a.sigma_l;
+  options.use_features = !a.no_features;
+  options.device_index = a.device;
+  const auto t1 = std::chrono::steady_clock::now();
+  const Image clean = denoise(noisy, options, input.string());
+  const auto t2 = std::chrono::steady_clock::now();
+  write_image(output, clean);
+  const bool features = options.use_features && !noisy.aovs.albedo.empty();
+  const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double filter = std::chrono::duration<double>(t2 - t1).count();
+  std::cout << output.string() << ": " << noisy.width << "x" << noisy.height << ", denoised "
+            << (features ? "with albedo, normal, depth" : "with beauty and variance only") << ", "
+            << format_seconds(filter) << " s denoising, " << format_seconds(total) << " s in all" << std::endl;
+  return 0;
 }
 
 }  // namespace pyrolume

@@ -47,4 +47,15 @@ struct CompareArgs {
 };
 int run_compare(const CompareArgs& args);
 
+// `pyrolume denoise IN -o OUT` (docs/compositing.md "Denoiser"): IN must have
+// variance (render --variance); OUT is a new file, never IN.
+struct DenoiseArgs {
+  std::string input, output;
+  int iterations = 5;
+  float sigma_l = 4.0f;
+  bool no_features = false;
+  int device = -1;
+};
+int run_denoise(const DenoiseArgs& args);
+
 }  // namespace pyrolume

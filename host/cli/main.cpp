@@ -110,6 +110,17 @@ int main(int argc, char** argv) {
   compare->add_option("--max-relmse", cmp.max_relmse, "Exit 3 if relMSE exceeds X");
   compare->add_option("--max-outliers", cmp.max_outliers, "Exit 3 if the fraction beyond 4 sigma exceeds F");
 
+  DenoiseArgs dn;
+  auto* denoise = app.add_subcommand("denoise", "Denoise a render (EXR with variance) into a new image");
+  denoise->add_option("input", dn.input, "EXR written by render --variance (read only)")->required();
+  denoise->add_option("-o,--output", dn.output, "Output image (.exr, or .png)")->required();
+  denoise->add_option("--iterations", dn.iterations, "À-trous iterations (default 5: taps reach ±62 px)")
+      ->check(CLI::Range(0, 12));
+  denoise->add_option("--sigma-l", dn.sigma_l, "Luminance edge-stopping in noise standard deviations (default 4)")
+      ->check(CLI::PositiveNumber);
+  denoise->add_flag("--no-features", dn.no_features, "Ignore the albedo, normal and depth AOVs");
+  denoise->add_option("--device", dn.device, "Vulkan device index")->check(CLI::NonNegativeNumber);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -138,6 +149,7 @@ int main(int argc, char** argv) {
     if (*devices) return run_devices(devices_device);
     if (*blackbody) return run_blackbody(bb);
     if (*compare) return run_compare(cmp);
+    if (*denoise) return run_denoise(dn);
   } catch (const InputError& e) {
     std::cerr << "pyrolume: " << e.what() << "\n";
     return 2;

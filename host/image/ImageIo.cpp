@@ -81,6 +81,27 @@ class StdOStreamAdaptor : public Imf::OStream {
   std::ostream& os_;
 };
 
+// The AOV channels (docs/compositing.md "AOVs"): layer.channel, the Aovs
+// vector they live in, its floats per pixel and the channel's place there.
+struct AovChannel {
+  const char* name;
+  std::vector<float> Aovs::*layer;
+  int stride, offset;
+};
+constexpr AovChannel kAovChannels[] = {
+    {"emission.R", &Aovs::emission, 3, 0},     {"emission.G", &Aovs::emission, 3, 1},
+    {"emission.B", &Aovs::emission, 3, 2},     {"scatter.R", &Aovs::scatter, 3, 0},
+    {"scatter.G", &Aovs::scatter, 3, 1},       {"scatter.B", &Aovs::scatter, 3, 2},
+    {"surface.R", &Aovs::surface, 3, 0},       {"surface.G", &Aovs::surface, 3, 1},
+    {"surface.B", &Aovs::surface, 3, 2},       {"background.R", &Aovs::background, 3, 0},
+    {"background.G", &Aovs::background, 3, 1}, {"background.B", &Aovs::background, 3, 2},
+    {"albedo.R", &Aovs::albedo, 3, 0},         {"albedo.G", &Aovs::albedo, 3, 1},
+    {"albedo.B", &Aovs::albedo, 3, 2},         {"normal.X", &Aovs::normal, 3, 0},
+    {"normal.Y", &Aovs::normal, 3, 1},         {"normal.Z", &Aovs::normal, 3, 2},
+    {"depth.Z", &Aovs::depth, 1, 0},
+};
+constexpr int kAovFloats = 19;  // per pixel, all layers
+
 void write_exr(std::ostream& os, const Image& img) {
   Imf::Header header(img.width, img.height);
   header.compression() = Imf::ZIP_COMPRESSION;  // lossless: compare must see the exact floats
@@ -92,6 +113,8 @@ void write_exr(std::ostream& os, const Image& img) {
   if (img.has_variance())
     for (const char* n : var_names) header.channels().insert(n, Imf::Channel(Imf::FLOAT));
   if (img.has_alpha()) header.channels().insert("A", Imf::Channel(Imf::FLOAT));
+  if (img.has_aovs())
+    for (const AovChannel& a : kAovChannels) header.channels().insert(a.name, Imf::Channel(Imf::FLOAT));
 
   Imf::FrameBuffer fb;
   const size_t xs = 3 * sizeof(float), ys = xs * size_t(img.width);
@@ -102,6 +125,12 @@ void write_exr(std::ostream& os, const Image& img) {
   }
   if (img.has_alpha())
     fb.insert("A", Imf::Slice(Imf::FLOAT, (char*)img.alpha.data(), sizeof(float), sizeof(float) * size_t(img.width)));
+  if (img.has_aovs())
+    for (const AovChannel& a : kAovChannels) {
+      const std::vector<float>& layer = img.aovs.*a.layer;
+      const size_t axs = size_t(a.stride) * sizeof(float);
+      fb.insert(a.name, Imf::Slice(Imf::FLOAT, (char*)(layer.data() + a.offset), axs, axs * size_t(img.width)));
+    }
   StdOStreamAdaptor stream(os);
   Imf::OutputFile out(stream, header);
   out.setFrameBuffer(fb);
@@ -288,6 +317,14 @@ Image read_exr(const fs::path& file, const std::vector<unsigned char>& bytes) {
   int var_count = int(has(var_names[0])) + int(has(var_names[1])) + int(has(var_names[2]));
   if (var_count != 0 && var_count != 3)
     throw input_error(file.string(), "", "EXR has only some of variance.R, variance.G, variance.B");
+  // AOVs: all of them or none (image/Image.h Aovs).
+  const char* aov_present = nullptr;
+  const char* aov_missing = nullptr;
+  for (const AovChannel& a : kAovChannels) (has(a.name) ? aov_present : aov_missing) = a.name;
+  if (aov_present && aov_missing)
+    throw input_error(file.string(), "",
+                      std::string("EXR has some AOV channels (") + aov_present + ") but not " + aov_missing);
+  const bool aovs = aov_present != nullptr;
 
   // Read in blocks of rows, growing the image as they decode: memory follows
   // the pixel data the file really holds, not what a corrupt header claims
@@ -298,7 +335,8 @@ Image read_exr(const fs::path& file, const std::vector<unsigned char>& bytes) {
   img.width = dw.max.x - dw.min.x + 1;
   img.height = dw.max.y - dw.min.y + 1;
   require_memory(file.string(), "", std::to_string(img.width) + " x " + std::to_string(img.height) + " pixels",
-                 uint64_t(img.width) * uint64_t(img.height) * sizeof(float) * ((var_count == 3 ? 6 : 3) + (alpha ? 1 : 0)));
+                 uint64_t(img.width) * uint64_t(img.height) * sizeof(float) *
+                     ((var_count == 3 ? 6 : 3) + (alpha ? 1 : 0) + (aovs ? kAovFloats : 0)));
   const size_t row_floats = size_t(img.width) * 3, xs = 3 * sizeof(float), ys = xs * size_t(img.width);
   const int rows_per_block = int(std::max<size_t>(1, (size_t(16) << 20) / ys));
   for (int y0 = 0; y0 < img.height; y0 += rows_per_block) {
@@ -306,6 +344,8 @@ Image read_exr(const fs::path& file, const std::vector<unsigned char>& bytes) {
     img.rgb.resize(size_t(y0 + rows) * row_floats, 0.0f);
     if (var_count == 3) img.variance.resize(img.rgb.size(), 0.0f);
     if (alpha) img.alpha.resize(size_t(y0 + rows) * size_t(img.width), 0.0f);
+    if (aovs)
+      for (const AovChannel& a : kAovChannels) (img.aovs.*a.layer).resize(size_t(y0 + rows) * size_t(img.width) * a.stride, 0.0f);
     const Imath::Box2i block(Imath::V2i(dw.min.x, dw.min.y + y0), Imath::V2i(dw.max.x, dw.min.y + y0 + rows - 1));
     // A FrameBuffer maps each name once, so a Y-only file fills R and is copied to G, B.
     Imf::FrameBuffer fb;
@@ -319,6 +359,13 @@ Image read_exr(const fs::path& file, const std::vector<unsigned char>& bytes) {
     if (alpha)
       fb.insert("A", Imf::Slice::Make(Imf::FLOAT, img.alpha.data() + size_t(y0) * size_t(img.width), block,
                                       sizeof(float), sizeof(float) * size_t(img.width)));
+    if (aovs)
+      for (const AovChannel& a : kAovChannels) {
+        std::vector<float>& layer = img.aovs.*a.layer;
+        const size_t axs = size_t(a.stride) * sizeof(float);
+        fb.insert(a.name, Imf::Slice::Make(Imf::FLOAT, layer.data() + size_t(y0) * size_t(img.width) * a.stride + a.offset,
+                                           block, axs, axs * size_t(img.width)));
+      }
     in.setFrameBuffer(fb);
     in.readPixels(block.min.y, block.max.y);
   }
@@ -385,6 +432,10 @@ void write_image(const fs::path& file, const Image& img, double exposure_stops, 
     throw std::logic_error("write_image: image size does not match its pixel data");
   if (img.has_variance() && img.variance.size() != img.rgb.size())
     throw std::logic_error("write_image: variance size does not match the image");
+  if (img.has_aovs())
+    for (const AovChannel& a : kAovChannels)
+      if ((img.aovs.*a.layer).size() != img.pixel_count() * size_t(a.stride))
+        throw std::logic_error(std::string("write_image: AOV ") + a.name + " size does not match the image");
 
   try {
     write_file_atomic(file, [&](std::ostream& os) {

@@ -21,7 +21,8 @@ unsigned char srgb_encode_u8(float linear, double exposure_stops = 0.0);
 
 // Chooses the format by extension (case-insensitive):
 //   .exr  float32, ZIP, channels R, G, B (+ variance.R/G/B when img has variance,
-//         + A when img has alpha);
+//         + A when img has alpha; + emission.R/G/B, scatter.R/G/B, surface.R/G/B,
+//         background.R/G/B, albedo.R/G/B, normal.X/Y/Z, depth.Z when img has AOVs);
 //         int header attributes "spp" / "spp_target" when img.spp / spp_target > 0;
 //         linear, exposure NOT applied.
 //   .png  8-bit sRGB RGB through exposure and `view` (image/DisplayTransform.h
@@ -35,7 +36,10 @@ void write_image(const std::filesystem::path& file, const Image& img, double exp
 
 // Reads by content, not by extension:
 //   EXR: data window; R, G, B (missing ones read as 0); a Y-only file gives
-//        R = G = B = Y; A is ignored; variance.R/G/B loaded when all three exist;
+//        R = G = B = Y; A when present; variance.R/G/B loaded when all three exist;
+//        the AOV channels (above) when all of them exist; some of them only,
+//        or some variance channels only, is an InputError naming the file and
+//        the missing channel;
 //        the "spp" / "spp_target" attributes when present.
 //        Half and uint channels are converted to float.
 //   PNG/JPG/BMP/TGA (via stb_image): sRGB decoded to linear (8- and 16-bit).

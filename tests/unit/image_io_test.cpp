@@ -171,6 +171,63 @@ TEST(ImageIo, ExrRoundTripWithAlpha) {
   fs::remove_all(dir);
 }
 
+// AOVs (docs/compositing.md "AOVs"): every layer's channels in the same
+// single-part EXR as FLOAT, read back bit for bit; a file with some but not
+// all of them is refused with one line naming the file and a missing channel.
+TEST(ImageIo, ExrRoundTripWithAovs) {
+  auto dir = test::temp_dir("exraovs");
+  Image img = sample_image(true);
+  img.alpha = {0.0f, 0.25f, 1.0f, 0.5f, 0.75f, 1.0f};
+  float v = 0.5f;
+  for (auto* layer : {&img.aovs.emission, &img.aovs.scatter, &img.aovs.surface, &img.aovs.background,
+                      &img.aovs.albedo, &img.aovs.normal})
+    for (int i = 0; i < 18; ++i) layer->push_back(v += 0.37f);
+  img.aovs.depth = {0.0f, 1.5f, 1e6f, 3.25f, 0.0f, 7.0f};
+  ASSERT_TRUE(img.has_aovs());
+  write_image(dir / "aovs.exr", img);
+  Image back = read_image(dir / "aovs.exr");
+  EXPECT_EQ(back.rgb, img.rgb);
+  EXPECT_EQ(back.variance, img.variance);
+  EXPECT_EQ(back.alpha, img.alpha);
+  EXPECT_EQ(back.aovs.emission, img.aovs.emission);
+  EXPECT_EQ(back.aovs.scatter, img.aovs.scatter);
+  EXPECT_EQ(back.aovs.surface, img.aovs.surface);
+  EXPECT_EQ(back.aovs.background, img.aovs.background);
+  EXPECT_EQ(back.aovs.albedo, img.aovs.albedo);
+  EXPECT_EQ(back.aovs.normal, img.aovs.normal);
+  EXPECT_EQ(back.aovs.depth, img.aovs.depth);
+  {
+    Imf::InputFile f((dir / "aovs.exr").c_str());
+    EXPECT_FALSE(f.header().hasTileDescription());
+    for (const char* n : {"emission.R", "emission.G", "emission.B", "scatter.R", "scatter.G", "scatter.B", "surface.R",
+                          "surface.G", "surface.B", "background.R", "background.G", "background.B", "albedo.R",
+                          "albedo.G", "albedo.B", "normal.X", "normal.Y", "normal.Z", "depth.Z"}) {
+      ASSERT_NE(f.header().channels().findChannel(n), nullptr) << n;
+      EXPECT_EQ(f.header().channels().findChannel(n)->type, Imf::FLOAT) << n;
+    }
+  }
+  // Without AOVs: none of their channels, and none read back.
+  write_image(dir / "plain.exr", sample_image(false));
+  EXPECT_FALSE(read_image(dir / "plain.exr").has_aovs());
+  EXPECT_TRUE(read_image(dir / "plain.exr").aovs.depth.empty());
+
+  // Some AOV channels but not all: one line naming the file and a missing channel.
+  {
+    Imf::Header h(1, 1);
+    for (const char* n : {"R", "G", "B", "albedo.R", "albedo.G", "albedo.B"}) h.channels().insert(n, Imf::Channel(Imf::FLOAT));
+    float px[6] = {1, 2, 3, 0.5f, 0.5f, 0.5f};
+    Imf::FrameBuffer fb;
+    const char* names[6] = {"R", "G", "B", "albedo.R", "albedo.G", "albedo.B"};
+    for (int c = 0; c < 6; ++c) fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char*)(px + c), sizeof(float), sizeof(float)));
+    Imf::OutputFile out((dir / "partial.exr").c_str(), h);
+    out.setFrameBuffer(fb);
+    out.writePixels(1);
+  }
+  const std::string msg = expect_input_error([&] { read_image(dir / "partial.exr"); }, {"partial.exr", "depth.Z"});
+  EXPECT_EQ(msg.find('\n'), std::string::npos);
+  fs::remove_all(dir);
+}
+
 // PNG: RGB unless the image is transparent; then RGBA with straight alpha,
 // the colour being RGB/A through the view transform.
 TEST(ImageIo, PngHasStraightAlphaOnlyWhenTransparent) {

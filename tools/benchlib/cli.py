@@ -45,6 +45,7 @@ import shutil
 import statistics
 import time
 
+from . import denoise
 from .common import REPO, log
 from .configs import configs_for
 from .plot import plot
@@ -82,6 +83,12 @@ def parse_args(argv):
     ap.add_argument("--device", type=int, default=None, help="Vulkan device index, passed to pyrolume")
     ap.add_argument("--no-plot", action="store_true")
     ap.add_argument("--list", action="store_true", help="print scenes and configs, render nothing")
+    ap.add_argument("--denoise", action="store_true",
+                    help="time `pyrolume denoise` against the render it cleans (default scenes "
+                         "fire_ground,terrain_explosion at 1920x1080; benchlib/denoise.py)")
+    ap.add_argument("--denoise-spp", type=int, default=16, help="with --denoise: spp of the render (default 16)")
+    ap.add_argument("--render-reps", type=int, default=1,
+                    help="with --denoise: renders per scene (default 1; the denoise runs --reps times)")
     args = ap.parse_args(argv)
     args.overrides = any(getattr(args, k) is not None for k in ("resolution", "spp_max", "time_cap", "ref_spp"))
 
@@ -90,7 +97,7 @@ def parse_args(argv):
         args.generator = os.path.join(os.path.dirname(args.pyrolume), "gen_fire_vdb")
     if args.work_dir is None:
         args.work_dir = os.path.join(os.path.dirname(args.pyrolume), "bench")
-    res = args.resolution or ("160x90" if args.quick else "320x180")
+    res = args.resolution or ("1920x1080" if args.denoise else "160x90" if args.quick else "320x180")
     m = re.fullmatch(r"(\d+)[x×](\d+)", res)
     if not m:
         ap.error(f"--resolution {res}: expected WxH")
@@ -116,6 +123,8 @@ def main(argv):
         return 2
     work = os.path.abspath(args.work_dir)
     os.makedirs(work, exist_ok=True)
+    if args.denoise:
+        return denoise.run(args, argv)
 
     scenes, skipped = collect_scenes(args, work)
     cfg_filter = [c.strip() for c in args.configs.split(",")] if args.configs else None

@@ -1,0 +1,49 @@
+#pragma once
+// The denoiser: an edge-avoiding à-trous wavelet filter (Dammertz et al. 2010)
+// with SVGF's variance-guided edge-stopping (Schied et al. 2017), in GLSL
+// (shaders/denoise.comp) on the Vulkan device the renderer uses. It reads the
+// beauty, its variance of the mean and, when present, the albedo, normal and
+// depth AOVs (docs/compositing.md "Denoiser").
+#include <string>
+
+#include "image/Image.h"
+#include "render/vulkan/Context.h"
+#include "render/vulkan/Pipeline.h"
+
+namespace pyrolume {
+
+struct DenoiseOptions {
+  // À-trous iterations; iteration i spaces its 5×5 taps 2^i pixels apart, so
+  // 5 reach ±62 pixels.
+  int iterations = 5;
+  // Edge-stopping parameters, SVGF's names and defaults (σ_a is ours: the
+  // albedo, which SVGF demodulates instead).
+  float sigma_l = 4.0f;    // luminance, in standard deviations of its (filtered) noise
+  float sigma_n = 128.0f;  // normal: exponent of max(0, n_p·n_q)
+  float sigma_z = 1.0f;    // depth, in units of the depth's gradient times the tap distance
+  float sigma_a = 0.2f;    // albedo: Euclidean distance in RGB
+  bool use_features = true;  // use the albedo/normal/depth AOVs when the image has them
+  int device_index = -1;     // denoise(): the Vulkan device (-1: as the renderer chooses)
+};
+
+// Runs the filter on one device; holds its pipeline, so a sequence of frames
+// (or render --denoise, on the renderer's own context) reuses it.
+class Denoiser {
+ public:
+  explicit Denoiser(vk::Context& ctx);
+  // `noisy` must have variance (render --variance); the result has the
+  // denoised RGB and alpha (filtered with the same weights: premultiplied RGB
+  // and A stay consistent), the noisy image's spp and transparency, and no
+  // variance or AOVs. Non-finite input values are read as 0. An image too
+  // large for the device's storage buffers is an InputError naming `name`.
+  Image run(const Image& noisy, const DenoiseOptions& options, const std::string& name = "image");
+
+ private:
+  vk::Context& ctx_;
+  vk::ComputePipeline pipeline_;
+};
+
+// A Denoiser on a context of its own (options.device_index).
+Image denoise(const Image& noisy, const DenoiseOptions& options = {}, const std::string& name = "image");
+
+}  // namespace pyrolume

@@ -1,0 +1,41 @@
+// Data shared by the denoiser's shader (denoise.comp) and the host
+// (host/denoise/Denoiser.cpp), in the common subset of GLSL and C++
+// (shared/common.h), like shared/gpu_types.h.
+#ifndef PYROLUME_DENOISE_TYPES_H
+#define PYROLUME_DENOISE_TYPES_H
+
+#include "shared/common.h"
+#ifdef __cplusplus
+namespace pyrolume::gpu {
+#endif
+
+PYRO_CONST uint DENOISE_WORKGROUP_SIZE = 8;
+
+// Descriptor bindings of denoise.comp (set 0). One pixel per element, row 0 = top.
+PYRO_CONST uint DENOISE_BINDING_COLOR_IN = 0;   // readonly vec4[]: premultiplied RGB, alpha
+PYRO_CONST uint DENOISE_BINDING_VAR_IN = 1;     // readonly float[]: variance of the mean of the luminance
+PYRO_CONST uint DENOISE_BINDING_COLOR_OUT = 2;  // writeonly vec4[]
+PYRO_CONST uint DENOISE_BINDING_VAR_OUT = 3;    // writeonly float[]
+// The first-hit features (image/Image.h Aovs) as the host packs them; one
+// element each when the image has none. Two arrays rather than one struct of
+// 32 bytes, so that each stays within lavapipe's 128 MiB storage-buffer range
+// up to 3840×2160.
+PYRO_CONST uint DENOISE_BINDING_NORMAL_DEPTH = 4;  // readonly vec4[]: normal (0 in media and misses), depth
+PYRO_CONST uint DENOISE_BINDING_ALBEDO_DZ = 5;     // readonly vec4[]: albedo RGB; w: |∇depth| (larger central difference)
+
+// Which features denoise.comp uses (DenoiseConstants::flags).
+PYRO_CONST uint DENOISE_USE_NORMAL_DEPTH = 1;
+PYRO_CONST uint DENOISE_USE_ALBEDO = 2;
+
+// Push constants of one à-trous iteration.
+struct DenoiseConstants {
+  uvec4 size_step_flags;  // width, height, the tap spacing 2^i, DENOISE_USE_* bits
+  vec4 sigmas;            // σ_l (luminance), σ_n (normal exponent), σ_z (depth), σ_a (albedo)
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(DenoiseConstants) == 32);
+PYRO_OFFSET(DenoiseConstants, sigmas, 16);
+}  // namespace pyrolume::gpu
+#endif
+#endif

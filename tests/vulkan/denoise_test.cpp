@@ -1,0 +1,201 @@
+// The denoiser (host/denoise/Denoiser.h, shaders/denoise.comp) on images with
+// known answers, under the validation layers: a flat noisy square stays flat
+// at its true value, a sharp edge stays sharp (docs/compositing.md "Denoiser":
+// the edge width), the features keep an edge the luminance cannot see, and
+// `pyrolume denoise` writes a new file and leaves its input alone.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "denoise/Denoiser.h"
+#include "image/ImageIo.h"
+#include "render/vulkan/Context.h"
+#include "support/GpuCompute.h"
+#include "support/TestSupport.h"
+#include "util/Error.h"
+
+using namespace pyrolume;
+
+namespace {
+
+class DenoiseGpu : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    try {
+      ctx_ = std::make_unique<vk::Context>(test::validated());
+    } catch (const NoDeviceError& e) {
+      GTEST_SKIP() << e.what();
+    }
+    denoiser_ = std::make_unique<Denoiser>(*ctx_);
+  }
+  void TearDown() override {
+    if (ctx_) EXPECT_EQ(ctx_->validation_messages(), 0u) << "Vulkan validation reported problems";
+  }
+  std::unique_ptr<vk::Context> ctx_;
+  std::unique_ptr<Denoiser> denoiser_;
+};
+
+// An image whose pixel (x, y) has the true colour truth(x, y) · tint plus
+// Gaussian noise of standard deviation sigma(x, y) · tint per channel, and
+// that noise's variance as the variance of the mean.
+template <class Truth, class Sigma>
+Image noisy_image(int w, int h, Truth truth, Sigma sigma, uint32_t seed) {
+  const float tint[3] = {1.0f, 0.8f, 0.6f};
+  Image img = make_image(w, h, true);
+  img.alpha.assign(img.pixel_count(), 1.0f);
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> N(0.0f, 1.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const float s = sigma(x, y) * tint[c];
+        img.at(x, y, c) = truth(x, y) * tint[c] + s * N(rng);
+        img.var_at(x, y, c) = s * s;
+      }
+  return img;
+}
+
+struct Spread {
+  double mean = 0.0, sd = 0.0;
+  int n = 0;
+};
+// Mean and standard deviation of channel c over the pixels with keep(x, y).
+template <class Keep>
+Spread spread(const Image& img, int c, Keep keep) {
+  double s = 0.0, s2 = 0.0;
+  int n = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      if (keep(x, y)) {
+        s += img.at(x, y, c);
+        s2 += double(img.at(x, y, c)) * img.at(x, y, c);
+        ++n;
+      }
+  const double m = s / n;
+  return {m, std::sqrt(std::max(s2 / n - m * m, 0.0)), n};
+}
+
+}  // namespace
+
+// A 96×96 emissive square (value 2 · tint, noise σ = 20 % of it) on a black,
+// noise-free background: inside it, 4 px from its sides, the denoised image
+// is flat (its spread under a tenth of the input's) and its mean is the true
+// value within 4 standard errors of the noisy mean (SE ≈ 0.23 % here, so a
+// 1 % bias would be seen); the background stays black.
+TEST_F(DenoiseGpu, FlatSquareStaysFlatAtItsValue) {
+  const int w = 128, h = 128, lo = 16, hi = 112;
+  auto inside = [&](int x, int y) { return x >= lo && x < hi && y >= lo && y < hi; };
+  Image noisy = noisy_image(
+      w, h, [&](int x, int y) { return inside(x, y) ? 2.0f : 0.0f; },
+      [&](int x, int y) { return inside(x, y) ? 0.4f : 0.0f; }, 25);
+  Image out = denoiser_->run(noisy, {});
+  ASSERT_EQ(out.width, w);
+  ASSERT_EQ(out.height, h);
+  EXPECT_FALSE(out.has_variance());
+  ASSERT_TRUE(out.has_alpha());
+  auto interior = [&](int x, int y) { return x >= lo + 4 && x < hi - 4 && y >= lo + 4 && y < hi - 4; };
+  const float tint[3] = {1.0f, 0.8f, 0.6f};
+  for (int c = 0; c < 3; ++c) {
+    const Spread in = spread(noisy, c, interior), den = spread(out, c, interior);
+    const double truth = 2.0 * tint[c], se = in.sd / std::sqrt(double(in.n));
+    EXPECT_LT(den.sd, 0.1 * in.sd) << "channel " << c << ": spread " << den.sd << " vs input " << in.sd;
+    EXPECT_LT(std::abs(den.mean - truth), 4.0 * se) << "channel " << c << ": mean " << den.mean << " vs " << truth;
+    EXPECT_LT(se, 0.005 * truth / 2.0) << "not informative at 0.5 %";
+    RecordProperty("spread_ratio_" + std::to_string(c), std::to_string(den.sd / in.sd));
+  }
+  // The background 8 px or more outside the square: black (to 1e-6 of the
+  // square: the widest iterations' weights across are e^-(2/tiny), not 0), alpha 1.
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      if (x < lo - 8 || x >= hi + 8 || y < lo - 8 || y >= hi + 8) {
+        for (int c = 0; c < 3; ++c) ASSERT_LT(std::abs(out.at(x, y, c)), 2e-6f) << x << "," << y;
+        ASSERT_FLOAT_EQ(out.alpha[size_t(y) * w + x], 1.0f);
+      }
+}
+
+// Two noisy halves, 1 and 3 (× tint, noise σ = 20 % of each): every column
+// more than kEdgeWidth = 4 px from the edge has its mean within 4 standard
+// errors (of the noisy column's mean, σ/√rows) of its side's true value, and
+// is denoised (spread under a third of the input's from 8 px on).
+TEST_F(DenoiseGpu, SharpEdgeStaysSharp) {
+  const int w = 96, h = 256, edge = 48, kEdgeWidth = 4;
+  auto truth = [&](int x, int) { return x < edge ? 1.0f : 3.0f; };
+  Image noisy = noisy_image(w, h, truth, [&](int x, int y) { return 0.2f * truth(x, y); }, 7);
+  Image out = denoiser_->run(noisy, {});
+  double worst = 0.0;
+  for (int x = 0; x < w; ++x) {
+    const int d = x < edge ? edge - 1 - x : x - edge;  // whole pixels between x and the edge
+    for (int c = 0; c < 3; ++c) {
+      const Spread in = spread(noisy, c, [&](int px, int) { return px == x; });
+      const Spread den = spread(out, c, [&](int px, int) { return px == x; });
+      const double t = truth(x, 0) * (c == 0 ? 1.0 : c == 1 ? 0.8 : 0.6);
+      const double z = (den.mean - t) / (0.2 * t / std::sqrt(double(h)));
+      if (d >= kEdgeWidth) {
+        EXPECT_LT(std::abs(z), 4.0) << "column " << x << " (" << d << " px from the edge) channel " << c << ": "
+                                    << den.mean << " vs " << t;
+        worst = std::max(worst, std::abs(z));
+      }
+      if (d >= 8) EXPECT_LT(den.sd, in.sd / 3.0) << "column " << x << " channel " << c;
+    }
+  }
+  RecordProperty("worst_z_beyond_edge_width", std::to_string(worst));
+}
+
+// Two surfaces of the same noisy brightness level... almost: 1 and 1.3 (noise
+// σ = 0.3, so the luminance alone barely tells them apart), with albedos 0.2
+// and 0.8. With the features the edge holds 2 px from it; without them it
+// blurs further.
+TEST_F(DenoiseGpu, AlbedoKeepsAnEdgeTheLuminanceCannotSee) {
+  const int w = 64, h = 256, edge = 32;
+  auto truth = [&](int x, int) { return x < edge ? 1.0f : 1.3f; };
+  Image noisy = noisy_image(w, h, truth, [&](int, int) { return 0.3f; }, 11);
+  noisy.aovs.emission.assign(noisy.pixel_count() * 3, 0.0f);
+  noisy.aovs.scatter = noisy.aovs.background = noisy.aovs.emission;
+  noisy.aovs.surface = noisy.rgb;
+  noisy.aovs.albedo.resize(noisy.pixel_count() * 3);
+  noisy.aovs.normal.resize(noisy.pixel_count() * 3);
+  noisy.aovs.depth.assign(noisy.pixel_count(), 5.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        noisy.aovs.albedo[noisy.index(x, y, c)] = x < edge ? 0.2f : 0.8f;
+        noisy.aovs.normal[noisy.index(x, y, c)] = c == 2 ? 1.0f : 0.0f;
+      }
+  DenoiseOptions without;
+  without.use_features = false;
+  const Image with_f = denoiser_->run(noisy, {}), without_f = denoiser_->run(noisy, without);
+  auto column_error = [&](const Image& img, int x) {
+    return std::abs(spread(img, 1, [&](int px, int) { return px == x; }).mean - truth(x, 0) * 0.8);
+  };
+  const double se = 0.3 * 0.8 / std::sqrt(double(h));
+  double leak_with = 0.0, leak_without = 0.0;
+  for (int x : {edge - 3, edge - 4, edge + 2, edge + 3}) {
+    EXPECT_LT(column_error(with_f, x), 4.0 * se) << "column " << x;
+    leak_with = std::max(leak_with, column_error(with_f, x));
+    leak_without = std::max(leak_without, column_error(without_f, x));
+  }
+  EXPECT_GT(leak_without, 2.0 * leak_with) << "the features made no difference";
+  RecordProperty("leak_with_features", std::to_string(leak_with));
+  RecordProperty("leak_without_features", std::to_string(leak_without));
+}
+
+// The CLI: a new file with the denoised RGB and alpha and no variance; the
+// input is left as it was.
+TEST_F(DenoiseGpu, CliWritesANewFileAndLeavesTheInput) {
+  auto dir = test::temp_dir("denoisecli");
+  Image noisy = noisy_image(32, 16, [](int, int) { return 1.0f; }, [](int, int) { return 0.2f; }, 3);
+  write_image(dir / "in.exr", noisy);
+  const std::string before = test::read_file(dir / "in.exr");
+  test::CliResult r = test::run_cli("denoise " + (dir / "in.exr").string() + " -o " + (dir / "out.exr").string());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(test::read_file(dir / "in.exr"), before);
+  Image out = read_image(dir / "out.exr");
+  EXPECT_EQ(out.width, 32);
+  EXPECT_FALSE(out.has_variance());
+  EXPECT_TRUE(out.has_alpha());
+  EXPECT_LT(spread(out, 0, [](int, int) { return true; }).sd, 0.05);
+  std::filesystem::remove_all(dir);
+}

@@ -1,0 +1,82 @@
+"""tools/bench --denoise: the denoiser's time against the render it cleans
+(issue 25: under 20 % of a 16-spp render's time at 1920×1080).
+
+For each scene: render it at --resolution (default 1920x1080 in this mode) and
+--denoise-spp (16) with --variance, --render-reps times (the render's own
+"seconds" from --stats), then time `pyrolume denoise` on that EXR --reps times
+(the process's wall time: EXR read and write and the Vulkan device included;
+and the filter alone, as the command prints it). Medians go into the part of
+benchmarks.md between <!-- denoise:begin --> and <!-- denoise:end -->."""
+
+import os
+import re
+import statistics
+import subprocess
+import time
+
+from .common import REPO, log
+from .runner import machine_info, render
+
+BEGIN, END = "<!-- denoise:begin -->", "<!-- denoise:end -->"
+FILTER_RE = re.compile(r"([0-9.]+) s denoising")
+
+
+def time_denoise(args, exr, out):
+    cmd = [args.pyrolume, "denoise", exr, "-o", out] + (["--device", str(args.device)] if args.device is not None else [])
+    t0 = time.monotonic()
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    wall = time.monotonic() - t0
+    if p.returncode != 0:
+        raise RuntimeError(f"denoise exit {p.returncode}: {p.stderr.strip()}")
+    m = FILTER_RE.search(p.stdout)
+    return wall, float(m.group(1)) if m else float("nan")
+
+
+def run(args, argv):
+    names = [s.strip() for s in (args.scenes or "fire_ground,terrain_explosion").split(",")]
+    work = os.path.join(os.path.abspath(args.work_dir), "denoise")
+    os.makedirs(work, exist_ok=True)
+    rows = []
+    for name in names:
+        scene = os.path.join(REPO, "assets", "scenes", name + ".json")
+        if not os.path.exists(scene):
+            log(f"bench: --denoise: no scene {scene}")
+            return 2
+        exr = os.path.join(work, f"{name}_{args.width}x{args.height}_{args.denoise_spp}spp.exr")
+        render_s = []
+        for rep in range(args.render_reps):
+            stats = render(args, scene, exr, exr + ".stats.json", "vulkan", args.denoise_spp, 1 + rep, variance=True)
+            render_s.append(stats["seconds"])
+            log(f"bench: {name}: render {rep + 1}/{args.render_reps}: {stats['seconds']:.1f} s")
+        walls, filters = [], []
+        for rep in range(args.reps):
+            wall, filt = time_denoise(args, exr, os.path.join(work, f"{name}_denoised.exr"))
+            walls.append(wall)
+            filters.append(filt)
+            log(f"bench: {name}: denoise {rep + 1}/{args.reps}: {wall:.2f} s ({filt:.2f} s filtering)")
+        r, w, f = statistics.median(render_s), statistics.median(walls), statistics.median(filters)
+        rows.append((name, r, render_s, w, walls, f, 100.0 * w / r))
+    mi = machine_info(args.pyrolume)
+    lines = [BEGIN, "",
+             f"`tools/bench {' '.join(argv)}`, {args.width}×{args.height}, {args.denoise_spp} spp; "
+             f"{mi['cpu']}, {mi['nproc']} cores, {mi['devices'] or 'device unknown'}; "
+             f"load {' / '.join(f'{x:.2f}' for x in os.getloadavg())} at the end; medians (every run in brackets).", "",
+             "| scene | render, s | `pyrolume denoise`, s (wall) | filter alone, s | denoise / render |",
+             "|---|---|---|---|---|"]
+    for name, r, rs, w, ws, f, pct in rows:
+        lines.append(f"| {name} | {r:.1f} [{', '.join(f'{x:.1f}' for x in rs)}] | "
+                     f"{w:.2f} [{', '.join(f'{x:.2f}' for x in ws)}] | {f:.2f} | {pct:.1f} % |")
+    lines += ["", END]
+    block = "\n".join(lines)
+    print(block)
+    md = os.path.join(os.path.abspath(args.out_dir), "benchmarks.md")
+    text = open(md).read() if os.path.exists(md) else ""
+    if BEGIN in text and END in text:
+        text = text[:text.index(BEGIN)] + block + text[text.index(END) + len(END):]
+    else:
+        text = text.rstrip("\n") + "\n\n## Denoiser\n\n" + block + "\n"
+    with open(md + ".tmp", "w") as fh:
+        fh.write(text)
+    os.replace(md + ".tmp", md)
+    log(f"bench: --denoise: {os.path.relpath(md)}")
+    return 0
