@@ -14,6 +14,9 @@ struct RenderArgs {
   bool variance = false;
   // EXR: the light layers and first-hit features (film.aovs; docs/compositing.md "AOVs").
   bool aovs = false;
+  // Also write OUT.denoised.EXT (docs/compositing.md "Denoiser"); the render
+  // then accumulates the features it reads (AOVs) unless checkpoints are on.
+  bool denoise = false;
   int device = -1;
   // Sequences (docs/animation.md): "A-B[:step]"; output and stats are then
   // patterns (out_####.exr, stats_####.json), one file per frame.
