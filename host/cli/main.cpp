@@ -35,12 +35,12 @@ extern "C" void on_signal(int sig) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Few malloc arenas: llvmpipe runs each dispatch on worker threads, and
+  // One malloc arena: llvmpipe runs each dispatch on worker threads, and
   // glibc's default of one arena per thread let freed memory pile up in
-  // them (terrain_explosion at 64x36 grew from 0.47 GB of RSS at 64 spp to
-  // 1.2 GB at 512 spp, and a 320x180 4096-spp render was killed for memory
-  // on a 23 GB machine; with 1 arena, 0.32 GB at 512 spp; docs/robustness.md).
-  mallopt(M_ARENA_MAX, 2);
+  // them. terrain_explosion at 64x36, 2048 spp peaked at 1.8 GB of RSS with
+  // the default and at 0.65 GB with one arena; a 320x180 4096-spp render had
+  // been killed for memory on a 23 GB machine (docs/robustness.md).
+  mallopt(M_ARENA_MAX, 1);
   using namespace pyrolume;
   CLI::App app{"pyrolume: a renderer for fire, smoke and explosions (emissive participating media)"};
   app.require_subcommand(1);
