@@ -49,8 +49,8 @@ int run_compare(const CompareArgs& args);
 // variance (render --variance); OUT is a new file, never IN.
 struct DenoiseArgs {
   std::string input, output;
-  int iterations = 5;
-  float sigma_l = 4.0f;
+  int iterations = 3;
+  float sigma_l = 1.5f;
   bool no_features = false;
   int device = -1;
 };

@@ -14,11 +14,12 @@ namespace pyrolume {
 
 struct DenoiseOptions {
   // À-trous iterations; iteration i spaces its 5×5 taps 2^i pixels apart, so
-  // 5 reach ±62 pixels.
-  int iterations = 5;
+  // 3 reach ±14 pixels (tuned on the 16-spp fires: more blur their texture;
+  // docs/compositing.md "Denoiser").
+  int iterations = 3;
   // Edge-stopping parameters, SVGF's names and defaults (σ_a is ours: the
   // albedo, which SVGF demodulates instead).
-  float sigma_l = 4.0f;    // luminance, in standard deviations of its (filtered) noise
+  float sigma_l = 1.5f;    // luminance, in standard deviations of the noise of l_p − l_q
   float sigma_n = 128.0f;  // normal: exponent of max(0, n_p·n_q)
   float sigma_z = 1.0f;    // depth, in units of the depth's gradient times the tap distance
   float sigma_a = 0.2f;    // albedo: Euclidean distance in RGB
