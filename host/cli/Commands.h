@@ -49,7 +49,7 @@ int run_compare(const CompareArgs& args);
 // variance (render --variance); OUT is a new file, never IN.
 struct DenoiseArgs {
   std::string input, output;
-  int iterations = 3;
+  int iterations = 1;
   float sigma_l = 1.5f;
   bool no_features = false;
   int device = -1;

@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
   auto* denoise = app.add_subcommand("denoise", "Denoise a render (EXR with variance) into a new image");
   denoise->add_option("input", dn.input, "EXR written by render --variance (read only)")->required();
   denoise->add_option("-o,--output", dn.output, "Output image (.exr, or .png)")->required();
-  denoise->add_option("--iterations", dn.iterations, "À-trous iterations (default 3: taps reach ±14 px)")
+  denoise->add_option("--iterations", dn.iterations, "À-trous iterations (default 1; n reach ±(2^(n+1) − 2) px)")
       ->check(CLI::Range(0, 12));
   denoise->add_option("--sigma-l", dn.sigma_l, "Luminance edge-stopping, in standard deviations of the noise (default 1.5)")
       ->check(CLI::PositiveNumber);

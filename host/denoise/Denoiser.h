@@ -14,9 +14,11 @@ namespace pyrolume {
 
 struct DenoiseOptions {
   // À-trous iterations; iteration i spaces its 5×5 taps 2^i pixels apart, so
-  // 3 reach ±14 pixels (tuned on the 16-spp fires: more blur their texture;
-  // docs/compositing.md "Denoiser").
-  int iterations = 3;
+  // n reach ±(2^(n+1) − 2) pixels. 1 measured best on the 16-spp fires
+  // without AOVs (relMSE; more iterations blur the fire's and the terrain's
+  // texture, which the noisy luminance cannot tell from noise: docs/compositing.md
+  // "Denoiser"). Retune once the renders carry AOVs.
+  int iterations = 1;
   // Edge-stopping parameters, SVGF's names and defaults (σ_a is ours: the
   // albedo, which SVGF demodulates instead).
   float sigma_l = 1.5f;    // luminance, in standard deviations of the noise of l_p − l_q

