@@ -51,7 +51,7 @@ struct DenoiseArgs {
   std::string input, output;
   int iterations = 1;
   float sigma_l = 1.5f;
-  bool no_features = false;
+  bool features = false;
   int device = -1;
 };
 int run_denoise(const DenoiseArgs& args);

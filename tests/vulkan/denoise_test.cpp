@@ -66,6 +66,7 @@ DenoiseOptions tested() {
   DenoiseOptions o;
   o.iterations = 3;
   o.sigma_l = 1.5f;
+  o.use_features = true;  // off by default; tested here for what they do
   return o;
 }
 
