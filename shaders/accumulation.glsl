@@ -50,3 +50,49 @@ void add_pass(uint pixel_index, vec3 pass_sum, vec3 pass_sum_c, vec3 pass_sq, ve
   alpha_accum[pixel_index] = AlphaTexel(sa.x, ca.x, sa.y, ca.y);
 }
 
+
+// film.aovs (docs/compositing.md "AOVs"): a pass's sums of the light layers
+// and of the first-event features.
+struct AovSums {
+  vec3 emission, scatter, surface, background;
+  vec3 albedo, normal;
+  float depth, hits;
+};
+
+AovSums no_aovs() { return AovSums(vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0.0); }
+
+// One finished sample into the pass's AOV sums. The layers split p.L at the
+// path's first vertex (L_first) and take out what the camera ray saw of the
+// background (L_direct), so they add up to p.L; a sample that add_sample
+// records as 0 (not finite) adds 0 to every layer.
+void add_sample_aovs(inout PathState p, inout AovSums a) {
+  if (all(lessThanEqual(abs(p.L), vec3(MAX_SAMPLE_RADIANCE)))) {
+    const vec3 before = p.first_vertex == AOV_VERTEX_NONE ? p.L : p.L_first;
+    a.emission += before - p.L_direct;
+    a.background += p.L_direct;
+    if (p.first_vertex == AOV_VERTEX_SURFACE) a.surface += p.L - before;
+    else a.scatter += p.L - before;
+  }
+  if (p.has_feature) {
+    a.albedo += p.feature_albedo;
+    a.normal += p.feature_normal;
+    a.depth += p.feature_depth;
+    a.hits += 1.0;
+  }
+}
+
+// A pass's AOV sums into the pixel's (plain float sums: AovLightTexel).
+void add_pass_aovs(uint pixel_index, AovSums a) {
+  AovLightTexel l = aov_lights[pixel_index];
+  l.emission += a.emission;
+  l.scatter += a.scatter;
+  l.surface += a.surface;
+  l.background += a.background;
+  aov_lights[pixel_index] = l;
+  AovFeatureTexel f = aov_features[pixel_index];
+  f.albedo += a.albedo;
+  f.normal += a.normal;
+  f.depth += a.depth;
+  f.hits += a.hits;
+  aov_features[pixel_index] = f;
+}

@@ -73,16 +73,25 @@ bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, 
   if (LIGHT_COUNT > 0u && event == EVENT_SURFACE && p.hit.kind == SURFACE_HIT_LIGHT) {
     // A delta light ray arrives (its weight holds f·I/(r²·P)); any other ray
     // sees the sphere light's radiance, MIS-weighted, and ends: it is opaque.
-    if (p.hit.primitive == p.delta_light) p.L += p.w;
-    else if (!p.skip_segment)
-      p.L += unidirectional_weight(p.pdf_dir, p.p_light) * p.w *
-             sphere_light_radiance(analytic_lights[p.hit.primitive], p.o + p.hit.t * p.d, p.d);
+    if (p.hit.primitive == p.delta_light) {
+      p.L += p.w;
+    } else if (!p.skip_segment) {
+      const vec3 x_light = p.o + p.hit.t * p.d;
+      const vec3 seen = unidirectional_weight(p.pdf_dir, p.p_light) * p.w *
+                        sphere_light_radiance(analytic_lights[p.hit.primitive], x_light, p.d);
+      p.L += seen;
+      if (AOVS && p.depth == 0u) {
+        p.L_direct = seen;
+        set_features(p, vec3(0.0), normalize(analytic_lights[p.hit.primitive].position - x_light), x_light);
+      }
+    }
     return ray_ends(p);
   }
   if (event == EVENT_END || (event == EVENT_SURFACE && NEE && p.light_ray)) return ray_ends(p);
   const bool surface = HAS_SURFACES && event == EVENT_SURFACE;
   if (!surface) {
     stats.events += 1.0;
+    set_features(p, collision_albedo(c.sigma_a, sigma_s), vec3(0.0), x);
     if (event == EVENT_ABSORB) {
       // Absorbed: the absorption estimator collects sigma_a·Le / (sigma_bar·P_a).
       if (HAS_EMISSION && !COLLISION_ESTIMATOR)
@@ -141,6 +150,11 @@ void camera_path(uvec2 pixel, uint k, out uint rng, inout PathState p) {
   p.vertex_wa = p.vertex_n = vec3(0.0);
   p.light_pending = false;
   p.delta_light = LIGHT_COUNT;
+  p.L_direct = p.L_first = vec3(0.0);
+  p.first_vertex = AOV_VERTEX_NONE;
+  p.has_feature = false;
+  p.feature_albedo = p.feature_normal = vec3(0.0);
+  p.feature_depth = 0.0;
   p.vertex_norm = vec4(0.0);
   p.vertex_medium = false;
   p.vertex_d_in = vec3(0.0);

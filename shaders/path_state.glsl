@@ -69,7 +69,33 @@ struct PathState {
   // reaches the light (a point or spot: path_begin puts a hit there; a
   // distant light: escaping).
   uint delta_light;
+  // film.aovs (docs/compositing.md "AOVs"; only with AOVS): L_direct, what
+  // the camera ray sees of the background and sphere lights; L_first, L when
+  // the path made its first vertex (first_vertex: AOV_VERTEX_*). Then the
+  // camera ray's first event's features (has_feature: it had one).
+  vec3 L_direct, L_first;
+  uint first_vertex;
+  bool has_feature;
+  vec3 feature_albedo, feature_normal;
+  float feature_depth;
 };
+
+const uint AOV_VERTEX_NONE = 0u, AOV_VERTEX_MEDIUM = 1u, AOV_VERTEX_SURFACE = 2u;
+
+// film.aovs: the camera ray's first event (depth 0) sets the features.
+void set_features(inout PathState p, vec3 albedo, vec3 normal, vec3 x) {
+  if (!AOVS || p.depth != 0u || p.has_feature) return;
+  p.has_feature = true;
+  p.feature_albedo = albedo;
+  p.feature_normal = normal;
+  p.feature_depth = distance(x, frame.camera_position);
+}
+
+// film.aovs: the single-scattering albedo σs/σt of a real collision.
+vec3 collision_albedo(vec3 sigma_a, vec3 sigma_s) {
+  const vec3 sigma_t = sigma_a + sigma_s;
+  return mix(vec3(0.0), sigma_s / max(sigma_t, vec3(1e-30)), greaterThan(sigma_t, vec3(0.0)));
+}
 
 // Radiance of a ray that leaves the scene: the environment map (+Z up,
 // docs/lights.md), or the constant background.
@@ -89,7 +115,10 @@ void escape(inout PathState p) {
     p.alpha = 1.0 - avg3(p.w);
     if (frame.transparent != 0u) return;  // the plate shows there: no background
   }
-  if (!p.skip_segment) p.L += unidirectional_weight(p.pdf_dir, p.p_light) * p.w * escaped_radiance(p.d);
+  if (p.skip_segment) return;
+  const vec3 seen = unidirectional_weight(p.pdf_dir, p.p_light) * p.w * escaped_radiance(p.d);
+  p.L += seen;
+  if (AOVS && p.depth == 0u) p.L_direct = seen;
 }
 
 // Start a new ray at a vertex, its direction sampled with solid-angle pdf pdf_dir.

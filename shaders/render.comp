@@ -41,6 +41,7 @@ void main() {
   vec3 pass_sum = vec3(0.0), pass_sq = vec3(0.0);
   vec3 pass_sum_c = vec3(0.0), pass_sq_c = vec3(0.0);  // their Kahan compensations
   vec2 pass_alpha = vec2(0.0);                          // Σα, Σα²
+  AovSums aovs = no_aovs();
   PathStats stats = PathStats(0.0, 0.0);
   float nonfinite = 0.0;
   const uint first = pass_constants.sample_offset, last = first + pass_constants.spp;
@@ -74,6 +75,7 @@ void main() {
       for (uint n = 0u; n < 16384u && k < last; ++n) {
         if (!path_step(p, span, rng, stats)) continue;
         add_sample(p.L, p.alpha, pass_sum, pass_sum_c, pass_sq, pass_sq_c, pass_alpha, nonfinite);
+        if (AOVS) add_sample_aovs(p, aovs);
         if (++k < last) camera_path(pixel, k, rng, p);
       }
     }
@@ -85,4 +87,5 @@ void main() {
   }
 
   add_pass(pixel_index, pass_sum, pass_sum_c, pass_sq, pass_sq_c, pass_alpha, stats, nonfinite);
+  if (AOVS) add_pass_aovs(pixel_index, aovs);
 }

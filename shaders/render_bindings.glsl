@@ -33,6 +33,8 @@ layout(constant_id = SPEC_EARLY_EVENT_EXIT) const bool EARLY_EVENT_EXIT = false;
 layout(constant_id = SPEC_TEMPERATURE_IN_DENSITY) const bool TEMPERATURE_IN_DENSITY = false;
 // The scene's analytic lights (shaders/analytic_lights.glsl); 0: none of their code.
 layout(constant_id = SPEC_LIGHT_COUNT) const uint LIGHT_COUNT = 0;
+// film.aovs: the light layers and first-hit features; off compiles their code out.
+layout(constant_id = SPEC_AOVS) const bool AOVS = false;
 
 layout(std140, set = 0, binding = BINDING_FRAME) uniform FrameBlock { FrameConstants frame; };
 // Media and grids are uniform blocks: every lane reads the same entries, which
@@ -40,6 +42,8 @@ layout(std140, set = 0, binding = BINDING_FRAME) uniform FrameBlock { FrameConst
 layout(std140, set = 0, binding = BINDING_MEDIA) uniform MediaBlock { GpuMedium media[MAX_MEDIA]; };
 layout(std430, set = 0, binding = BINDING_ACCUM) buffer AccumBlock { AccumTexel accum[]; };
 layout(std430, set = 0, binding = BINDING_ALPHA) buffer AlphaBlock { AlphaTexel alpha_accum[]; };
+layout(std430, set = 0, binding = BINDING_AOV_LIGHTS) buffer AovLightBlock { AovLightTexel aov_lights[]; };
+layout(std430, set = 0, binding = BINDING_AOV_FEATURES) buffer AovFeatureBlock { AovFeatureTexel aov_features[]; };
 layout(std140, set = 0, binding = BINDING_GRIDS) uniform GridBlock { GpuGrid grids[MAX_GRIDS]; };
 layout(std430, set = 0, binding = BINDING_MAJORANTS) readonly buffer MajorantBlock { float majorants[]; };
 layout(set = 0, binding = BINDING_DENSITY) uniform sampler3D density_tex[MAX_GRIDS];

@@ -51,6 +51,7 @@ const uint EVENT_NONE = 0u, EVENT_ESCAPE = 1u, EVENT_SURFACE = 2u, EVENT_ABSORB 
 struct Collision {
   vec3 x, sigma_s;
   float sigma_bar, p_a, p_s;
+  vec3 sigma_a;  // read only for film.aovs' albedo (the wavefront does not carry it)
 };
 
 // Free flights along the current ray until its event (path_step's loop).
@@ -162,6 +163,6 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
       if (2u * tracking <= lanes) break;
     }
   }
-  c_out = Collision(x, sigma_s, sigma_bar, p_a, p_s);
+  c_out = Collision(x, sigma_s, sigma_bar, p_a, p_s, sigma_a);
   return event;
 }

@@ -107,13 +107,14 @@ bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float
   if (surface) {
     SurfaceInteraction si = surface_interaction(p.o, p.d, p.hit);
     stats.events += 1.0;
-    if (p.depth >= frame.max_depth) return true;  // max_depth reached
-    ++p.depth;
     GpuMaterial m = surface_materials[si.material];
     albedo = m.albedo;
     if (ALBEDO_TEXTURE_COUNT > 0u && m.texture_slot != NO_TEXTURE)
       albedo *= albedo_texture_at(m.texture_slot, vec2(si.uv.x, 1.0 - si.uv.y));  // OBJ v=0 at the bottom
     n = dot(si.normal, p.d) < 0.0 ? si.normal : -si.normal;
+    set_features(p, albedo, n, si.position);
+    if (p.depth >= frame.max_depth) return true;  // max_depth reached
+    ++p.depth;
     o = offset_ray_origin(si.position, n);
   } else {
     if (p.depth >= frame.max_depth) return true;  // max_depth reached
@@ -144,6 +145,10 @@ bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float
       total += q[i];
     }
     for (uint i = 0u; i < MEDIUM_COUNT; ++i) q[i] /= total;
+  }
+  if (AOVS && p.depth == 1u) {  // the path's first vertex: what follows is its scatter or surface layer
+    p.L_first = p.L;
+    p.first_vertex = surface ? AOV_VERTEX_SURFACE : AOV_VERTEX_MEDIUM;
   }
   if (NEE) light_norms(o, p.vertex_norm);
   vec3 d;

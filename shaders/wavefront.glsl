@@ -225,7 +225,7 @@ void wavefront_main() {
     s.nonfinite = 0.0;
     s.stats = PathStats(0.0, 0.0);
     s.event = EVENT_NONE;
-    s.c = Collision(vec3(0.0), vec3(0.0), 0.0, 0.0, 0.0);
+    s.c = Collision(vec3(0.0), vec3(0.0), 0.0, 0.0, 0.0, vec3(0.0));
     for (uint i = 0u; i < MEDIUM_COUNT; ++i) rho[i] = temperature_value[i] = 0.0;
     camera_path(pixel, s.k, s.rng, p);
     if (!settle(pixel, p, s, span, false)) {

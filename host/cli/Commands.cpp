@@ -48,7 +48,39 @@ namespace {
 // Where one frame goes: the image, and the stats JSON when asked for.
 struct FrameOutputs {
   std::filesystem::path image, stats;
+  std::filesystem::path denoised;  // render --denoise: OUT.denoised.EXT; else empty
 };
+
+// render --denoise: the denoised image goes next to OUT, as OUT.denoised.EXT.
+std::filesystem::path denoised_path(const std::filesystem::path& output) {
+  std::filesystem::path p = output;
+  p.replace_extension(".denoised" + output.extension().string());
+  return p;
+}
+
+// Whether the render accumulates AOVs: asked for, or read by --denoise
+// (which goes without them when checkpoints are on: they carry no AOVs).
+bool render_aovs(const RenderArgs& args, const Scene& scene) {
+  return args.aovs || scene.film.aovs || (args.denoise && !args.resume && args.checkpoint <= 0.0);
+}
+
+// The image as the user asked for it (render --denoise computes variance and
+// features for the denoiser; the raw output keeps only what was asked).
+Image requested_image(Image image, const RenderArgs& args, const Scene& scene) {
+  if (!args.variance) image.variance.clear();
+  if (!args.aovs && !scene.film.aovs) image.aovs = Aovs{};
+  return image;
+}
+
+// render --denoise: the denoised image, through the same display transform
+// as OUT when it is a PNG. Returns the seconds the filter took.
+double write_denoised(const std::filesystem::path& file, const Image& image, double stops, ViewTransform view) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Image clean = denoise(image, DenoiseOptions{}, file.string());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  write_image(file, clean, stops, view);
+  return seconds;
+}
 
 // Where the auto exposure line goes: stderr, for display output only (an EXR
 // is linear; an exposure chosen for it would mean nothing).
@@ -60,6 +92,7 @@ std::ostream* display_log(const std::filesystem::path& output) {
 void check_frame_outputs(const FrameOutputs& out, const Scene& frame_scene, CreatedFolders& folders) {
   std::vector<NamedPath> outputs{{"-o", out.image}};
   if (!out.stats.empty()) outputs.push_back({"--stats", out.stats});
+  if (!out.denoised.empty()) outputs.push_back({"--denoise", out.denoised});
   check_outputs(outputs, {}, scene_inputs(frame_scene), folders);
 }
 
@@ -122,6 +155,7 @@ RenderSettings settings_from(const RenderArgs& args, const Scene& scene) {
   settings.spp = args.spp.value_or(scene.film.spp);
   settings.seed = args.seed.value_or(scene.film.seed);
   settings.time_limit = args.time_limit;
+  settings.aovs = render_aovs(args, scene);
   return settings;
 }
 
@@ -183,9 +217,11 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
   // The first frame's outputs before the backend starts; each frame's again before its render.
   CreatedFolders folders;
   auto frame_outputs = [&](int frame) {
-    return FrameOutputs{expand_frame_pattern(output.string(), frame),
+    const std::filesystem::path image = expand_frame_pattern(output.string(), frame);
+    return FrameOutputs{image,
                         args.stats.empty() ? std::filesystem::path()
-                                           : std::filesystem::path(expand_frame_pattern(args.stats, frame))};
+                                           : std::filesystem::path(expand_frame_pattern(args.stats, frame)),
+                        args.denoise ? denoised_path(image) : std::filesystem::path()};
   };
   check_frame_outputs(frame_outputs(range.first), scene_at_frame(scene, range.first), folders);
 
@@ -246,13 +282,15 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
                 << " spp; that frame is not written (rerun with --skip-existing to resume)\n";
       break;
     }
-    Image image = image_from_render(result, args.variance);
-    image.transparent = frame_scene.film.transparent;
+    Image full = image_from_render(result, args.variance || args.denoise);
+    full.transparent = frame_scene.film.transparent;
+    const Image image = requested_image(full, args, frame_scene);
     const double stops = exposure.stops(frame_scene.film, image, display_log(out.image));
     {
-      OutputCommit both;  // the image and its stats, or neither
+      OutputCommit both;  // the image and its stats (and the denoised image), or none
       write_image(out.image, image, stops, frame_scene.film.view);
       if (!out.stats.empty()) write_stats(out.stats, args, out.image, result, frame);
+      if (!out.denoised.empty()) write_denoised(out.denoised, full, stops, frame_scene.film.view);
       both.commit();
     }
     print_warnings(result, tag);
@@ -310,6 +348,18 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   if (ext != ".exr" && ext != ".png")
     throw input_error(output.string(), "", "unknown image type \"" + ext + "\" (use .exr or .png)");
   if (args.variance && ext != ".exr") throw input_error(output.string(), "", "--variance needs an .exr output");
+  if (args.aovs && ext != ".exr") throw input_error(output.string(), "", "--aovs needs an .exr output (PNG has no layers)");
+  if (scene.film.aovs && ext != ".exr")
+    throw input_error(scene.file.string(), "film.aovs", "needs an .exr output (PNG has no layers), not " + output.string());
+  // Checkpoints carry the beauty and alpha, not the AOVs (docs/checkpoints.md).
+  const bool aovs = args.aovs || scene.film.aovs;
+  if (aovs && args.resume)
+    throw input_error("--resume", "", std::string("checkpoints do not carry AOVs (") +
+                                          (args.aovs ? "--aovs" : scene.file.string() + ": film.aovs") +
+                                          "): render again without --resume");
+  if (aovs && args.checkpoint > 0.0)
+    throw input_error("--checkpoint", "", std::string("checkpoints do not carry AOVs (") +
+                                              (args.aovs ? "--aovs" : scene.file.string() + ": film.aovs") + ")");
 
   if (sequence) return run_sequence(args, scene, output, cancel, remarks);
 
@@ -329,6 +379,7 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   {
     std::vector<NamedPath> outputs{{"-o", output}};
     if (!args.stats.empty()) outputs.push_back({"--stats", args.stats});
+    if (args.denoise) outputs.push_back({"--denoise", denoised_path(output)});
     check_outputs(outputs, {{"the checkpoint (-o + .checkpoint)", checkpoint_file}}, scene_inputs(scene), folders);
   }
 
@@ -386,8 +437,9 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   // The image and (short of the target) the checkpoint of what was rendered.
   DisplayExposure exposure(parse_exposure(args.exposure));
   auto save = [&](const RenderResult& result, bool keep_checkpoint) {
-    Image image = image_from_render(result, args.variance);
-    image.transparent = scene.film.transparent;
+    Image full = image_from_render(result, args.variance || args.denoise);
+    full.transparent = scene.film.transparent;
+    const Image image = requested_image(full, args, scene);
     const double stops = exposure.stops(scene.film, image, display_log(output));
     {
       OutputCommit both;  // the image and the stats, or neither
@@ -395,11 +447,19 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
       if (!args.stats.empty()) write_stats(args.stats, args, output, result, std::nullopt);
       both.commit();
     }
+    if (args.denoise && result.spp > 0) {  // after the raw image is safe: a failure here loses nothing
+      const std::filesystem::path file = denoised_path(output);
+      OutputCommit one;
+      const double seconds = write_denoised(file, full, stops, scene.film.view);
+      one.commit();
+      std::cout << file.string() << ": denoised " << (full.has_aovs() ? "with albedo, normal, depth" : "with beauty and variance only")
+                << ", " << format_seconds(seconds) << " s" << std::endl;
+    }
     if (result.spp >= settings.spp)  // a finished render: one the user will look at
       if (const std::string w = film_look_warning(image, stops, scene.film.view, ext == ".png"); !w.empty())
         std::cerr << "pyrolume: warning: " << output.string() << ": " << w << "\n";
     bool checkpointed = false;
-    if (result.spp < settings.spp && keep_checkpoint && !result.state.data.empty())
+    if (result.spp < settings.spp && keep_checkpoint && !settings.aovs && !result.state.data.empty())
       checkpointed = save_checkpoint(result.state);
     if (result.spp >= settings.spp) {
       std::error_code ec;

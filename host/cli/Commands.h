@@ -12,6 +12,11 @@ struct RenderArgs {
   std::optional<uint32_t> seed;
   double time_limit = 0.0;
   bool variance = false;
+  // EXR: the light layers and first-hit features (film.aovs; docs/compositing.md "AOVs").
+  bool aovs = false;
+  // Also write OUT.denoised.EXT (docs/compositing.md "Denoiser"); the render
+  // then accumulates the features it reads (AOVs) unless checkpoints are on.
+  bool denoise = false;
   int device = -1;
   // Sequences (docs/animation.md): "A-B[:step]"; output and stats are then
   // patterns (out_####.exr, stats_####.json), one file per frame.

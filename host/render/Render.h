@@ -52,7 +52,17 @@ struct RenderSettings {
   // own even where it could be the density texture's second channel (Vulkan;
   // GpuScene::temperature_in_density).
   bool temperature_in_density = true;
+  // film.aovs or --aovs (docs/compositing.md "AOVs"): also accumulate the
+  // light layers and first-hit features (RenderResult::aov_sum).
+  bool aovs = false;
 };
+
+// RenderResult::aov_sum's layout: per pixel, kAovValues sums over its samples,
+// at these offsets: the light layers (RGB; they sum to RenderResult::sum),
+// then the first-event features (albedo RGB, normal XYZ, depth) summed over
+// the samples that have a first event, and their number (kAovHits).
+constexpr int kAovEmission = 0, kAovScatter = 3, kAovSurface = 6, kAovBackground = 9;
+constexpr int kAovAlbedo = 12, kAovNormal = 15, kAovDepth = 18, kAovHits = 19, kAovValues = 20;
 
 // Called after each progressive pass: samples per pixel done so far, target.
 using ProgressFn = std::function<void(int spp_done, int spp_target)>;
@@ -81,6 +91,8 @@ struct RenderResult {
   std::vector<double> sum, sum_sq;
   // Per pixel (width*height): Σα and Σα² of the samples' alpha (docs/compositing.md).
   std::vector<double> alpha_sum, alpha_sum_sq;
+  // RenderSettings::aovs: width*height*kAovValues sums (layout above); else empty.
+  std::vector<double> aov_sum;
   std::string backend, device;
   // What the render resolved from integrator.mis / emission_estimator
   // (host/light/LightSelection.h): "bsdf" | "mis" | "light_only" and

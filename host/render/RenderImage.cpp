@@ -6,6 +6,34 @@
 
 namespace pyrolume {
 
+Aovs aovs_from_render(const RenderResult& result) {
+  const size_t pixels = size_t(result.width) * size_t(result.height);
+  if (result.aov_sum.size() != pixels * kAovValues)
+    throw std::logic_error("aovs_from_render: AOV sums do not match width*height*kAovValues");
+  Aovs a;
+  for (auto* v : {&a.emission, &a.scatter, &a.surface, &a.background, &a.albedo, &a.normal}) v->assign(pixels * 3, 0.0f);
+  a.depth.assign(pixels, 0.0f);
+  const double n = double(result.spp);
+  for (size_t i = 0; i < pixels; ++i) {
+    const double* s = result.aov_sum.data() + i * kAovValues;
+    const double hits = s[kAovHits];
+    for (int c = 0; c < 3; ++c) {
+      if (n > 0.0) {  // the layers are means over all samples, like the beauty
+        a.emission[i * 3 + c] = float(s[kAovEmission + c] / n);
+        a.scatter[i * 3 + c] = float(s[kAovScatter + c] / n);
+        a.surface[i * 3 + c] = float(s[kAovSurface + c] / n);
+        a.background[i * 3 + c] = float(s[kAovBackground + c] / n);
+      }
+      if (hits > 0.0) {  // the features, over the samples that have a first event
+        a.albedo[i * 3 + c] = float(s[kAovAlbedo + c] / hits);
+        a.normal[i * 3 + c] = float(s[kAovNormal + c] / hits);
+      }
+    }
+    if (hits > 0.0) a.depth[i] = float(s[kAovDepth] / hits);
+  }
+  return a;
+}
+
 Image image_from_render(const RenderResult& result, bool with_variance) {
   Image img = make_image(result.width, result.height, with_variance);
   img.spp = result.spp;
@@ -21,6 +49,7 @@ Image image_from_render(const RenderResult& result, bool with_variance) {
     if (n > 0.0)
       for (size_t i = 0; i < img.alpha.size(); ++i) img.alpha[i] = float(result.alpha_sum[i] / n);
   }
+  if (!result.aov_sum.empty()) img.aovs = aovs_from_render(result);
   if (n <= 0.0) return img;
   for (size_t i = 0; i < count; ++i) {
     const double mean = result.sum[i] / n;

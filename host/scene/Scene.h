@@ -80,6 +80,8 @@ struct Film {
   // still lights it), so RGB over A composites over a plate; PNG then has
   // alpha (docs/compositing.md).
   bool transparent = false;
+  // EXR: the light layers and first-hit features (docs/compositing.md "AOVs").
+  bool aovs = false;
 };
 
 // How emission in media is collected: at absorptions only, or at every

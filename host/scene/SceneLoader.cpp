@@ -495,6 +495,7 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
     s.film.view = f.choice("view", "agx", {"agx", "standard"}) == "agx" ? ViewTransform::AgX : ViewTransform::Standard;
     s.film.seed = static_cast<uint32_t>(f.integer("seed", static_cast<int>(s.film.seed), 0, 2147483647));
     s.film.transparent = f.boolean("transparent", false);
+    s.film.aovs = f.boolean("aovs", false);
     f.finish();
   }
   if (r.has("integrator")) {

@@ -54,6 +54,8 @@ PYRO_CONST uint BINDING_PATHS = 23;    // uimageBuffer (rgba32ui): the wavefront
 PYRO_CONST uint BINDING_LIGHTS = 25;    // readonly buffer GpuLight[]: the scene's analytic lights (shared/light_types.h)
 PYRO_CONST uint BINDING_QUEUES = 24;   // buffer WavefrontQueues, then its queues of path slots
 PYRO_CONST uint BINDING_ALPHA = 26;    // buffer AlphaTexel[] (one per pixel)
+PYRO_CONST uint BINDING_AOV_LIGHTS = 27;    // buffer AovLightTexel[] (one per pixel; film.aovs)
+PYRO_CONST uint BINDING_AOV_FEATURES = 28;  // buffer AovFeatureTexel[] (one per pixel; film.aovs)
 
 // Specialisation constants of render.comp: a scene pays only for what it uses.
 PYRO_CONST uint SPEC_HAS_GRIDS = 0;
@@ -85,6 +87,7 @@ PYRO_CONST uint SPEC_WAVEFRONT_SPLIT = 17;  // the event stage leaves the next r
 // Every emitting grid's temperature is the second channel of its density
 // texture (GpuScene::temperature_in_density): one lookup reads both.
 PYRO_CONST uint SPEC_TEMPERATURE_IN_DENSITY = 18;
+PYRO_CONST uint SPEC_AOVS = 20;  // film.aovs: the light layers and first-hit features (docs/compositing.md "AOVs")
 PYRO_CONST uint SPEC_LIGHT_COUNT = 19;  // analytic lights (the scene's `lights`); 0 compiles their code out
 PYRO_CONST uint WAVEFRONT_GROUP = 64;      // lanes per workgroup of the queue stages
 // 16-byte words of one path's state: a fixed part and a part per medium.
@@ -240,6 +243,30 @@ struct AlphaTexel {
   float sq_c;
 };
 
+// film.aovs (docs/compositing.md "AOVs"): a pixel's sums over its samples
+// of the four light layers, which sum to AccumTexel::sum per sample. Plain
+// float sums (no Kahan terms: they would take the binding past lavapipe's
+// 128 MiB range at 1920×1080). Its own binding after the AlphaTexels.
+struct AovLightTexel {
+  vec3 emission;    // media emission reaching the camera unscattered
+  float pad0;
+  vec3 scatter;     // paths whose first vertex scatters in a medium
+  float pad1;
+  vec3 surface;     // paths whose first vertex is on a surface
+  float pad2;
+  vec3 background;  // background, environment, sun discs, sphere lights seen directly
+  float pad3;
+};
+
+// film.aovs: sums of the camera ray's first-event features over the samples
+// that have one (hits counts them).
+struct AovFeatureTexel {
+  vec3 albedo;
+  float depth;
+  vec3 normal;
+  float hits;
+};
+
 #ifdef __cplusplus
 // Every field where std140/std430 put it (a vec3 ends 4 bytes before the next 16).
 static_assert(sizeof(GpuMedium) == 96);
@@ -286,6 +313,10 @@ PYRO_OFFSET(AccumTexel, sum_sq, 32); PYRO_OFFSET(AccumTexel, lookups, 44); PYRO_
 PYRO_OFFSET(AccumTexel, nonfinite, 60);
 static_assert(sizeof(AlphaTexel) == 16);
 PYRO_OFFSET(AlphaTexel, sum_c, 4); PYRO_OFFSET(AlphaTexel, sq, 8); PYRO_OFFSET(AlphaTexel, sq_c, 12);
+static_assert(sizeof(AovLightTexel) == 64);
+PYRO_OFFSET(AovLightTexel, scatter, 16); PYRO_OFFSET(AovLightTexel, surface, 32); PYRO_OFFSET(AovLightTexel, background, 48);
+static_assert(sizeof(AovFeatureTexel) == 32);
+PYRO_OFFSET(AovFeatureTexel, depth, 12); PYRO_OFFSET(AovFeatureTexel, normal, 16); PYRO_OFFSET(AovFeatureTexel, hits, 28);
 }  // namespace pyrolume::gpu
 #endif
 #endif

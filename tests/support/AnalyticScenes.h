@@ -30,6 +30,7 @@ inline RenderSettings settings_for(const Scene& s) {
   rs.height = s.film.height;
   rs.spp = s.film.spp;
   rs.seed = s.film.seed;
+  rs.aovs = s.film.aovs;
   return rs;
 }
 

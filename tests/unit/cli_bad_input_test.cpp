@@ -78,6 +78,12 @@ INSTANTIATE_TEST_SUITE_P(
                 "bad.json: integrator.light_only: true asks for light sampling, which needs the collision estimator"},
         CliCase{"wrong_type", R"({"film": {"height": [3]}})", "", "film.height: expected an integer"},
         CliCase{"not_json", "this is not json", "", "invalid JSON"},
+        // Checkpoints carry no AOVs (docs/compositing.md "AOVs").
+        CliCase{"aovs_with_resume", kSphere, "--aovs --resume", "--resume: checkpoints do not carry AOVs (--aovs)"},
+        CliCase{"film_aovs_with_checkpoint",
+                R"({"film": {"width": 8, "height": 8, "spp": 1, "aovs": true},
+                    "media": [{"type": "homogeneous", "bounds": {"sphere": {"center": [0,1,0], "radius": 1}}}]})",
+                "--checkpoint 5", "film.aovs)"},
         CliCase{"flag_spp_zero", kSphere, "--spp 0", "--spp"},
         CliCase{"vdb_missing_file", R"({"media": [{"type": "vdb", "file": "nothere.vdb"}]})", "",
                 "nothere.vdb: file not found"},
@@ -108,5 +114,16 @@ TEST(Cli, UnknownImageType) {
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("x.tiff: unknown image type"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "x.tiff"));
+  std::filesystem::remove_all(dir);
+}
+
+// AOVs are layers of an EXR: PNG has none.
+TEST(Cli, AovsNeedAnExr) {
+  auto dir = temp_dir("cliaovs");
+  write_file(dir / "s.json", kSphere);
+  CliResult r = run_cli("render " + (dir / "s.json").string() + " --backend cpu --aovs -o " + (dir / "x.png").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("x.png: --aovs needs an .exr output"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
   std::filesystem::remove_all(dir);
 }

@@ -205,6 +205,8 @@ INSTANTIATE_TEST_SUITE_P(
         // film.transparent (docs/compositing.md) takes true or false only.
         BadCase{"transparent not a boolean", R"({"film": {"transparent": 1}})",
                 "film.transparent: expected true or false"},
+        // film.aovs (docs/compositing.md "AOVs") likewise.
+        BadCase{"aovs not a boolean", R"({"film": {"aovs": "yes"}})", "film.aovs: expected true or false"},
         // The lights array (docs/scene-format.md "lights").
         BadCase{"lights not an array", R"({"lights": {}})", "lights: expected an array"},
         BadCase{"light type", R"({"lights": [{"type": "area", "radiance": [1, 1, 1]}]})",

@@ -254,9 +254,26 @@ struct VertexLobe {
 // A light ray (next_event) or a path: how the walk treats tentative collisions.
 enum class WalkRole { Path, LightRay };
 
+// film.aovs (docs/compositing.md "AOVs"): what a camera path's channel walk
+// tells the layers and features. The walk's L splits at its first vertex:
+// before_vertex (all of L when it has none) less direct (the background or
+// sphere light the camera ray sees) is emission; direct is background; the
+// rest is scatter or surface, by the first vertex's kind.
+struct WalkAov {
+  enum class Vertex { None, Medium, Surface } first_vertex = Vertex::None;
+  double direct = 0.0, before_vertex = 0.0;
+  // The camera ray's first event (a real collision, a surface, a sphere light).
+  bool has_feature = false;
+  double albedo = 0.0;  // this channel's
+  glm::dvec3 normal{0.0};
+  double depth = 0.0;
+};
+
 // camera_escaped: set when the walk's first ray (a camera ray) leaves the scene.
+// aov: filled for a camera path (role Path) when given.
 double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
-                    Scratch& s, int max_depth, WalkRole role = WalkRole::Path, bool* camera_escaped = nullptr);
+                    Scratch& s, int max_depth, WalkRole role = WalkRole::Path, bool* camera_escaped = nullptr,
+                    WalkAov* aov = nullptr);
 
 // One light sample: a direction from the mixture of eq. (3) of docs/mis.md,
 // or the direction toward a delta light with what it delivers.
@@ -524,7 +541,22 @@ constexpr double kScatterRouletteBelow = 0.1;
 // the environment is (1 for camera rays). Delta lights only reach vertices
 // through next_event.
 double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
-                    Scratch& s, int max_depth, WalkRole role, bool* camera_escaped) {
+                    Scratch& s, int max_depth, WalkRole role, bool* camera_escaped, WalkAov* aov) {
+  if (role != WalkRole::Path) aov = nullptr;
+  // The camera ray's first event (scatters == 0: o is still the camera).
+  auto feature = [&](double albedo, const glm::dvec3& normal, double depth) {
+    if (!aov || aov->has_feature) return;
+    aov->has_feature = true;
+    aov->albedo = albedo;
+    aov->normal = normal;
+    aov->depth = depth;
+  };
+  // The path's first vertex: the layers' split point.
+  auto first_vertex = [&](double L_now, WalkAov::Vertex kind) {
+    if (!aov || aov->first_vertex != WalkAov::Vertex::None) return;
+    aov->first_vertex = kind;
+    aov->before_vertex = L_now;
+  };
   const MediaData& md = ws.md;
   const WalkLights& lights = ws.lights;
   const bool collision_estimator = ws.collision_estimator;
@@ -584,6 +616,7 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
         // collision estimator has collected the emission here already, and
         // β · σs/(σa + σs) keeps the expectation.
         const bool survive = lights.active() && collision_estimator && sigma_s > 0.0;
+        if (scatters == 0 && u < sigma_a + sigma_s) feature(sigma_s / (sigma_a + sigma_s), glm::dvec3(0.0), t);
         if (!survive && u < sigma_a) {
           ++cnt.collisions;
           return collision_estimator ? L : beta * emitted_at(md, c, x, s) / sigma_a;
@@ -592,6 +625,7 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
         ++cnt.collisions;
         if (scatters == max_depth) return collision_estimator ? L : 0.0;
         ++scatters;
+        first_vertex(L, WalkAov::Vertex::Medium);
         if (survive) {
           // Russian roulette once these factors have lowered β below
           // kScatterRouletteBelow of what it was: survive with probability
@@ -644,23 +678,34 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
     if (scattered) continue;
     // A sphere light absorbs the ray and adds its radiance, weighted like the
     // environment's (docs/lights.md "Sampling"); black from inside.
-    if (sphere.light >= 0)
-      return L + (sphere.outside ? beta * w_ray * lights.analytic[sphere.light].value[c] : 0.0);
+    if (sphere.light >= 0) {
+      const double seen = sphere.outside ? beta * w_ray * lights.analytic[sphere.light].value[c] : 0.0;
+      if (scatters == 0 && aov) {
+        const glm::dvec3 x = o + sphere.t * d;
+        aov->direct = seen;
+        feature(0.0, glm::normalize(x - lights.analytic[sphere.light].light.center), sphere.t);
+      }
+      return L + seen;
+    }
     if (!hit_surface) {
       if (role == WalkRole::Path && scatters == 0) {  // the camera ray itself: alpha, transparency
         if (camera_escaped) *camera_escaped = true;
         if (ws.transparent) return L;
       }
-      return L + beta * w_ray * ws.escaped(d, c);
+      const double seen = beta * w_ray * ws.escaped(d, c);
+      if (scatters == 0 && aov) aov->direct = seen;
+      return L + seen;
     }
 
     // Reached the surface: a Lambertian bounce.
     ++cnt.collisions;
+    const double albedo = geometry::albedo_at(ws.surfaces, hit)[c];
+    const glm::dvec3 n_f = glm::dot(hit.normal, d) < 0.0 ? hit.normal : -hit.normal;
+    if (scatters == 0) feature(albedo, n_f, hit.t);
     if (scatters == max_depth) return collision_estimator ? L : 0.0;
     ++scatters;
-    const double albedo = geometry::albedo_at(ws.surfaces, hit)[c];
+    first_vertex(L, WalkAov::Vertex::Surface);
     if (!(beta * albedo > 0.0)) return L;  // black surface: nothing more can arrive
-    const glm::dvec3 n_f = glm::dot(hit.normal, d) < 0.0 ? hit.normal : -hit.normal;
     o = geometry::offset_ray_origin(hit.position, n_f);
     auto lambert = [&](const glm::dvec3& w) {
       const double cos_theta = std::max(0.0, glm::dot(n_f, w));
@@ -682,6 +727,29 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
            walk_channel(ws, c, o, d, rng, cnt, s.light_ray(), 0, WalkRole::LightRay);
       skip_segment = true;
     }
+  }
+}
+
+// film.aovs: one sample's three channel walks into a pixel's AOV sums
+// (RenderResult::aov_sum's layout). L is the sample; recorded is false when
+// it was not finite and was recorded as 0: then every layer adds 0. Each channel's walk is its own
+// path, so each channel splits at its own first vertex. The features are
+// averaged over the channel walks that have a first event: hits counts them
+// in thirds (for surfaces and grey media every channel has the same chance).
+void add_sample_aovs(const glm::dvec3& L, bool recorded, const WalkAov aov[3], double* sum) {
+  for (int c = 0; c < 3; ++c) {
+    const WalkAov& a = aov[c];
+    if (recorded) {
+      const double before = a.first_vertex == WalkAov::Vertex::None ? L[c] : a.before_vertex;
+      sum[kAovEmission + c] += before - a.direct;
+      sum[kAovBackground + c] += a.direct;
+      sum[(a.first_vertex == WalkAov::Vertex::Surface ? kAovSurface : kAovScatter) + c] += L[c] - before;
+    }
+    if (!a.has_feature) continue;
+    sum[kAovAlbedo + c] += a.albedo;
+    for (int k = 0; k < 3; ++k) sum[kAovNormal + k] += a.normal[k] / 3.0;
+    sum[kAovDepth] += a.depth / 3.0;
+    sum[kAovHits] += 1.0 / 3.0;
   }
 }
 
@@ -823,6 +891,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   res.sum_sq.assign(size_t(W) * H * 3, 0.0);
   res.alpha_sum.assign(size_t(W) * H, 0.0);
   res.alpha_sum_sq.assign(size_t(W) * H, 0.0);
+  if (settings.aovs) res.aov_sum.assign(size_t(W) * H * kAovValues, 0.0);
   // Resumed: the sums continue in sample order, so the result is bit-identical
   // to an uninterrupted render's (per-pixel sums never depend on passes).
   CpuCounters totals;
@@ -844,6 +913,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   // before it made it.
   std::vector<double> next_sum(res.sum.size()), next_sum_sq(res.sum_sq.size());
   std::vector<double> next_alpha(res.alpha_sum.size()), next_alpha_sq(res.alpha_sum_sq.size());
+  std::vector<double> next_aov(res.aov_sum.size());
   while (spp_done < settings.spp) {
     const int s_begin = spp_done, s_end = std::min(settings.spp, spp_done + kPassSpp);
     std::atomic<int> next_tile{0};
@@ -862,6 +932,8 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
               sum_sq[c] = res.sum_sq[pix * 3 + c];
             }
             double alpha_sum = res.alpha_sum[pix], alpha_sq = res.alpha_sum_sq[pix];
+            double aov_sum[kAovValues] = {};
+            if (settings.aovs) std::copy_n(res.aov_sum.data() + pix * kAovValues, kAovValues, aov_sum);
             for (int si = s_begin; si < s_end; ++si) {
               cnt.step();
               Pcg32 rng = Pcg32::for_sample(settings.seed, settings.frame, pix, uint64_t(si));
@@ -873,10 +945,11 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
               // tracker whose camera ray escapes with probability T_c, so
               // 1 − (escapes)/3 has mean 1 − avg_c T_c.
               int escapes = 0;
+              WalkAov aov[3];
               for (int c = 0; c < 3; ++c) {
                 bool escaped = false;
                 L[c] = walk_channel(walk_scene, c, scene.camera.position, dir, rng, cnt, scratch, max_depth,
-                                    WalkRole::Path, &escaped);
+                                    WalkRole::Path, &escaped, settings.aovs ? &aov[c] : nullptr);
                 escapes += escaped ? 1 : 0;
               }
               const double alpha = 1.0 - escapes / 3.0;
@@ -885,7 +958,8 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
               // NaN, Inf and beyond MAX_SAMPLE_RADIANCE (where float sums of
               // squares could overflow): recorded as 0, counted in nonfinite_samples.
               const double kMaxL = kMaxSampleRadiance;
-              if (!(std::abs(L.x) <= kMaxL && std::abs(L.y) <= kMaxL && std::abs(L.z) <= kMaxL)) {
+              const bool recorded = std::abs(L.x) <= kMaxL && std::abs(L.y) <= kMaxL && std::abs(L.z) <= kMaxL;
+              if (!recorded) {
                 ++cnt.nonfinite;
                 L = glm::dvec3(0.0);
               }
@@ -893,7 +967,9 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
                 sum[c] += L[c];
                 sum_sq[c] += L[c] * L[c];
               }
+              if (settings.aovs) add_sample_aovs(L, recorded, aov, aov_sum);
             }
+            if (settings.aovs) std::copy_n(aov_sum, kAovValues, next_aov.data() + pix * kAovValues);
             for (int c = 0; c < 3; ++c) {
               next_sum[pix * 3 + c] = sum[c];
               next_sum_sq[pix * 3 + c] = sum_sq[c];
@@ -925,6 +1001,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
     res.sum_sq.swap(next_sum_sq);
     res.alpha_sum.swap(next_alpha);
     res.alpha_sum_sq.swap(next_alpha_sq);
+    res.aov_sum.swap(next_aov);
     for (const auto& cnt : counters) {
       totals.collisions += cnt.collisions;
       totals.nonfinite += cnt.nonfinite;

@@ -291,7 +291,7 @@ Context::~Context() {
 
 void Context::submit_and_wait(const std::function<void(VkCommandBuffer)>& record) {
   std::lock_guard lock(submit_mutex_);
-  VK_CHECK(vkResetCommandBuffer(command_buffer_, 0));
+  VK_CHECK(vkResetCommandBuffer(command_buffer_, VK_COMMAND_BUFFER_RESET_RELEASE_RESOURCES_BIT));
   VkCommandBufferBeginInfo bi{.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   VK_CHECK(vkBeginCommandBuffer(command_buffer_, &bi));

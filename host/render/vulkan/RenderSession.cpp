@@ -52,11 +52,15 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                           range_binds ? range : ctx.max_allocation_size(),
                           range_binds ? "this device's maxStorageBufferRange" : "this device's maxMemoryAllocationSize");
   // The alpha texels follow the AccumTexels in the same buffer, as a binding of their own.
+  // So do the AOV texels (settings.aovs), with the AOV sums' doubles on the host.
+  const size_t aov_bytes = settings.aovs ? sizeof(gpu::AovLightTexel) + sizeof(gpu::AovFeatureTexel) : 0;
+  const size_t aov_host_bytes = settings.aovs ? kAovValues * sizeof(double) : 0;
   check_accumulation_size(scene.file.string(), settings.width, settings.height,
-                          sizeof(gpu::AccumTexel) + sizeof(gpu::AlphaTexel), ctx.max_allocation_size(),
+                          sizeof(gpu::AccumTexel) + sizeof(gpu::AlphaTexel) + aov_bytes, ctx.max_allocation_size(),
                           "this device's maxMemoryAllocationSize");
   check_accumulation_fits_memory(scene.file.string(), settings.width, settings.height,
-                                 sizeof(gpu::AccumTexel) + sizeof(gpu::AlphaTexel) + 8 * sizeof(double));
+                                 sizeof(gpu::AccumTexel) + sizeof(gpu::AlphaTexel) + aov_bytes + 8 * sizeof(double) +
+                                     aov_host_bytes);
   check_scene_ranges(scene);
   // Load only what the scene uses: the grids of its vdb media, each checked
   // against the device's texture limits before its dense array is allocated.
@@ -76,8 +80,15 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   majorant_buffer_ = storage_buffer(ctx, gpu_scene_.majorants, "majorant cells");
   const VkDeviceSize pixels = VkDeviceSize(settings.width) * VkDeviceSize(settings.height);
   const VkDeviceSize align = std::max<VkDeviceSize>(ctx.properties().limits.minStorageBufferOffsetAlignment, 1);
-  alpha_offset_ = (pixels * sizeof(gpu::AccumTexel) + align - 1) / align * align;
-  accum_ = vk::Buffer(ctx, alpha_offset_ + pixels * sizeof(gpu::AlphaTexel),
+  auto aligned = [&](VkDeviceSize bytes) { return (bytes + align - 1) / align * align; };
+  alpha_offset_ = aligned(pixels * sizeof(gpu::AccumTexel));
+  VkDeviceSize accum_bytes = alpha_offset_ + pixels * sizeof(gpu::AlphaTexel);
+  if (settings.aovs) {
+    aov_lights_offset_ = aligned(accum_bytes);
+    aov_features_offset_ = aligned(aov_lights_offset_ + pixels * sizeof(gpu::AovLightTexel));
+    accum_bytes = aov_features_offset_ + pixels * sizeof(gpu::AovFeatureTexel);
+  }
+  accum_ = vk::Buffer(ctx, accum_bytes,
                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                           VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                       vk::MemoryKind::DeviceLocal, "accumulation");
@@ -100,6 +111,8 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                         {gpu::BINDING_MEDIA, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
                         {gpu::BINDING_ACCUM, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_ALPHA, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_AOV_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_AOV_FEATURES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_GRIDS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
                         {gpu::BINDING_MAJORANTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_DENSITY, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS},
@@ -129,7 +142,15 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   set_->write_buffer(gpu::BINDING_FRAME, frame_buffer_);
   set_->write_buffer(gpu::BINDING_MEDIA, media_buffer_);
   set_->write_buffer(gpu::BINDING_ACCUM, accum_, 0, accumulation_texel_bytes());
-  set_->write_buffer(gpu::BINDING_ALPHA, accum_, alpha_offset_, accum_.size() - alpha_offset_);
+  const VkDeviceSize alpha_bytes = pixels * sizeof(gpu::AlphaTexel);
+  set_->write_buffer(gpu::BINDING_ALPHA, accum_, alpha_offset_, alpha_bytes);
+  if (settings.aovs) {
+    set_->write_buffer(gpu::BINDING_AOV_LIGHTS, accum_, aov_lights_offset_, pixels * sizeof(gpu::AovLightTexel));
+    set_->write_buffer(gpu::BINDING_AOV_FEATURES, accum_, aov_features_offset_, pixels * sizeof(gpu::AovFeatureTexel));
+  } else {  // compiled out (AOVS false), but every binding needs a buffer
+    set_->write_buffer(gpu::BINDING_AOV_LIGHTS, accum_, alpha_offset_, alpha_bytes);
+    set_->write_buffer(gpu::BINDING_AOV_FEATURES, accum_, alpha_offset_, alpha_bytes);
+  }
   set_->write_buffer(gpu::BINDING_PASS_STATUS, pass_status_);
   set_->write_buffer(gpu::BINDING_GRIDS, grid_buffer_);
   write_grid_descriptors();
@@ -192,6 +213,7 @@ std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const S
           {gpu::SPEC_SURFACE_HAS_TRIANGLES, flag(gpu_surfaces_.triangle_count > 0)},
           {gpu::SPEC_HAS_ENVIRONMENT, flag(scene.environment.has_value())},
           {gpu::SPEC_LIGHT_COUNT, uint32_t(scene.lights.size())},
+          {gpu::SPEC_AOVS, flag(settings.aovs)},
           {gpu::SPEC_LIGHT_STRATEGY, lights.strategy == LightStrategy::Mis         ? gpu::LIGHT_STRATEGY_MIS
                                      : lights.strategy == LightStrategy::LightOnly ? gpu::LIGHT_STRATEGY_LIGHT_ONLY
                                                                                    : gpu::LIGHT_STRATEGY_BSDF},
@@ -527,7 +549,8 @@ void RenderSession::create_wavefront(const std::vector<uint32_t>& code) {
   bool has_lights = false;
   for (const auto& [id, value] : spec_)
     if (id == gpu::SPEC_LIGHT_COUNT) has_lights = value > 0;
-  const bool on = (mode == "1" || mode == "2") && settings_.debug_mode == 0 && !has_lights;
+  // Nor with AOVs: its path state does not carry them.
+  const bool on = (mode == "1" || mode == "2") && settings_.debug_mode == 0 && !has_lights && !settings_.aovs;
   wavefront_split_ = on && mode == "2";
   const size_t slots = on ? size_t(settings_.width) * size_t(settings_.height) : 1;
   const size_t words = gpu::WAVEFRONT_PATH_WORDS + gpu::WAVEFRONT_PATH_WORDS_PER_MEDIUM *
@@ -786,7 +809,37 @@ void RenderSession::load_state(const AccumulationState& st) {
   needs_clear_ = st.spp == 0;
 }
 
-void RenderSession::read(RenderResult& result) { result_from_state(save_state(), result); }
+void RenderSession::read(RenderResult& result) {
+  result_from_state(save_state(), result);
+  read_aovs(result);
+}
+
+void RenderSession::read_aovs(RenderResult& result) {
+  result.aov_sum.clear();
+  if (!settings_.aovs) return;
+  const size_t pixels = size_t(settings_.width) * size_t(settings_.height);
+  result.aov_sum.assign(pixels * kAovValues, 0.0);
+  if (spp_done_ <= 0 || needs_clear_) return;
+  std::vector<gpu::AovLightTexel> lights(pixels);
+  std::vector<gpu::AovFeatureTexel> features(pixels);
+  accum_.download(ctx_, lights.data(), pixels * sizeof(gpu::AovLightTexel), aov_lights_offset_);
+  accum_.download(ctx_, features.data(), pixels * sizeof(gpu::AovFeatureTexel), aov_features_offset_);
+  for (size_t i = 0; i < pixels; ++i) {
+    double* s = result.aov_sum.data() + i * kAovValues;
+    const gpu::AovLightTexel& l = lights[i];
+    const gpu::AovFeatureTexel& f = features[i];
+    for (int c = 0; c < 3; ++c) {
+      s[kAovEmission + c] = l.emission[c];
+      s[kAovScatter + c] = l.scatter[c];
+      s[kAovSurface + c] = l.surface[c];
+      s[kAovBackground + c] = l.background[c];
+      s[kAovAlbedo + c] = f.albedo[c];
+      s[kAovNormal + c] = f.normal[c];
+    }
+    s[kAovDepth] = f.depth;
+    s[kAovHits] = f.hits;
+  }
+}
 
 void RenderSession::result_from_state(const AccumulationState& state, RenderResult& result) {
   const size_t pixels = size_t(state.width) * size_t(state.height);

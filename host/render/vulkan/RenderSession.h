@@ -89,6 +89,9 @@ class RenderSession {
   // same Kahan sums and compensations, so it equals an uninterrupted render.
   AccumulationState save_state();
   void load_state(const AccumulationState& state);
+  // settings.aovs: the AOV sums into result.aov_sum (not part of the saved
+  // state: checkpoints do not carry AOVs). Empty without AOVs.
+  void read_aovs(RenderResult& result);
   // A saved state's sums and counters, as read() would give them.
   static void result_from_state(const AccumulationState& state, RenderResult& result);
   // Warnings from loading the grids (one line each).
@@ -140,6 +143,9 @@ class RenderSession {
   std::vector<std::pair<uint32_t, uint32_t>> spec_;  // the variant pipeline_ was compiled for
   vk::Buffer pass_status_, accum_backup_;  // PassStatus; the accumulation before the pass in flight
   VkDeviceSize alpha_offset_ = 0;          // where accum_'s AlphaTexels start (aligned for their binding)
+  // settings.aovs: where accum_'s AovLightTexels and AovFeatureTexels start
+  // (0: no AOVs, their bindings then show the AlphaTexels, unread).
+  VkDeviceSize aov_lights_offset_ = 0, aov_features_offset_ = 0;
   int max_pass_spp_ = 1 << 30;
   int band_rows_ = 0;  // 0: not measured yet (first_band_rows)
   // Rows for one dispatch of `spp` samples per pixel before anything is measured.

@@ -122,6 +122,7 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
     saved = {};  // (memory: the final readback replaces it)
     AccumulationState final_state = session.save_state();
     RenderSession::result_from_state(final_state, result);
+    session.read_aovs(result);
     result.dropped_samples = session.dropped_samples() - dropped_before;
     if (result.dropped_samples > 0)
       result.warnings.push_back(std::to_string(result.dropped_samples) +

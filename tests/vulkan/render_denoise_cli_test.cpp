@@ -1,0 +1,66 @@
+// `pyrolume render --denoise` and `--aovs` as a user runs them: the raw
+// output stays as asked (no variance or layers unless asked), the denoised
+// image lands next to it as OUT.denoised.EXT, and the AOV layers written to
+// the EXR add up to its RGB.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "image/ImageIo.h"
+#include "support/TestSupport.h"
+
+using namespace pyrolume;
+using namespace pyrolume::test;
+
+namespace {
+const std::string kScene = R"({"film": {"width": 24, "height": 16, "spp": 8},
+  "camera": {"position": [0, -5, 1.5], "look_at": [0, 0, 0.8]},
+  "background": {"rgb": [0.2, 0.3, 0.5]},
+  "shapes": [{"plane": {"center": [0, 0, 0], "normal": [0, 0, 1]}, "material": {"diffuse": {"rgb": [0.6, 0.6, 0.6]}}}],
+  "media": [{"type": "homogeneous", "bounds": {"sphere": {"center": [0, 0, 1], "radius": 0.7}},
+             "sigma_a": [1, 1, 1], "sigma_s": [1, 1, 1], "emission": {"rgb": [2, 1, 0.4]}}]})";
+}  // namespace
+
+TEST(CliRenderDenoise, WritesTheDenoisedImageBesideTheUntouchedRender) {
+  auto dir = temp_dir("clirenderdenoise");
+  write_file(dir / "s.json", kScene);
+  const auto out = dir / "out.exr", denoised = dir / "out.denoised.exr";
+  CliResult r = run_cli("render " + (dir / "s.json").string() + " -o " + out.string() + " --denoise");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find(denoised.string()), std::string::npos) << "says where the denoised image went: " << r.out;
+  const Image raw = read_image(out), clean = read_image(denoised);
+  EXPECT_FALSE(raw.has_variance()) << "--denoise must not add variance to the raw output";
+  EXPECT_FALSE(raw.has_aovs()) << "--denoise must not add layers to the raw output";
+  ASSERT_EQ(clean.width, raw.width);
+  ASSERT_EQ(clean.height, raw.height);
+  // The denoiser averages: the image means agree, the pixel spread shrinks.
+  double m_raw = 0, m_clean = 0;
+  for (size_t i = 0; i < raw.rgb.size(); ++i) {
+    m_raw += raw.rgb[i];
+    m_clean += clean.rgb[i];
+  }
+  EXPECT_NEAR(m_clean / m_raw, 1.0, 0.1);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CliRenderDenoise, AovLayersInTheExrSumToItsRgb) {
+  auto dir = temp_dir("clirenderaovs");
+  write_file(dir / "s.json", kScene);
+  const auto out = dir / "out.exr";
+  CliResult r = run_cli("render " + (dir / "s.json").string() + " -o " + out.string() + " --aovs");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Image img = read_image(out);
+  ASSERT_TRUE(img.has_aovs());
+  double layer_total[4] = {0, 0, 0, 0};
+  for (size_t i = 0; i < img.rgb.size(); ++i) {
+    const double sum = double(img.aovs.emission[i]) + img.aovs.scatter[i] + img.aovs.surface[i] + img.aovs.background[i];
+    EXPECT_NEAR(sum, img.rgb[i], 1e-5 * std::abs(img.rgb[i]) + 1e-7) << "value " << i;
+    layer_total[0] += img.aovs.emission[i];
+    layer_total[1] += img.aovs.scatter[i];
+    layer_total[2] += img.aovs.surface[i];
+    layer_total[3] += img.aovs.background[i];
+  }
+  for (double t : layer_total) EXPECT_GT(t, 0.0);
+  std::filesystem::remove_all(dir);
+}
