@@ -541,7 +541,7 @@ int run_denoise(const DenoiseArgs& a) {
   DenoiseOptions options;
   options.iterations = a.iterations;
   options.sigma_l = a.sigma_l;
-  options.use_features = !a.no_features;
+  options.use_features = a.features;
   options.device_index = a.device;
   const auto t1 = std::chrono::steady_clock::now();
   const Image clean = denoise(noisy, options, input.string());

@@ -54,9 +54,9 @@ int run_compare(const CompareArgs& args);
 // variance (render --variance); OUT is a new file, never IN.
 struct DenoiseArgs {
   std::string input, output;
-  int iterations = 5;
-  float sigma_l = 4.0f;
-  bool no_features = false;
+  int iterations = 1;
+  float sigma_l = 1.5f;
+  bool features = false;
   int device = -1;
 };
 int run_denoise(const DenoiseArgs& args);

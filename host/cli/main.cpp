@@ -123,11 +123,12 @@ int main(int argc, char** argv) {
   auto* denoise = app.add_subcommand("denoise", "Denoise a render (EXR with variance) into a new image");
   denoise->add_option("input", dn.input, "EXR written by render --variance (read only)")->required();
   denoise->add_option("-o,--output", dn.output, "Output image (.exr, or .png)")->required();
-  denoise->add_option("--iterations", dn.iterations, "À-trous iterations (default 5: taps reach ±62 px)")
+  denoise->add_option("--iterations", dn.iterations, "À-trous iterations (default 1; n reach ±(2^(n+1) − 2) px)")
       ->check(CLI::Range(0, 12));
-  denoise->add_option("--sigma-l", dn.sigma_l, "Luminance edge-stopping in noise standard deviations (default 4)")
+  denoise->add_option("--sigma-l", dn.sigma_l, "Luminance edge-stopping, in standard deviations of the noise (default 1.5)")
       ->check(CLI::PositiveNumber);
-  denoise->add_flag("--no-features", dn.no_features, "Ignore the albedo, normal and depth AOVs");
+  denoise->add_flag("--features", dn.features,
+                    "Also stop at edges in the albedo, normal and depth AOVs (off: they measured worse on the fires)");
   denoise->add_option("--device", dn.device, "Vulkan device index")->check(CLI::NonNegativeNumber);
 
   try {

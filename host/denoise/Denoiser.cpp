@@ -55,7 +55,8 @@ Denoiser::Denoiser(vk::Context& ctx)
                  {gpu::DENOISE_BINDING_COLOR_OUT, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                  {gpu::DENOISE_BINDING_VAR_OUT, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                  {gpu::DENOISE_BINDING_NORMAL_DEPTH, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                 {gpu::DENOISE_BINDING_ALBEDO_DZ, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
+                 {gpu::DENOISE_BINDING_ALBEDO_DZ, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                 {gpu::DENOISE_BINDING_VAR_BLURRED, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
                 sizeof(gpu::DenoiseConstants), {}, "denoise") {}
 
 Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std::string& name) {
@@ -100,6 +101,7 @@ Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std
                              vk::Buffer(ctx_, n * sizeof(vec4), usage, kind, "denoise colour 1")};
   vk::Buffer var_buf[2] = {vk::Buffer(ctx_, n * sizeof(float), usage, kind, "denoise variance 0"),
                            vk::Buffer(ctx_, n * sizeof(float), usage, kind, "denoise variance 1")};
+  vk::Buffer var_blurred(ctx_, n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, kind, "denoise blurred variance");
   vk::Buffer nz_buf(ctx_, nz.size() * sizeof(vec4), usage, kind, "denoise normal, depth");
   vk::Buffer alb_buf(ctx_, alb.size() * sizeof(vec4), usage, kind, "denoise albedo, depth gradient");
   color_buf[0].upload(ctx_, color.data(), n * sizeof(vec4));
@@ -117,23 +119,27 @@ Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std
     sets[k].write_buffer(gpu::DENOISE_BINDING_VAR_OUT, var_buf[1 - k]);
     sets[k].write_buffer(gpu::DENOISE_BINDING_NORMAL_DEPTH, nz_buf);
     sets[k].write_buffer(gpu::DENOISE_BINDING_ALBEDO_DZ, alb_buf);
+    sets[k].write_buffer(gpu::DENOISE_BINDING_VAR_BLURRED, var_blurred);
   }
   const uint32_t flags = features ? (gpu::DENOISE_USE_NORMAL_DEPTH | gpu::DENOISE_USE_ALBEDO) : 0u;
   const uint32_t groups_x = (uint32_t(noisy.width) + gpu::DENOISE_WORKGROUP_SIZE - 1) / gpu::DENOISE_WORKGROUP_SIZE;
   const uint32_t groups_y = (uint32_t(noisy.height) + gpu::DENOISE_WORKGROUP_SIZE - 1) / gpu::DENOISE_WORKGROUP_SIZE;
   vk::submit_and_wait(ctx_, [&](VkCommandBuffer cmd) {
     for (int i = 0; i < options.iterations; ++i) {
-      gpu::DenoiseConstants dc{};
-      dc.size_step_flags = gpu::uvec4(uint32_t(noisy.width), uint32_t(noisy.height), 1u << i, flags);
-      dc.sigmas = vec4(options.sigma_l, options.sigma_n, options.sigma_z, options.sigma_a);
       pipeline_.bind(cmd, sets[i % 2].set());
-      pipeline_.push(cmd, dc);
-      vkCmdDispatch(cmd, groups_x, groups_y, 1);
-      // This iteration's output is the next one's input, and the next one
-      // overwrites what this one read.
-      vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT,
-                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                         VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT);
+      // The variance prefilter, then the iteration; each pass's output is
+      // the next one's input, and the next one overwrites what this one read.
+      for (uint32_t pass : {gpu::DENOISE_PASS_PREFILTER, 0u}) {
+        gpu::DenoiseConstants dc{};
+        dc.size_step_flags = gpu::uvec4(uint32_t(noisy.width), uint32_t(noisy.height), 1u << i, flags | pass);
+        dc.sigmas = vec4(options.sigma_l, options.sigma_n, options.sigma_z, options.sigma_a);
+        pipeline_.push(cmd, dc);
+        vkCmdDispatch(cmd, groups_x, groups_y, 1);
+        vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                           VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT,
+                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT);
+      }
     }
   });
   color_buf[options.iterations % 2].download(ctx_, color.data(), n * sizeof(vec4));

@@ -22,10 +22,13 @@ PYRO_CONST uint DENOISE_BINDING_VAR_OUT = 3;    // writeonly float[]
 // up to 3840×2160.
 PYRO_CONST uint DENOISE_BINDING_NORMAL_DEPTH = 4;  // readonly vec4[]: normal (0 in media and misses), depth
 PYRO_CONST uint DENOISE_BINDING_ALBEDO_DZ = 5;     // readonly vec4[]: albedo RGB; w: |∇depth| (larger central difference)
+PYRO_CONST uint DENOISE_BINDING_VAR_BLURRED = 6;   // float[]: the 3×3 Gaussian of VAR_IN (the prefilter pass writes it)
 
 // Which features denoise.comp uses (DenoiseConstants::flags).
 PYRO_CONST uint DENOISE_USE_NORMAL_DEPTH = 1;
 PYRO_CONST uint DENOISE_USE_ALBEDO = 2;
+// The pass before each iteration: blur VAR_IN into VAR_BLURRED, nothing else.
+PYRO_CONST uint DENOISE_PASS_PREFILTER = 4;
 
 // Push constants of one à-trous iteration.
 struct DenoiseConstants {
