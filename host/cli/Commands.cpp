@@ -58,14 +58,13 @@ std::filesystem::path denoised_path(const std::filesystem::path& output) {
   return p;
 }
 
-// Whether the render accumulates AOVs: asked for, or read by --denoise
-// (which goes without them when checkpoints are on: they carry no AOVs).
-bool render_aovs(const RenderArgs& args, const Scene& scene) {
-  return args.aovs || scene.film.aovs || (args.denoise && !args.resume && args.checkpoint <= 0.0);
-}
+// Whether the render accumulates AOVs: when asked for. (--denoise does not
+// need them: the denoiser's default reads beauty and variance only, which
+// measured better than with the features; docs/benchmarks.md "Denoiser".)
+bool render_aovs(const RenderArgs& args, const Scene& scene) { return args.aovs || scene.film.aovs; }
 
-// The image as the user asked for it (render --denoise computes variance and
-// features for the denoiser; the raw output keeps only what was asked).
+// The image as the user asked for it (render --denoise computes variance for
+// the denoiser; the raw output keeps only what was asked).
 Image requested_image(Image image, const RenderArgs& args, const Scene& scene) {
   if (!args.variance) image.variance.clear();
   if (!args.aovs && !scene.film.aovs) image.aovs = Aovs{};
@@ -452,8 +451,7 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
       OutputCommit one;
       const double seconds = write_denoised(file, full, stops, scene.film.view);
       one.commit();
-      std::cout << file.string() << ": denoised " << (full.has_aovs() ? "with albedo, normal, depth" : "with beauty and variance only")
-                << ", " << format_seconds(seconds) << " s" << std::endl;
+      std::cout << file.string() << ": denoised, " << format_seconds(seconds) << " s" << std::endl;
     }
     if (result.spp >= settings.spp)  // a finished render: one the user will look at
       if (const std::string w = film_look_warning(image, stops, scene.film.view, ext == ".png"); !w.empty())

@@ -14,8 +14,8 @@ struct RenderArgs {
   bool variance = false;
   // EXR: the light layers and first-hit features (film.aovs; docs/compositing.md "AOVs").
   bool aovs = false;
-  // Also write OUT.denoised.EXT (docs/compositing.md "Denoiser"); the render
-  // then accumulates the features it reads (AOVs) unless checkpoints are on.
+  // Also write OUT.denoised.EXT (docs/compositing.md "Denoiser"), from the
+  // beauty and its variance (computed for it whether or not --variance is given).
   bool denoise = false;
   int device = -1;
   // Sequences (docs/animation.md): "A-B[:step]"; output and stats are then
