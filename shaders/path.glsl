@@ -82,7 +82,7 @@ bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, 
       p.L += seen;
       if (AOVS && p.depth == 0u) {
         p.L_direct = seen;
-        set_features(p, vec3(0.0), normalize(analytic_lights[p.hit.primitive].position - x_light), x_light);
+        set_features(p, vec3(0.0), normalize(x_light - analytic_lights[p.hit.primitive].position), x_light);
       }
     }
     return ray_ends(p);

@@ -13,6 +13,7 @@
 #include "render/RenderImage.h"
 #include "support/AnalyticScenes.h"
 #include "support/BackendSuite.h"
+#include "support/LightScenes.h"
 #include "support/SurfaceScenes.h"
 
 namespace pyrolume::test {
@@ -138,6 +139,25 @@ TEST_P(Aovs, FeaturesAreThoseOfTheFirstHit) {
     }
   EXPECT_GT(plane_pixels, 100);
   EXPECT_GT(medium_pixels, 10);
+}
+
+// A sphere light seen directly: albedo 0, its outward normal (toward the
+// camera that sees it), the distance to its surface.
+TEST_P(Aovs, SphereLightFeaturesAreItsOutwardNormalAndDistance) {
+  Scene s = analytic_base_scene(16, 16, 4);
+  s.film.aovs = true;
+  s.camera.position = {0.0, 0.0, 5.0};
+  s.camera.look_at = {0.0, 0.0, 0.0};
+  s.camera.fov_deg = 10.0;  // the light fills the view
+  s.lights.push_back(sphere_light({0.0, 0.0, 0.0}, 1.0, glm::dvec3(2.0)));
+  const RenderResult r = render(s);
+  const Image img = image_from_render(r, false);
+  ASSERT_TRUE(img.has_aovs());
+  const size_t p = size_t(8) * r.width + 8;  // next to the view's centre
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(img.aovs.albedo[p * 3 + c], 0.0, 1e-6);
+  EXPECT_GT(img.aovs.normal[p * 3 + 2], 0.99) << "the normal faces the camera (+Z)";
+  EXPECT_NEAR(img.aovs.depth[p], 4.0, 0.01);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(img.aovs.background[p * 3 + c], img.rgb[p * 3 + c], 1e-5);
 }
 
 // Without film.aovs nothing is accumulated.
