@@ -10,12 +10,16 @@ void kahan_add(inout vec3 s, inout vec3 c, vec3 x) {
   s = t;
 }
 
+// Whether a sample's radiance is recorded as it is: NaN, Inf and beyond
+// MAX_SAMPLE_RADIANCE fail the comparison (add_sample records 0 instead).
+bool recorded_radiance(vec3 L) { return all(lessThanEqual(abs(L), vec3(MAX_SAMPLE_RADIANCE))); }
+
 // One sample's radiance and alpha into the pass's sums (NaN and Inf fail the
 // comparison too: counted, and recorded as 0; alpha as 1). The pass's alpha
 // sums (Σα, Σα²) are plain: α is at most ~1 and a pass is short.
 void add_sample(vec3 L, float alpha, inout vec3 pass_sum, inout vec3 pass_sum_c, inout vec3 pass_sq,
                 inout vec3 pass_sq_c, inout vec2 pass_alpha, inout float nonfinite) {
-  if (!all(lessThanEqual(abs(L), vec3(MAX_SAMPLE_RADIANCE)))) {
+  if (!recorded_radiance(L)) {
     nonfinite += 1.0;
     L = vec3(0.0);
   }
@@ -66,7 +70,7 @@ AovSums no_aovs() { return AovSums(vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), v
 // background (L_direct), so they add up to p.L; a sample that add_sample
 // records as 0 (not finite) adds 0 to every layer.
 void add_sample_aovs(inout PathState p, inout AovSums a) {
-  if (all(lessThanEqual(abs(p.L), vec3(MAX_SAMPLE_RADIANCE)))) {
+  if (recorded_radiance(p.L)) {
     const vec3 before = p.first_vertex == AOV_VERTEX_NONE ? p.L : p.L_first;
     a.emission += before - p.L_direct;
     a.background += p.L_direct;

@@ -67,7 +67,7 @@ bool render_aovs(const RenderArgs& args, const Scene& scene) { return args.aovs 
 // the denoiser; the raw output keeps only what was asked).
 Image requested_image(Image image, const RenderArgs& args, const Scene& scene) {
   if (!args.variance) image.variance.clear();
-  if (!args.aovs && !scene.film.aovs) image.aovs = Aovs{};
+  if (!render_aovs(args, scene)) image.aovs = Aovs{};
   return image;
 }
 
@@ -351,14 +351,12 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   if (scene.film.aovs && ext != ".exr")
     throw input_error(scene.file.string(), "film.aovs", "needs an .exr output (PNG has no layers), not " + output.string());
   // Checkpoints carry the beauty and alpha, not the AOVs (docs/checkpoints.md).
-  const bool aovs = args.aovs || scene.film.aovs;
-  if (aovs && args.resume)
-    throw input_error("--resume", "", std::string("checkpoints do not carry AOVs (") +
-                                          (args.aovs ? "--aovs" : scene.file.string() + ": film.aovs") +
-                                          "): render again without --resume");
-  if (aovs && args.checkpoint > 0.0)
-    throw input_error("--checkpoint", "", std::string("checkpoints do not carry AOVs (") +
-                                              (args.aovs ? "--aovs" : scene.file.string() + ": film.aovs") + ")");
+  if (render_aovs(args, scene)) {
+    const std::string no_aovs =
+        "checkpoints do not carry AOVs (" + (args.aovs ? std::string("--aovs") : scene.file.string() + ": film.aovs") + ")";
+    if (args.resume) throw input_error("--resume", "", no_aovs + ": render again without --resume");
+    if (args.checkpoint > 0.0) throw input_error("--checkpoint", "", no_aovs);
+  }
 
   if (sequence) return run_sequence(args, scene, output, cancel, remarks);
 

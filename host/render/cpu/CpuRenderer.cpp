@@ -732,8 +732,9 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
 
 // film.aovs: one sample's three channel walks into a pixel's AOV sums
 // (RenderResult::aov_sum's layout). L is the sample; recorded is false when
-// it was not finite and was recorded as 0: then every layer adds 0. Each channel's walk is its own
-// path, so each channel splits at its own first vertex. The features are
+// it was not finite and was recorded as 0: then every layer adds 0. Each
+// channel's walk is its own path, so each channel splits at its own first
+// vertex. The features are
 // averaged over the channel walks that have a first event: hits counts them
 // in thirds (for surfaces and grey media every channel has the same chance).
 void add_sample_aovs(const glm::dvec3& L, bool recorded, const WalkAov aov[3], double* sum) {
