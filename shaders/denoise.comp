@@ -26,7 +26,8 @@
 layout(local_size_x = DENOISE_WORKGROUP_SIZE, local_size_y = DENOISE_WORKGROUP_SIZE) in;
 
 // Storage buffers: the taps are neighbours, so these gathers stay in cache
-// (/work/shared/LAVAPIPE.md's slow SSBO case is random gathers through a volume).
+// (on lavapipe storage-buffer loads are slow when they gather at random, as
+// lookups through a volume do, not for neighbouring pixels).
 layout(std430, set = 0, binding = DENOISE_BINDING_COLOR_IN) readonly buffer ColorIn { vec4 color_in[]; };
 layout(std430, set = 0, binding = DENOISE_BINDING_VAR_IN) readonly buffer VarIn { float var_in[]; };
 layout(std430, set = 0, binding = DENOISE_BINDING_COLOR_OUT) writeonly buffer ColorOut { vec4 color_out[]; };
