@@ -5,10 +5,11 @@ set -euo pipefail
 PYROLUME_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 PYROLUME_BUILD="${PYROLUME_BUILD:-$PYROLUME_ROOT/build}"
 
-# Build tools (clang + compiler-rt: the sanitizer and libFuzzer build), Vulkan (loader, headers, lavapipe, validation layers, glslang),
+# Build tools (clang + compiler-rt: the sanitizer and libFuzzer build; lld: links
+# in a third of GNU ld's time), Vulkan (loader, headers, lavapipe, validation layers, glslang),
 # and the libraries the host uses.
 PYROLUME_PACKAGES=(
-  build-essential cmake ninja-build pkg-config
+  build-essential cmake ninja-build pkg-config lld
   libvulkan-dev mesa-vulkan-drivers vulkan-tools vulkan-validationlayers glslang-tools
   libopenvdb-dev libboost-iostreams-dev libnanovdb-dev libtbb-dev
   libglfw3-dev xvfb xauth python3 python3-matplotlib libtinyobjloader-dev
