@@ -207,10 +207,14 @@ inline void expect_cli_sigterm_saves(const std::string& backend) {
 // A pathologically dense medium: a grid whose one hot voxel (1e7 per unit)
 // sets a global majorant that every ray through it steps at, while the rest
 // is nearly empty (1e-3), so a ray crossing it takes ~3e7 null collisions and
-// a pass never ends on its own. SIGTERM ~1 s in must end the render within
-// 2 s (cancellation inside passes: the CPU polls its tracking loops, the GPU
-// dispatches bands that finish well under a second), exit 143, and leave
-// either nothing (no pass finished) or a whole image of the passes that did.
+// a pass never ends on its own (hours). SIGTERM ~1 s in must end the render
+// within 6 s (cancellation inside passes: the CPU polls its tracking loops,
+// the GPU dispatches bands that finish well under a second on an idle
+// machine), exit 143, and leave either nothing (no pass finished) or a whole
+// image of the passes that did. The bound is far below a pass and far above
+// a band: with 2 s, a CI run under ctest -j2 with lavapipe's threads on 2
+// cores answered in 2.05 s; a render that waited for its pass would still be
+// running at the 20-s watchdog.
 inline void expect_sigterm_ends_a_pathological_pass(const std::string& backend) {
   auto dir = temp_dir("cli-dense-" + backend);
   write_vdb(dir / "dense.vdb", {make_float_grid("density", Lattice{0.25}, VoxelBox{{0, 0, 0}, {7, 7, 7}},
@@ -227,10 +231,10 @@ inline void expect_sigterm_ends_a_pathological_pass(const std::string& backend) 
   ASSERT_EQ(waitpid(p.pid, &raw, WNOHANG), 0) << "the render ended on its own: " << read_file(p.err);
   const auto t0 = std::chrono::steady_clock::now();
   kill(p.pid, SIGTERM);
-  // Waits at most 10 s, then kills it, so a regression fails instead of hanging.
+  // Waits at most 20 s, then kills it, so a regression fails instead of hanging.
   for (;;) {
     if (waitpid(p.pid, &raw, WNOHANG) == p.pid) break;
-    if (std::chrono::steady_clock::now() - t0 > std::chrono::seconds(10)) {
+    if (std::chrono::steady_clock::now() - t0 > std::chrono::seconds(20)) {
       kill(p.pid, SIGKILL);
       waitpid(p.pid, &raw, 0);
       break;
@@ -239,7 +243,7 @@ inline void expect_sigterm_ends_a_pathological_pass(const std::string& backend) 
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("%s: SIGTERM answered in %.3f s\n", backend.c_str(), seconds);
-  EXPECT_LT(seconds, 2.0) << read_file(p.err);
+  EXPECT_LT(seconds, 6.0) << read_file(p.err);
   EXPECT_EQ(exit_status_of(raw), 143) << read_file(p.err);
   const std::string err = read_file(p.err);
   if (std::filesystem::exists(out)) {
