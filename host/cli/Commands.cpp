@@ -72,10 +72,12 @@ Image requested_image(Image image, const RenderArgs& args, const Scene& scene) {
 }
 
 // render --denoise: the denoised image, through the same display transform
-// as OUT when it is a PNG. Returns the seconds the filter took.
-double write_denoised(const std::filesystem::path& file, const Image& image, double stops, ViewTransform view) {
+// as OUT when it is a PNG. Returns the seconds the filter took (the first
+// call also starts the session's device).
+double write_denoised(const std::filesystem::path& file, const Image& image, double stops, ViewTransform view,
+                      DenoiserSession& denoiser) {
   const auto t0 = std::chrono::steady_clock::now();
-  const Image clean = denoise(image, DenoiseOptions{}, file.string());
+  const Image clean = denoiser.run(image, DenoiseOptions{}, file.string());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_image(file, clean, stops, view);
   return seconds;
@@ -234,6 +236,7 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
   DisplayExposure exposure(parse_exposure(args.exposure));
   const std::string ext = lower_extension(output);
   bool look_warned = false;
+  DenoiserSession denoiser;  // --denoise: one device for the whole sequence
   int rendered = 0, skipped = 0, missing = 0;
   double load_seconds = 0.0, render_seconds = 0.0;
   for (int frame : range) {
@@ -289,7 +292,7 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
       OutputCommit both;  // the image and its stats (and the denoised image), or none
       write_image(out.image, image, stops, frame_scene.film.view);
       if (!out.stats.empty()) write_stats(out.stats, args, out.image, result, frame);
-      if (!out.denoised.empty()) write_denoised(out.denoised, full, stops, frame_scene.film.view);
+      if (!out.denoised.empty()) write_denoised(out.denoised, full, stops, frame_scene.film.view, denoiser);
       both.commit();
     }
     print_warnings(result, tag);
@@ -447,7 +450,8 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
     if (args.denoise && result.spp > 0) {  // after the raw image is safe: a failure here loses nothing
       const std::filesystem::path file = denoised_path(output);
       OutputCommit one;
-      const double seconds = write_denoised(file, full, stops, scene.film.view);
+      DenoiserSession denoiser;
+      const double seconds = write_denoised(file, full, stops, scene.film.view, denoiser);
       one.commit();
       std::cout << file.string() << ": denoised, " << format_seconds(seconds) << " s" << std::endl;
     }

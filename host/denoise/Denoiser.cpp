@@ -156,12 +156,18 @@ Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std
   return out;
 }
 
+Image DenoiserSession::run(const Image& noisy, const DenoiseOptions& options, const std::string& name) {
+  if (!denoiser_) {
+    vk::Context::Options o;
+    o.device_index = device_index_;
+    ctx_ = std::make_unique<vk::Context>(o);
+    denoiser_ = std::make_unique<Denoiser>(*ctx_);
+  }
+  return denoiser_->run(noisy, options, name);
+}
+
 Image denoise(const Image& noisy, const DenoiseOptions& options, const std::string& name) {
-  vk::Context::Options o;
-  o.device_index = options.device_index;
-  vk::Context ctx(o);
-  Denoiser d(ctx);
-  return d.run(noisy, options, name);
+  return DenoiserSession(options.device_index).run(noisy, options, name);
 }
 
 }  // namespace pyrolume

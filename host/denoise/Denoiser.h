@@ -4,6 +4,7 @@
 // (shaders/denoise.comp) on the Vulkan device the renderer uses. It reads the
 // beauty, its variance of the mean and, when present, the albedo, normal and
 // depth AOVs (docs/compositing.md "Denoiser").
+#include <memory>
 #include <string>
 
 #include "image/Image.h"
@@ -51,7 +52,21 @@ class Denoiser {
   vk::ComputePipeline pipeline_;
 };
 
-// A Denoiser on a context of its own (options.device_index).
+// A Denoiser on a context of its own, opened at the first run() and kept: a
+// frame sequence (render --denoise --frames) starts the Vulkan device and
+// builds the pipeline once, not once per frame.
+class DenoiserSession {
+ public:
+  explicit DenoiserSession(int device_index = -1) : device_index_(device_index) {}
+  Image run(const Image& noisy, const DenoiseOptions& options, const std::string& name = "image");
+
+ private:
+  int device_index_;
+  std::unique_ptr<vk::Context> ctx_;
+  std::unique_ptr<Denoiser> denoiser_;
+};
+
+// One image: a DenoiserSession on options.device_index.
 Image denoise(const Image& noisy, const DenoiseOptions& options = {}, const std::string& name = "image");
 
 }  // namespace pyrolume

@@ -183,6 +183,25 @@ TEST_P(Sequence, SkipExistingRendersNothingTheSecondTimeAndResumes) {
 
 INSTANTIATE_TEST_SUITE_P(Backends, Sequence, ::testing::Values("vulkan", "cpu"));
 
+// --denoise over a sequence keeps one denoiser (device and pipeline) for all
+// frames: each frame's denoised image must still be exactly what
+// `pyrolume denoise`, starting afresh, makes of that frame's render.
+TEST(SequenceCli, DenoisedFramesMatchDenoisingEachFrameAlone) {
+  fs::path dir = scene_with_frames("seq-denoise", {1, 2, 3});
+  CliResult r = run_cli("render " + q(dir / "seq.json") + " --frames 1-3 --variance --denoise -o " +
+                        q(dir / "out_####.exr"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (int f : {1, 2, 3}) {
+    const std::string n = "000" + std::to_string(f);
+    ASSERT_TRUE(fs::exists(dir / ("out_" + n + ".denoised.exr"))) << f;
+    CliResult a = run_cli("denoise " + q(dir / ("out_" + n + ".exr")) + " -o " + q(dir / ("alone_" + n + ".exr")));
+    ASSERT_EQ(a.status, 0) << a.err;
+    EXPECT_TRUE(same_pixels(dir / ("alone_" + n + ".exr"), dir / ("out_" + n + ".denoised.exr"))) << "frame " << f;
+  }
+  EXPECT_FALSE(same_pixels(dir / "out_0001.denoised.exr", dir / "out_0003.denoised.exr"));
+  fs::remove_all(dir);
+}
+
 TEST(SequenceCli, BadInputExitsTwoWithAClearMessage) {
   fs::path dir = scene_with_frames("seq-bad", {1});
   const std::string scene = q(dir / "seq.json");
