@@ -159,7 +159,7 @@ Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std
 Image DenoiserSession::run(const Image& noisy, const DenoiseOptions& options, const std::string& name) {
   if (!denoiser_) {
     vk::Context::Options o;
-    o.device_index = device_index_;
+    o.device_index = options.device_index;
     ctx_ = std::make_unique<vk::Context>(o);
     denoiser_ = std::make_unique<Denoiser>(*ctx_);
   }
@@ -167,7 +167,7 @@ Image DenoiserSession::run(const Image& noisy, const DenoiseOptions& options, co
 }
 
 Image denoise(const Image& noisy, const DenoiseOptions& options, const std::string& name) {
-  return DenoiserSession(options.device_index).run(noisy, options, name);
+  return DenoiserSession().run(noisy, options, name);
 }
 
 }  // namespace pyrolume

@@ -52,21 +52,20 @@ class Denoiser {
   vk::ComputePipeline pipeline_;
 };
 
-// A Denoiser on a context of its own, opened at the first run() and kept: a
-// frame sequence (render --denoise --frames) starts the Vulkan device and
-// builds the pipeline once, not once per frame.
+// A Denoiser on a context of its own, opened at the first run() on that
+// run's options.device_index and kept: a frame sequence (render --denoise
+// --frames) starts the Vulkan device and builds the pipeline once, not once
+// per frame.
 class DenoiserSession {
  public:
-  explicit DenoiserSession(int device_index = -1) : device_index_(device_index) {}
   Image run(const Image& noisy, const DenoiseOptions& options, const std::string& name = "image");
 
  private:
-  int device_index_;
   std::unique_ptr<vk::Context> ctx_;
   std::unique_ptr<Denoiser> denoiser_;
 };
 
-// One image: a DenoiserSession on options.device_index.
+// One image, on a DenoiserSession of its own.
 Image denoise(const Image& noisy, const DenoiseOptions& options = {}, const std::string& name = "image");
 
 }  // namespace pyrolume
