@@ -61,9 +61,26 @@ struct AovSums {
   vec3 emission, scatter, surface, background;
   vec3 albedo, normal;
   float depth, hits;
+  vec3 guide;
+  float guide_alpha;
 };
 
-AovSums no_aovs() { return AovSums(vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0.0); }
+AovSums no_aovs() {
+  return AovSums(vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0.0, vec3(0.0), 0.0);
+}
+
+// Sample k's guide (guide.glsl) into the sums: its ray goes through the
+// k-th point of the R2 sequence in the pixel (Roberts 2018, from the plastic
+// number: x_k = frac(0.5 + k·(1/g, 1/g²)), g³ = g + 1), not through the
+// sample's random one, so that the guide's average over the pixel's samples
+// is a well-spread quadrature of the pixel, whatever the spp.
+void add_sample_guide(uvec2 pixel, uint k, inout AovSums a) {
+  const vec2 r2 = fract(vec2(0.5) + float(k) * vec2(0.7548776662466927, 0.5698402909980532));
+  vec3 L, T;
+  guide_march(frame.camera_position, camera_direction(pixel, r2), L, T);
+  a.guide += L;
+  a.guide_alpha += 1.0 - avg3(T);
+}
 
 // One finished sample into the pass's AOV sums. The layers split p.L at the
 // path's first vertex (L_first) and take out what the camera ray saw of the
@@ -98,5 +115,7 @@ void add_pass_aovs(uint pixel_index, AovSums a) {
   f.normal += a.normal;
   f.depth += a.depth;
   f.hits += a.hits;
+  f.guide += a.guide;
+  f.guide_alpha += a.guide_alpha;
   aov_features[pixel_index] = f;
 }

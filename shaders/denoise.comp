@@ -35,6 +35,7 @@ layout(std430, set = 0, binding = DENOISE_BINDING_VAR_OUT) writeonly buffer VarO
 layout(std430, set = 0, binding = DENOISE_BINDING_NORMAL_DEPTH) readonly buffer NormalDepth { vec4 normal_depth[]; };
 layout(std430, set = 0, binding = DENOISE_BINDING_ALBEDO_DZ) readonly buffer AlbedoDz { vec4 albedo_dz[]; };
 layout(std430, set = 0, binding = DENOISE_BINDING_VAR_BLURRED) buffer VarBlurred { float var_blurred[]; };
+layout(std430, set = 0, binding = DENOISE_BINDING_GUIDE) readonly buffer Guide { vec4 guide[]; };
 layout(push_constant) uniform DenoiseBlock { DenoiseConstants dc; };
 
 // Rec. 709 / linear sRGB luminance, the l of the edge-stopping function.
@@ -53,6 +54,25 @@ void main() {
   const float sigma_l = dc.sigmas.x, sigma_n = dc.sigmas.y, sigma_z = dc.sigmas.z, sigma_a = dc.sigmas.w;
   const int ip = p.y * size.x + p.x;
 
+
+  if ((flags & DENOISE_PASS_BLUR) != 0u) {
+    // The ratio estimator's window (host/denoise/Denoiser.cpp): a plain
+    // Gaussian, separable, with the taps that fall outside the image left out.
+    const float s = dc.guide_sigmas.w;
+    const int r = int(ceil(2.0 * s));
+    const ivec2 axis = step == 1 ? ivec2(1, 0) : ivec2(0, 1);
+    vec4 sum = vec4(0.0);
+    float wsum = 0.0;
+    for (int j = -r; j <= r; ++j) {
+      const ivec2 q = p + j * axis;
+      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
+      const float w = exp(-0.5 * float(j * j) / (s * s));
+      sum += w * color_in[q.y * size.x + q.x];
+      wsum += w;
+    }
+    color_out[ip] = sum / wsum;
+    return;
+  }
 
   if ((flags & DENOISE_PASS_PREFILTER) != 0u) {
     // SVGF eq. 5: the luminance variance under a 3×3 Gaussian, so that one
@@ -75,8 +95,11 @@ void main() {
   const float var_p = var_blurred[ip];
 
   const bool use_nz = (flags & DENOISE_USE_NORMAL_DEPTH) != 0u, use_a = (flags & DENOISE_USE_ALBEDO) != 0u;
-  vec4 nz_p = vec4(0.0), a_p = vec4(0.0);
+  const bool use_guide = (flags & DENOISE_USE_GUIDE) != 0u, guided_features = (flags & DENOISE_GUIDED_FEATURES) != 0u;
+  vec4 nz_p = vec4(0.0), a_p = vec4(0.0), g_p = vec4(0.0);
   if (use_nz || use_a) nz_p = normal_depth[ip], a_p = albedo_dz[ip];
+  if (use_guide) g_p = guide[ip];
+  const float guide_l_p = luminance(g_p.rgb);
   const bool surface_p = use_nz && on_surface(nz_p.xyz);
 
   // B3 spline (1/16, 1/4, 3/8, 1/4, 1/16) scaled to 1 at the centre; the
@@ -100,14 +123,26 @@ void main() {
           // depth is a random free-flight distance, not a feature.
           const vec4 nz_q = normal_depth[iq];
           const bool surface_q = on_surface(nz_q.xyz);
-          if (surface_p && surface_q) {
+          if (surface_p && surface_q && guided_features) {
+            wn = pow(max(0.0, dot(normalize(nz_p.xyz), normalize(nz_q.xyz))), sigma_n);
+            e += abs(nz_p.w - nz_q.w) / (sigma_z * (nz_p.w + nz_q.w) + 1e-6);
+          } else if (surface_p && surface_q) {
             wn = pow(max(0.0, dot(nz_p.xyz, nz_q.xyz)), sigma_n);  // SVGF eq. 3
             e += abs(nz_p.w - nz_q.w) / (sigma_z * a_p.w * float(step) * length(vec2(xx, yy)) + 1e-3);  // SVGF eq. 2
           } else if (surface_p != surface_q) {
             wn = 0.0;  // a surface's silhouette against a medium or the background
           }
         }
-        if (use_a) e += length(a_p.rgb - albedo_dz[iq].rgb) / sigma_a;
+        if (use_a && (!guided_features || (surface_p && on_surface(normal_depth[iq].xyz))))
+          e += length(a_p.rgb - albedo_dz[iq].rgb) / sigma_a;
+      }
+      if (use_guide) {
+        // The guide's relative difference, with a floor τ_g where it is dark,
+        // and its alpha's difference.
+        const vec4 g_q = guide[iq];
+        const float guide_l_q = luminance(g_q.rgb);
+        e += abs(guide_l_p - guide_l_q) / (dc.guide_sigmas.x * (guide_l_p + guide_l_q) + dc.guide_sigmas.y) +
+             abs(g_p.a - g_q.a) / dc.guide_sigmas.z;
       }
       const float w = h[abs(xx)] * h[abs(yy)] * wn * exp(-e);
       sum_c += w * cq;

@@ -117,18 +117,22 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
 // Start p as a camera ray through pixel `pixel` for sample `k`, with that
 // sample's random stream (p is filled in place: PathState holds arrays sized
 // by a specialisation constant, which GLSL cannot copy).
+// The camera ray's direction through film point pixel + jitter (jitter in [0,1)²).
+vec3 camera_direction(uvec2 pixel, vec2 jitter) {
+  vec2 ndc = vec2(2.0 * (float(pixel.x) + jitter.x) / float(frame.width) - 1.0,
+                  1.0 - 2.0 * (float(pixel.y) + jitter.y) / float(frame.height));
+  float tan_half = frame.tan_half_fov, aspect = frame.aspect;
+  return normalize(frame.camera_forward + ndc.x * tan_half * aspect * frame.camera_right +
+                   ndc.y * tan_half * frame.camera_up);
+}
+
 void camera_path(uvec2 pixel, uint k, out uint rng, inout PathState p) {
   uint width = frame.width, height = frame.height;
   rng = rng_init(frame.seed, frame.frame_index, pixel.y * width + pixel.x, k);
   // Box filter: jitter uniformly inside the pixel; pixel (0,0) is top-left.
   vec2 jitter = vec2(rng_next(rng), rng_next(rng));
-  vec2 ndc = vec2(2.0 * (float(pixel.x) + jitter.x) / float(width) - 1.0,
-                  1.0 - 2.0 * (float(pixel.y) + jitter.y) / float(height));
-  float tan_half = frame.tan_half_fov, aspect = frame.aspect;
-  vec3 d = normalize(frame.camera_forward + ndc.x * tan_half * aspect * frame.camera_right +
-                     ndc.y * tan_half * frame.camera_up);
   p.o = frame.camera_position;
-  p.d = d;
+  p.d = camera_direction(pixel, jitter);
   p.w = vec3(1.0);
   p.L = vec3(0.0);
   p.alpha = 1.0;

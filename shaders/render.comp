@@ -24,6 +24,7 @@ layout(local_size_x = WORKGROUP_SIZE_X, local_size_y = WORKGROUP_SIZE_Y) in;
 #include "vertex.glsl"
 #include "tracking.glsl"
 #include "path.glsl"
+#include "guide.glsl"
 #include "accumulation.glsl"
 
 #include "wavefront.glsl"
@@ -70,13 +71,17 @@ void main() {
     uint rng;
     PathState p;
     camera_path(pixel, k, rng, p);
+    if (AOVS) add_sample_guide(pixel, k, aovs);
     vec2 span[MEDIA_N];
     while (k < last) {
       for (uint n = 0u; n < 16384u && k < last; ++n) {
         if (!path_step(p, span, rng, stats)) continue;
         add_sample(p.L, p.alpha, pass_sum, pass_sum_c, pass_sq, pass_sq_c, pass_alpha, nonfinite);
         if (AOVS) add_sample_aovs(p, aovs);
-        if (++k < last) camera_path(pixel, k, rng, p);
+        if (++k < last) {
+          camera_path(pixel, k, rng, p);
+          if (AOVS) add_sample_guide(pixel, k, aovs);
+        }
       }
     }
   }

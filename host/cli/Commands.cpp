@@ -58,10 +58,16 @@ std::filesystem::path denoised_path(const std::filesystem::path& output) {
   return p;
 }
 
-// Whether the render accumulates AOVs: when asked for. (--denoise does not
-// need them: the denoiser's default reads beauty and variance only, which
-// measured better than with the features; docs/benchmarks.md "Denoiser".)
+// Whether the user asked for AOVs in the output.
 bool render_aovs(const RenderArgs& args, const Scene& scene) { return args.aovs || scene.film.aovs; }
+
+// Whether the render accumulates them: when asked for, and for --denoise,
+// whose guided filter reads the layers, features and guide (docs/compositing.md
+// "Denoiser"), except with checkpoints, which do not carry AOVs: a render
+// that keeps or resumes one is denoised from its beauty and variance alone.
+bool accumulate_aovs(const RenderArgs& args, const Scene& scene) {
+  return render_aovs(args, scene) || (args.denoise && args.checkpoint <= 0.0 && !args.resume);
+}
 
 // The image as the user asked for it (render --denoise computes variance for
 // the denoiser; the raw output keeps only what was asked).
@@ -156,7 +162,7 @@ RenderSettings settings_from(const RenderArgs& args, const Scene& scene) {
   settings.spp = args.spp.value_or(scene.film.spp);
   settings.seed = args.seed.value_or(scene.film.seed);
   settings.time_limit = args.time_limit;
-  settings.aovs = render_aovs(args, scene);
+  settings.aovs = accumulate_aovs(args, scene);
   return settings;
 }
 
@@ -459,7 +465,9 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
       if (const std::string w = film_look_warning(image, stops, scene.film.view, ext == ".png"); !w.empty())
         std::cerr << "pyrolume: warning: " << output.string() << ": " << w << "\n";
     bool checkpointed = false;
-    if (result.spp < settings.spp && keep_checkpoint && !settings.aovs && !result.state.data.empty())
+    // The beauty's checkpoint also when --denoise accumulated AOVs for its
+    // guide: a resumed render is denoised without them (accumulate_aovs).
+    if (result.spp < settings.spp && keep_checkpoint && !render_aovs(args, scene) && !result.state.data.empty())
       checkpointed = save_checkpoint(result.state);
     if (result.spp >= settings.spp) {
       std::error_code ec;

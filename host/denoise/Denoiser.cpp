@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <stdexcept>
 #include <vector>
 
@@ -56,8 +57,75 @@ Denoiser::Denoiser(vk::Context& ctx)
                  {gpu::DENOISE_BINDING_VAR_OUT, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                  {gpu::DENOISE_BINDING_NORMAL_DEPTH, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                  {gpu::DENOISE_BINDING_ALBEDO_DZ, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                 {gpu::DENOISE_BINDING_VAR_BLURRED, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
+                 {gpu::DENOISE_BINDING_VAR_BLURRED, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                 {gpu::DENOISE_BINDING_GUIDE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
                 sizeof(gpu::DenoiseConstants), {}, "denoise") {}
+
+std::vector<vec4> Denoiser::filter(int width, int height, const std::vector<vec4>& color, const std::vector<float>& var,
+                                   const Features& f, const Pass& pass) {
+  const size_t n = size_t(width) * size_t(height);
+  const VkBufferUsageFlags usage =
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+  const auto kind = vk::MemoryKind::DeviceLocal;
+  vk::Buffer color_buf[2] = {vk::Buffer(ctx_, n * sizeof(vec4), usage, kind, "denoise colour 0"),
+                             vk::Buffer(ctx_, n * sizeof(vec4), usage, kind, "denoise colour 1")};
+  vk::Buffer var_buf[2] = {vk::Buffer(ctx_, n * sizeof(float), usage, kind, "denoise variance 0"),
+                           vk::Buffer(ctx_, n * sizeof(float), usage, kind, "denoise variance 1")};
+  vk::Buffer var_blurred(ctx_, n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, kind, "denoise blurred variance");
+  const vec4 none(0.0f);
+  auto upload = [&](const std::vector<vec4>& v, const char* what) {
+    vk::Buffer b(ctx_, std::max<size_t>(v.size(), 1) * sizeof(vec4), usage, kind, what);
+    b.upload(ctx_, v.empty() ? &none : v.data(), std::max<size_t>(v.size(), 1) * sizeof(vec4));
+    return b;
+  };
+  vk::Buffer nz_buf = upload(f.normal_depth, "denoise normal, depth");
+  vk::Buffer alb_buf = upload(f.albedo_dz, "denoise albedo, depth gradient");
+  vk::Buffer guide_buf = upload(f.guide, "denoise guide");
+  color_buf[0].upload(ctx_, color.data(), n * sizeof(vec4));
+  var_buf[0].upload(ctx_, var.data(), n * sizeof(float));
+
+  // Two descriptor sets, ping-pong: set k reads buffers k and writes 1 − k.
+  vk::DescriptorSet sets[2] = {vk::DescriptorSet(ctx_, pipeline_, "denoise 0 -> 1"),
+                               vk::DescriptorSet(ctx_, pipeline_, "denoise 1 -> 0")};
+  for (int k = 0; k < 2; ++k) {
+    sets[k].write_buffer(gpu::DENOISE_BINDING_COLOR_IN, color_buf[k]);
+    sets[k].write_buffer(gpu::DENOISE_BINDING_VAR_IN, var_buf[k]);
+    sets[k].write_buffer(gpu::DENOISE_BINDING_COLOR_OUT, color_buf[1 - k]);
+    sets[k].write_buffer(gpu::DENOISE_BINDING_VAR_OUT, var_buf[1 - k]);
+    sets[k].write_buffer(gpu::DENOISE_BINDING_NORMAL_DEPTH, nz_buf);
+    sets[k].write_buffer(gpu::DENOISE_BINDING_ALBEDO_DZ, alb_buf);
+    sets[k].write_buffer(gpu::DENOISE_BINDING_VAR_BLURRED, var_blurred);
+    sets[k].write_buffer(gpu::DENOISE_BINDING_GUIDE, guide_buf);
+  }
+  const uint32_t groups_x = (uint32_t(width) + gpu::DENOISE_WORKGROUP_SIZE - 1) / gpu::DENOISE_WORKGROUP_SIZE;
+  const uint32_t groups_y = (uint32_t(height) + gpu::DENOISE_WORKGROUP_SIZE - 1) / gpu::DENOISE_WORKGROUP_SIZE;
+  // A blur is two passes (x, then y); an à-trous filter `iterations`, each
+  // after its variance prefilter. Each pass's output is the next one's input.
+  const int passes = pass.blur ? 2 : pass.iterations;
+  vk::submit_and_wait(ctx_, [&](VkCommandBuffer cmd) {
+    for (int i = 0; i < passes; ++i) {
+      pipeline_.bind(cmd, sets[i % 2].set());
+      const std::vector<uint32_t> stages =
+          pass.blur ? std::vector<uint32_t>{gpu::DENOISE_PASS_BLUR} : std::vector<uint32_t>{gpu::DENOISE_PASS_PREFILTER, 0u};
+      for (uint32_t stage : stages) {
+        gpu::DenoiseConstants dc{};
+        const uint32_t step = pass.blur ? uint32_t(i + 1) : (1u << i);
+        dc.size_step_flags = gpu::uvec4(uint32_t(width), uint32_t(height), step, pass.flags | stage);
+        dc.sigmas = pass.sigmas;
+        dc.guide_sigmas = pass.guide_sigmas;
+        pipeline_.push(cmd, dc);
+        vkCmdDispatch(cmd, groups_x, groups_y, 1);
+        vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                           VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT,
+                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT);
+      }
+    }
+  });
+  std::vector<vec4> out(n);
+  color_buf[passes % 2].download(ctx_, out.data(), n * sizeof(vec4));
+  return out;
+}
 
 Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std::string& name) {
   const size_t n = noisy.pixel_count();
@@ -72,77 +140,41 @@ Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std
                                     " pixels are too many to denoise on this device (" + std::to_string(n * sizeof(vec4)) +
                                     " bytes per buffer exceed its storage-buffer range of " + std::to_string(range) + ")");
 
-  // Pack: colour and alpha, the luminance variance, and the features (all
-  // three groups present, or none: Aovs says all or nothing).
-  std::vector<vec4> color(n);
+  // The luminance variance, and the features (all three groups present, or
+  // none: Aovs says all or nothing).
   std::vector<float> var(n);
-  for (size_t i = 0; i < n; ++i) {
-    color[i] = vec4(finite_or_0(noisy.rgb[i * 3]), finite_or_0(noisy.rgb[i * 3 + 1]), finite_or_0(noisy.rgb[i * 3 + 2]),
-                    noisy.has_alpha() ? finite_or_0(noisy.alpha[i]) : 1.0f);
-    var[i] = luminance_variance(&noisy.variance[i * 3]);
-  }
+  for (size_t i = 0; i < n; ++i) var[i] = luminance_variance(&noisy.variance[i * 3]);
   const Aovs& a = noisy.aovs;
-  const bool features = options.use_features && a.albedo.size() == n * 3 && a.normal.size() == n * 3 &&
-                        a.depth.size() == n;
-  std::vector<vec4> nz(features ? n : 1, vec4(0.0f)), alb(features ? n : 1, vec4(0.0f));
+  const bool have_features = a.albedo.size() == n * 3 && a.normal.size() == n * 3 && a.depth.size() == n;
+  const bool guided = options.use_guide && have_features && a.guide.size() == n * 3 && a.guide_alpha.size() == n &&
+                      a.emission.size() == n * 3 && a.surface.size() == n * 3;
+  const bool features = guided || (options.use_features && have_features);
+  Features f;
   if (features) {
     const std::vector<float> dz = depth_gradient(noisy);
+    f.normal_depth.resize(n);
+    f.albedo_dz.resize(n);
     for (size_t i = 0; i < n; ++i) {
-      nz[i] = vec4(finite_or_0(a.normal[i * 3]), finite_or_0(a.normal[i * 3 + 1]), finite_or_0(a.normal[i * 3 + 2]),
-                   finite_or_0(a.depth[i]));
-      alb[i] = vec4(finite_or_0(a.albedo[i * 3]), finite_or_0(a.albedo[i * 3 + 1]), finite_or_0(a.albedo[i * 3 + 2]), dz[i]);
+      f.normal_depth[i] = vec4(finite_or_0(a.normal[i * 3]), finite_or_0(a.normal[i * 3 + 1]),
+                               finite_or_0(a.normal[i * 3 + 2]), finite_or_0(a.depth[i]));
+      f.albedo_dz[i] = vec4(finite_or_0(a.albedo[i * 3]), finite_or_0(a.albedo[i * 3 + 1]),
+                            finite_or_0(a.albedo[i * 3 + 2]), dz[i]);
     }
   }
-
-  const VkBufferUsageFlags usage =
-      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
-  const auto kind = vk::MemoryKind::DeviceLocal;
-  vk::Buffer color_buf[2] = {vk::Buffer(ctx_, n * sizeof(vec4), usage, kind, "denoise colour 0"),
-                             vk::Buffer(ctx_, n * sizeof(vec4), usage, kind, "denoise colour 1")};
-  vk::Buffer var_buf[2] = {vk::Buffer(ctx_, n * sizeof(float), usage, kind, "denoise variance 0"),
-                           vk::Buffer(ctx_, n * sizeof(float), usage, kind, "denoise variance 1")};
-  vk::Buffer var_blurred(ctx_, n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, kind, "denoise blurred variance");
-  vk::Buffer nz_buf(ctx_, nz.size() * sizeof(vec4), usage, kind, "denoise normal, depth");
-  vk::Buffer alb_buf(ctx_, alb.size() * sizeof(vec4), usage, kind, "denoise albedo, depth gradient");
-  color_buf[0].upload(ctx_, color.data(), n * sizeof(vec4));
-  var_buf[0].upload(ctx_, var.data(), n * sizeof(float));
-  nz_buf.upload(ctx_, nz.data(), nz.size() * sizeof(vec4));
-  alb_buf.upload(ctx_, alb.data(), alb.size() * sizeof(vec4));
-
-  // Two descriptor sets, ping-pong: set k reads buffers k and writes 1 − k.
-  vk::DescriptorSet sets[2] = {vk::DescriptorSet(ctx_, pipeline_, "denoise 0 -> 1"),
-                               vk::DescriptorSet(ctx_, pipeline_, "denoise 1 -> 0")};
-  for (int k = 0; k < 2; ++k) {
-    sets[k].write_buffer(gpu::DENOISE_BINDING_COLOR_IN, color_buf[k]);
-    sets[k].write_buffer(gpu::DENOISE_BINDING_VAR_IN, var_buf[k]);
-    sets[k].write_buffer(gpu::DENOISE_BINDING_COLOR_OUT, color_buf[1 - k]);
-    sets[k].write_buffer(gpu::DENOISE_BINDING_VAR_OUT, var_buf[1 - k]);
-    sets[k].write_buffer(gpu::DENOISE_BINDING_NORMAL_DEPTH, nz_buf);
-    sets[k].write_buffer(gpu::DENOISE_BINDING_ALBEDO_DZ, alb_buf);
-    sets[k].write_buffer(gpu::DENOISE_BINDING_VAR_BLURRED, var_blurred);
+  auto alpha_at = [&](size_t i) { return noisy.has_alpha() ? finite_or_0(noisy.alpha[i]) : 1.0f; };
+  std::vector<vec4> color(n);
+  if (!guided) {
+    for (size_t i = 0; i < n; ++i)
+      color[i] = vec4(finite_or_0(noisy.rgb[i * 3]), finite_or_0(noisy.rgb[i * 3 + 1]), finite_or_0(noisy.rgb[i * 3 + 2]),
+                      alpha_at(i));
+    Pass p;
+    p.iterations = options.iterations;
+    p.flags = features ? (gpu::DENOISE_USE_NORMAL_DEPTH | gpu::DENOISE_USE_ALBEDO) : 0u;
+    p.sigmas = vec4(options.sigma_l, options.sigma_n, options.sigma_z, options.sigma_a);
+    color = filter(noisy.width, noisy.height, color, var, f, p);
+  } else {
+    color = run_guided(noisy, var, f);
   }
-  const uint32_t flags = features ? (gpu::DENOISE_USE_NORMAL_DEPTH | gpu::DENOISE_USE_ALBEDO) : 0u;
-  const uint32_t groups_x = (uint32_t(noisy.width) + gpu::DENOISE_WORKGROUP_SIZE - 1) / gpu::DENOISE_WORKGROUP_SIZE;
-  const uint32_t groups_y = (uint32_t(noisy.height) + gpu::DENOISE_WORKGROUP_SIZE - 1) / gpu::DENOISE_WORKGROUP_SIZE;
-  vk::submit_and_wait(ctx_, [&](VkCommandBuffer cmd) {
-    for (int i = 0; i < options.iterations; ++i) {
-      pipeline_.bind(cmd, sets[i % 2].set());
-      // The variance prefilter, then the iteration; each pass's output is
-      // the next one's input, and the next one overwrites what this one read.
-      for (uint32_t pass : {gpu::DENOISE_PASS_PREFILTER, 0u}) {
-        gpu::DenoiseConstants dc{};
-        dc.size_step_flags = gpu::uvec4(uint32_t(noisy.width), uint32_t(noisy.height), 1u << i, flags | pass);
-        dc.sigmas = vec4(options.sigma_l, options.sigma_n, options.sigma_z, options.sigma_a);
-        pipeline_.push(cmd, dc);
-        vkCmdDispatch(cmd, groups_x, groups_y, 1);
-        vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                           VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT,
-                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT);
-      }
-    }
-  });
-  color_buf[options.iterations % 2].download(ctx_, color.data(), n * sizeof(vec4));
 
   Image out = make_image(noisy.width, noisy.height);
   out.spp = noisy.spp;
@@ -152,6 +184,72 @@ Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std
   for (size_t i = 0; i < n; ++i) {
     for (int c = 0; c < 3; ++c) out.rgb[i * 3 + c] = color[i][c];
     if (noisy.has_alpha()) out.alpha[i] = color[i].w;
+  }
+  return out;
+}
+
+// The guided filter (docs/compositing.md "Denoiser"): the beauty in three
+// parts, each filtered as its noise and structure call for, then summed.
+//   emission: the ratio estimator E' = G·(g∗E)/(g∗G) per channel, G the
+//     guide (the expected emission, noise-free), g a Gaussian: the guide
+//     gives the structure, the noisy layer only a smooth correction;
+//   surface: divided by the albedo (texture is not noise), à-trous with the
+//     features, multiplied back;
+//   the rest (scatter, background) and alpha: à-trous whose weight adds the
+//     guide's and the guide alpha's differences to the features.
+static float tune(const char* k, float d) { const char* v = getenv(k); return v ? float(atof(v)) : d; }  // TUNING HACK
+std::vector<vec4> Denoiser::run_guided(const Image& noisy, const std::vector<float>& var, const Features& f) {
+  const size_t n = noisy.pixel_count();
+  const Aovs& a = noisy.aovs;
+  const int w = noisy.width, h = noisy.height;
+  Features g = f;
+  g.guide.resize(n);
+  std::vector<vec4> E(n), G(n), S(n), R(n), albedo(n);
+  std::vector<float> var_s(n);
+  for (size_t i = 0; i < n; ++i) {
+    g.guide[i] = vec4(finite_or_0(a.guide[i * 3]), finite_or_0(a.guide[i * 3 + 1]), finite_or_0(a.guide[i * 3 + 2]),
+                      finite_or_0(a.guide_alpha[i]));
+    G[i] = vec4(g.guide[i][0], g.guide[i][1], g.guide[i][2], 0.0f);
+    vec4 rgb(0.0f), al(0.0f);
+    for (int c = 0; c < 3; ++c) {
+      const size_t k = i * 3 + c;
+      rgb[c] = finite_or_0(noisy.rgb[k]);
+      E[i][c] = finite_or_0(a.emission[k]);
+      al[c] = std::max(finite_or_0(a.albedo[k]), kMinAlbedo);
+      S[i][c] = finite_or_0(a.surface[k]) / al[c];
+      R[i][c] = rgb[c] - E[i][c] - finite_or_0(a.surface[k]);
+    }
+    albedo[i] = al;
+    R[i][3] = noisy.has_alpha() ? finite_or_0(noisy.alpha[i]) : 1.0f;
+    const float l = 0.2126f * al[0] + 0.7152f * al[1] + 0.0722f * al[2];
+    var_s[i] = var[i] / (l * l);
+  }
+  Pass blur;
+  blur.blur = true;
+  blur.guide_sigmas = vec4(0.0f, 0.0f, 0.0f, tune("DN_RS", kRatioSigmaPx));
+  const std::vector<vec4> bE = filter(w, h, E, var, Features{}, blur), bG = filter(w, h, G, var, Features{}, blur);
+
+  const uint32_t feature_flags = gpu::DENOISE_USE_NORMAL_DEPTH | gpu::DENOISE_USE_ALBEDO | gpu::DENOISE_GUIDED_FEATURES;
+  Pass ps;
+  ps.iterations = int(tune("DN_SIT", kSurfaceIterations));
+  ps.flags = feature_flags;
+  ps.sigmas = vec4(tune("DN_SSL", kGuidedSigmaL), tune("DN_SN", kGuidedSigmaN), tune("DN_SZ", kGuidedSigmaZ), tune("DN_SA", kGuidedSigmaA));
+  const std::vector<vec4> Sf = filter(w, h, S, var_s, f, ps);
+
+  Pass pr = ps;
+  pr.iterations = int(tune("DN_RIT", kRestIterations));
+  pr.sigmas[0] = tune("DN_RSL", kGuidedSigmaL);
+  pr.flags = feature_flags | gpu::DENOISE_USE_GUIDE;
+  pr.guide_sigmas = vec4(tune("DN_SG", kGuideSigma), tune("DN_TAU", kGuideFloor), tune("DN_SGA", kGuideAlphaSigma), 0.0f);
+  const std::vector<vec4> Rf = filter(w, h, R, var, g, pr);
+
+  std::vector<vec4> out(n);
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const float e = bG[i][c] > 0.0f ? G[i][c] * bE[i][c] / bG[i][c] : 0.0f;
+      out[i][c] = e + Rf[i][c] + albedo[i][c] * Sf[i][c];
+    }
+    out[i][3] = Rf[i][3];
   }
   return out;
 }

@@ -4,12 +4,15 @@
 // (shaders/denoise.comp) on the Vulkan device the renderer uses. It reads the
 // beauty, its variance of the mean and, when present, the albedo, normal and
 // depth AOVs (docs/compositing.md "Denoiser").
+#include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "image/Image.h"
 #include "render/vulkan/Context.h"
 #include "render/vulkan/Pipeline.h"
+#include "shared/denoise_types.h"
 
 namespace pyrolume {
 
@@ -32,6 +35,9 @@ struct DenoiseOptions {
   // terrain_explosion; docs/compositing.md "Denoiser"), as they stop the
   // filter where the beauty needs no stopping.
   bool use_features = false;
+  // With the AOVs and their guide (renders with --aovs): the guided filter,
+  // whatever the settings above (docs/compositing.md "Denoiser").
+  bool use_guide = true;
   int device_index = -1;     // denoise(): the Vulkan device (-1: as the renderer chooses)
 };
 
@@ -48,6 +54,26 @@ class Denoiser {
   Image run(const Image& noisy, const DenoiseOptions& options, const std::string& name = "image");
 
  private:
+  // The guided filter's settings (measured: docs/benchmarks.md "Denoiser").
+  static constexpr float kMinAlbedo = 0.02f;        // demodulation: albedo floor
+  static constexpr float kRatioSigmaPx = 4.5f;      // the ratio estimator's Gaussian
+  static constexpr int kSurfaceIterations = 3, kRestIterations = 2;
+  static constexpr float kGuidedSigmaL = 6.0f, kGuidedSigmaN = 64.0f, kGuidedSigmaZ = 0.05f, kGuidedSigmaA = 0.1f;
+  static constexpr float kGuideSigma = 0.2f, kGuideFloor = 0.02f, kGuideAlphaSigma = 0.2f;
+
+  struct Features {  // per pixel; empty: not used
+    std::vector<gpu::vec4> normal_depth, albedo_dz, guide;
+  };
+  struct Pass {
+    int iterations = 1;
+    uint32_t flags = 0;
+    gpu::vec4 sigmas{0.0f}, guide_sigmas{0.0f};
+    bool blur = false;  // a separable Gaussian (σ = guide_sigmas.w) instead of à-trous
+  };
+  std::vector<gpu::vec4> filter(int width, int height, const std::vector<gpu::vec4>& color,
+                                const std::vector<float>& var, const Features& f, const Pass& pass);
+  std::vector<gpu::vec4> run_guided(const Image& noisy, const std::vector<float>& var, const Features& f);
+
   vk::Context& ctx_;
   vk::ComputePipeline pipeline_;
 };

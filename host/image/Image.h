@@ -23,6 +23,13 @@ struct Aovs {
   //   depth:  the distance from the camera to the event; 0 where no sample has one.
   std::vector<float> albedo, normal;
   std::vector<float> depth;  // one per pixel
+  // The denoiser's guide, averaged over the pixel's samples (empty in files
+  // written before it existed): the media's emission reaching the camera
+  // unscattered along each camera ray, by a deterministic ray march (the
+  // expected `emission` layer, without its noise), and the expected alpha of
+  // that ray (guide_alpha, one per pixel). docs/compositing.md "Denoiser".
+  std::vector<float> guide, guide_alpha;
+  bool has_guide() const { return !guide.empty(); }
 
   bool empty() const { return emission.empty(); }
 };

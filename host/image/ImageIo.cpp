@@ -101,6 +101,23 @@ constexpr AovChannel kAovChannels[] = {
     {"depth.Z", &Aovs::depth, 1, 0},
 };
 constexpr int kAovFloats = 19;  // per pixel, all layers
+// The denoiser's guide: written with the AOVs by renders that have it; a file
+// from before it has the AOVs without it (all four channels or none).
+constexpr AovChannel kGuideChannels[] = {
+    {"guide.R", &Aovs::guide, 3, 0},
+    {"guide.G", &Aovs::guide, 3, 1},
+    {"guide.B", &Aovs::guide, 3, 2},
+    {"guide.A", &Aovs::guide_alpha, 1, 0},
+};
+constexpr int kGuideFloats = 4;
+
+// The AOV channels an image holds: the AOVs, then the guide when it has one.
+std::vector<AovChannel> aov_channels(bool aovs, bool guide) {
+  std::vector<AovChannel> v;
+  if (aovs) v.assign(std::begin(kAovChannels), std::end(kAovChannels));
+  if (aovs && guide) v.insert(v.end(), std::begin(kGuideChannels), std::end(kGuideChannels));
+  return v;
+}
 
 void write_exr(std::ostream& os, const Image& img) {
   Imf::Header header(img.width, img.height);
@@ -113,8 +130,8 @@ void write_exr(std::ostream& os, const Image& img) {
   if (img.has_variance())
     for (const char* n : var_names) header.channels().insert(n, Imf::Channel(Imf::FLOAT));
   if (img.has_alpha()) header.channels().insert("A", Imf::Channel(Imf::FLOAT));
-  if (img.has_aovs())
-    for (const AovChannel& a : kAovChannels) header.channels().insert(a.name, Imf::Channel(Imf::FLOAT));
+  const std::vector<AovChannel> aov_out = aov_channels(img.has_aovs(), img.aovs.has_guide());
+  for (const AovChannel& a : aov_out) header.channels().insert(a.name, Imf::Channel(Imf::FLOAT));
 
   Imf::FrameBuffer fb;
   const size_t xs = 3 * sizeof(float), ys = xs * size_t(img.width);
@@ -125,12 +142,11 @@ void write_exr(std::ostream& os, const Image& img) {
   }
   if (img.has_alpha())
     fb.insert("A", Imf::Slice(Imf::FLOAT, (char*)img.alpha.data(), sizeof(float), sizeof(float) * size_t(img.width)));
-  if (img.has_aovs())
-    for (const AovChannel& a : kAovChannels) {
-      const std::vector<float>& layer = img.aovs.*a.layer;
-      const size_t axs = size_t(a.stride) * sizeof(float);
-      fb.insert(a.name, Imf::Slice(Imf::FLOAT, (char*)(layer.data() + a.offset), axs, axs * size_t(img.width)));
-    }
+  for (const AovChannel& a : aov_out) {
+    const std::vector<float>& layer = img.aovs.*a.layer;
+    const size_t axs = size_t(a.stride) * sizeof(float);
+    fb.insert(a.name, Imf::Slice(Imf::FLOAT, (char*)(layer.data() + a.offset), axs, axs * size_t(img.width)));
+  }
   StdOStreamAdaptor stream(os);
   Imf::OutputFile out(stream, header);
   out.setFrameBuffer(fb);
@@ -325,6 +341,14 @@ Image read_exr(const fs::path& file, const std::vector<unsigned char>& bytes) {
     throw input_error(file.string(), "",
                       std::string("EXR has some AOV channels (") + aov_present + ") but not " + aov_missing);
   const bool aovs = aov_present != nullptr;
+  const char* guide_present = nullptr;
+  const char* guide_missing = nullptr;
+  for (const AovChannel& a : kGuideChannels) (has(a.name) ? guide_present : guide_missing) = a.name;
+  if (guide_present && (guide_missing || !aovs))
+    throw input_error(file.string(), "",
+                      std::string("EXR has some guide channels (") + guide_present + ") but not " +
+                          (guide_missing ? guide_missing : kAovChannels[0].name));
+  const std::vector<AovChannel> aov_in = aov_channels(aovs, guide_present != nullptr);
 
   // Read in blocks of rows, growing the image as they decode: memory follows
   // the pixel data the file really holds, not what a corrupt header claims
@@ -336,7 +360,7 @@ Image read_exr(const fs::path& file, const std::vector<unsigned char>& bytes) {
   img.height = dw.max.y - dw.min.y + 1;
   require_memory(file.string(), "", std::to_string(img.width) + " x " + std::to_string(img.height) + " pixels",
                  uint64_t(img.width) * uint64_t(img.height) * sizeof(float) *
-                     ((var_count == 3 ? 6 : 3) + (alpha ? 1 : 0) + (aovs ? kAovFloats : 0)));
+                     ((var_count == 3 ? 6 : 3) + (alpha ? 1 : 0) + (aovs ? kAovFloats : 0) + (guide_present ? kGuideFloats : 0)));
   const size_t row_floats = size_t(img.width) * 3, xs = 3 * sizeof(float), ys = xs * size_t(img.width);
   const int rows_per_block = int(std::max<size_t>(1, (size_t(16) << 20) / ys));
   for (int y0 = 0; y0 < img.height; y0 += rows_per_block) {
@@ -344,8 +368,7 @@ Image read_exr(const fs::path& file, const std::vector<unsigned char>& bytes) {
     img.rgb.resize(size_t(y0 + rows) * row_floats, 0.0f);
     if (var_count == 3) img.variance.resize(img.rgb.size(), 0.0f);
     if (alpha) img.alpha.resize(size_t(y0 + rows) * size_t(img.width), 0.0f);
-    if (aovs)
-      for (const AovChannel& a : kAovChannels) (img.aovs.*a.layer).resize(size_t(y0 + rows) * size_t(img.width) * a.stride, 0.0f);
+    for (const AovChannel& a : aov_in) (img.aovs.*a.layer).resize(size_t(y0 + rows) * size_t(img.width) * a.stride, 0.0f);
     const Imath::Box2i block(Imath::V2i(dw.min.x, dw.min.y + y0), Imath::V2i(dw.max.x, dw.min.y + y0 + rows - 1));
     // A FrameBuffer maps each name once, so a Y-only file fills R and is copied to G, B.
     Imf::FrameBuffer fb;
@@ -359,13 +382,12 @@ Image read_exr(const fs::path& file, const std::vector<unsigned char>& bytes) {
     if (alpha)
       fb.insert("A", Imf::Slice::Make(Imf::FLOAT, img.alpha.data() + size_t(y0) * size_t(img.width), block,
                                       sizeof(float), sizeof(float) * size_t(img.width)));
-    if (aovs)
-      for (const AovChannel& a : kAovChannels) {
-        std::vector<float>& layer = img.aovs.*a.layer;
-        const size_t axs = size_t(a.stride) * sizeof(float);
-        fb.insert(a.name, Imf::Slice::Make(Imf::FLOAT, layer.data() + size_t(y0) * size_t(img.width) * a.stride + a.offset,
-                                           block, axs, axs * size_t(img.width)));
-      }
+    for (const AovChannel& a : aov_in) {
+      std::vector<float>& layer = img.aovs.*a.layer;
+      const size_t axs = size_t(a.stride) * sizeof(float);
+      fb.insert(a.name, Imf::Slice::Make(Imf::FLOAT, layer.data() + size_t(y0) * size_t(img.width) * a.stride + a.offset,
+                                         block, axs, axs * size_t(img.width)));
+    }
     in.setFrameBuffer(fb);
     in.readPixels(block.min.y, block.max.y);
   }
@@ -432,8 +454,7 @@ void write_image(const fs::path& file, const Image& img, double exposure_stops, 
     throw std::logic_error("write_image: image size does not match its pixel data");
   if (img.has_variance() && img.variance.size() != img.rgb.size())
     throw std::logic_error("write_image: variance size does not match the image");
-  if (img.has_aovs())
-    for (const AovChannel& a : kAovChannels)
+  for (const AovChannel& a : aov_channels(img.has_aovs(), img.aovs.has_guide()))
       if ((img.aovs.*a.layer).size() != img.pixel_count() * size_t(a.stride))
         throw std::logic_error(std::string("write_image: AOV ") + a.name + " size does not match the image");
 

@@ -60,9 +60,11 @@ struct RenderSettings {
 // RenderResult::aov_sum's layout: per pixel, kAovValues sums over its samples,
 // at these offsets: the light layers (RGB; they sum to RenderResult::sum),
 // then the first-event features (albedo RGB, normal XYZ, depth) summed over
-// the samples that have a first event, and their number (kAovHits).
+// the samples that have a first event, and their number (kAovHits); then the
+// denoiser's guide (RGB) and its alpha, summed over all samples.
 constexpr int kAovEmission = 0, kAovScatter = 3, kAovSurface = 6, kAovBackground = 9;
-constexpr int kAovAlbedo = 12, kAovNormal = 15, kAovDepth = 18, kAovHits = 19, kAovValues = 20;
+constexpr int kAovAlbedo = 12, kAovNormal = 15, kAovDepth = 18, kAovHits = 19;
+constexpr int kAovGuide = 20, kAovGuideAlpha = 23, kAovValues = 24;
 
 // Called after each progressive pass: samples per pixel done so far, target.
 using ProgressFn = std::function<void(int spp_done, int spp_target)>;

@@ -13,6 +13,8 @@ Aovs aovs_from_render(const RenderResult& result) {
   Aovs a;
   for (auto* v : {&a.emission, &a.scatter, &a.surface, &a.background, &a.albedo, &a.normal}) v->assign(pixels * 3, 0.0f);
   a.depth.assign(pixels, 0.0f);
+  a.guide.assign(pixels * 3, 0.0f);
+  a.guide_alpha.assign(pixels, 0.0f);
   const double n = double(result.spp);
   for (size_t i = 0; i < pixels; ++i) {
     const double* s = result.aov_sum.data() + i * kAovValues;
@@ -23,6 +25,7 @@ Aovs aovs_from_render(const RenderResult& result) {
         a.scatter[i * 3 + c] = float(s[kAovScatter + c] / n);
         a.surface[i * 3 + c] = float(s[kAovSurface + c] / n);
         a.background[i * 3 + c] = float(s[kAovBackground + c] / n);
+        a.guide[i * 3 + c] = float(s[kAovGuide + c] / n);
       }
       if (hits > 0.0) {  // the features, over the samples that have a first event
         a.albedo[i * 3 + c] = float(s[kAovAlbedo + c] / hits);
@@ -30,6 +33,7 @@ Aovs aovs_from_render(const RenderResult& result) {
       }
     }
     if (hits > 0.0) a.depth[i] = float(s[kAovDepth] / hits);
+    if (n > 0.0) a.guide_alpha[i] = float(s[kAovGuideAlpha] / n);
   }
   return a;
 }

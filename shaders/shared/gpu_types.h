@@ -259,12 +259,16 @@ struct AovLightTexel {
 };
 
 // film.aovs: sums of the camera ray's first-event features over the samples
-// that have one (hits counts them).
+// that have one (hits counts them), and of the denoiser's guide over all
+// samples (guide.glsl: the media's emission along the camera ray, and its
+// alpha, by a deterministic ray march).
 struct AovFeatureTexel {
   vec3 albedo;
   float depth;
   vec3 normal;
   float hits;
+  vec3 guide;
+  float guide_alpha;
 };
 
 #ifdef __cplusplus
@@ -315,8 +319,9 @@ static_assert(sizeof(AlphaTexel) == 16);
 PYRO_OFFSET(AlphaTexel, sum_c, 4); PYRO_OFFSET(AlphaTexel, sq, 8); PYRO_OFFSET(AlphaTexel, sq_c, 12);
 static_assert(sizeof(AovLightTexel) == 64);
 PYRO_OFFSET(AovLightTexel, scatter, 16); PYRO_OFFSET(AovLightTexel, surface, 32); PYRO_OFFSET(AovLightTexel, background, 48);
-static_assert(sizeof(AovFeatureTexel) == 32);
+static_assert(sizeof(AovFeatureTexel) == 48);
 PYRO_OFFSET(AovFeatureTexel, depth, 12); PYRO_OFFSET(AovFeatureTexel, normal, 16); PYRO_OFFSET(AovFeatureTexel, hits, 28);
+PYRO_OFFSET(AovFeatureTexel, guide, 32); PYRO_OFFSET(AovFeatureTexel, guide_alpha, 44);
 }  // namespace pyrolume::gpu
 #endif
 #endif

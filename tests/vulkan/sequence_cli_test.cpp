@@ -188,7 +188,8 @@ INSTANTIATE_TEST_SUITE_P(Backends, Sequence, ::testing::Values("vulkan", "cpu"))
 // `pyrolume denoise`, starting afresh, makes of that frame's render.
 TEST(SequenceCli, DenoisedFramesMatchDenoisingEachFrameAlone) {
   fs::path dir = scene_with_frames("seq-denoise", {1, 2, 3});
-  CliResult r = run_cli("render " + q(dir / "seq.json") + " --frames 1-3 --variance --denoise -o " +
+  // --aovs: the raw frames then carry what the guided filter reads.
+  CliResult r = run_cli("render " + q(dir / "seq.json") + " --frames 1-3 --variance --aovs --denoise -o " +
                         q(dir / "out_####.exr"));
   ASSERT_EQ(r.status, 0) << r.err;
   for (int f : {1, 2, 3}) {

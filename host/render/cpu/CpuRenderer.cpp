@@ -754,6 +754,66 @@ void add_sample_aovs(const glm::dvec3& L, bool recorded, const WalkAov aov[3], d
   }
 }
 
+// The denoiser's guide along a camera ray (film.aovs; docs/compositing.md
+// "Denoiser"; the GPU's shaders/guide.glsl is written apart from this): the
+// media's emission that reaches the camera unscattered, ∫ T σaLe dt, up to
+// the first surface, and the transmittance T to the background (0 when a
+// surface ends the ray, as alpha is 1 there), by a midpoint ray march: steps
+// of at most one density texel where a vdb medium is present (a segment with
+// homogeneous media only is one step), each exact for constant coefficients,
+// L += T·E/σt·(1 − e^(−σt·Δt)), T ·= e^(−σt·Δt). No random numbers.
+void guide_march(const WalkScene& ws, const glm::dvec3& o, const glm::dvec3& d, Scratch& s, glm::dvec3& L,
+                 glm::dvec3& T) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  L = glm::dvec3(0.0);
+  T = glm::dvec3(1.0);
+  double t_end = inf;
+  geometry::SurfaceHit hit;
+  const bool surface = !ws.surfaces.empty() && geometry::intersect(ws.surfaces, geometry::Ray{o, d}, inf, hit);
+  if (surface) t_end = hit.t;
+  ray_spans(ws.md, o, d, s.spans, s.cuts);
+  if (s.spans.empty()) {
+    if (surface) T = glm::dvec3(0.0);
+    return;
+  }
+  double h = inf;  // ray parameter per density texel, the finest grid's
+  for (const Span& sp : s.spans) {
+    const MediumData& m = ws.md.media[sp.medium];
+    if (!m.is_vdb()) continue;
+    const glm::dvec3 du(m.volume->density.grid.world_to_index * glm::dvec4(d, 0.0));
+    h = std::min(h, 1.0 / std::max(glm::length(du), 1e-300));
+  }
+  for (size_t k = 0; k + 1 < s.cuts.size(); ++k) {
+    const double a = s.cuts[k], b = std::min(s.cuts[k + 1], t_end);
+    if (!(b > a)) break;
+    media_present(ws.md, s.spans, a, b, 0, s.present);
+    if (s.present.empty()) continue;
+    bool vdb = false;
+    for (int i : s.present) vdb = vdb || ws.md.media[i].is_vdb();
+    const double steps = vdb ? std::ceil((b - a) / h) : 1.0;
+    const int n = int(std::clamp(steps, 1.0, 1e6));
+    const double dt = (b - a) / n;
+    for (int j = 0; j < n; ++j) {
+      const glm::dvec3 x = o + d * (a + (j + 0.5) * dt);
+      glm::dvec3 sigma_t(0.0), E(0.0);
+      for (int i : s.present) {
+        const MediumData& m = ws.md.media[i];
+        const double rho = m.is_vdb() ? grid_density(m, x) : 1.0;
+        for (int c = 0; c < 3; ++c) {
+          sigma_t[c] += (m.sigma_a[c] + m.sigma_s[c]) * rho;
+          E[c] += m.is_vdb() ? grid_sigma_a_Le(m, i, c, x, rho, s.Le_cache) : m.sigma_a_Le[c];
+        }
+      }
+      for (int c = 0; c < 3; ++c) {
+        const double tr = std::exp(-sigma_t[c] * dt);
+        L[c] += T[c] * (sigma_t[c] * dt > 1e-4 ? E[c] * (1.0 - tr) / sigma_t[c] : E[c] * dt);
+        T[c] *= tr;
+      }
+    }
+  }
+  if (surface) T = glm::dvec3(0.0);
+}
+
 }  // namespace
 
 glm::dvec3 camera_ray_direction(const Camera& camera, int width, int height, double fx, double fy) {
@@ -968,7 +1028,18 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
                 sum[c] += L[c];
                 sum_sq[c] += L[c] * L[c];
               }
-              if (settings.aovs) add_sample_aovs(L, recorded, aov, aov_sum);
+              if (settings.aovs) {
+                add_sample_aovs(L, recorded, aov, aov_sum);
+                // The guide's film point: the si-th of the R2 sequence in the
+                // pixel (as the GPU's add_sample_guide), not the sample's own.
+                const double r2x = std::fmod(0.5 + si * 0.7548776662466927, 1.0);
+                const double r2y = std::fmod(0.5 + si * 0.5698402909980532, 1.0);
+                const glm::dvec3 guide_dir = camera_ray_direction(scene.camera, W, H, x + r2x, y + r2y);
+                glm::dvec3 G, T;
+                guide_march(walk_scene, scene.camera.position, guide_dir, scratch, G, T);
+                for (int c = 0; c < 3; ++c) aov_sum[kAovGuide + c] += G[c];
+                aov_sum[kAovGuideAlpha] += 1.0 - (T.x + T.y + T.z) / 3.0;
+              }
             }
             if (settings.aovs) std::copy_n(aov_sum, kAovValues, next_aov.data() + pix * kAovValues);
             for (int c = 0; c < 3; ++c) {

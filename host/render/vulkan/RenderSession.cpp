@@ -835,9 +835,11 @@ void RenderSession::read_aovs(RenderResult& result) {
       s[kAovBackground + c] = l.background[c];
       s[kAovAlbedo + c] = f.albedo[c];
       s[kAovNormal + c] = f.normal[c];
+      s[kAovGuide + c] = f.guide[c];
     }
     s[kAovDepth] = f.depth;
     s[kAovHits] = f.hits;
+    s[kAovGuideAlpha] = f.guide_alpha;
   }
 }
 
