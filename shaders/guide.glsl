@@ -1,28 +1,24 @@
-// The denoiser's guide (film.aovs; docs/compositing.md "Denoiser"): along a
-// camera ray, the media's emission that reaches the camera unscattered,
+// The denoiser's guide (film.aovs; docs/compositing.md "Denoiser"): what a
+// camera ray sees without scattering, computed without random numbers. Up to
+// the first surface or sphere light, the media's emission,
 //   L = ∫ T(t) Σ σa·Le dt,  T(t) = exp(−∫ σt),
-// up to the first surface, and the transmittance T to the background (0 when
-// a surface ends the ray): the expected value of the `emission` layer and of
-// alpha, 1 − avg(T), for that ray, computed without random numbers. A ray march at midpoints, about one density texel per step inside
-// non-empty majorant cells (empty cells are skipped, a homogeneous medium is
-// one step per segment), each step exact for constant coefficients:
+// then what ends the ray times T: a sphere light's radiance, or the
+// background (environment, sun discs) unless film.transparent, or nothing at
+// a surface. That is the expected value of the `emission` plus `background`
+// layers for that ray; alpha is 1 − avg(T), with T = 0 at a surface or a
+// sphere light. A ray march at midpoints, about one density texel per step
+// inside non-empty majorant cells (empty cells are skipped, a homogeneous
+// medium is one step per segment), each step exact for constant
+// coefficients:
 //   L += T·E/σt·(1 − e^(−σt·Δt)),  T ·= e^(−σt·Δt).
 // Its only noise is the sample's film position, so the guide tells the
-// fire's structure from the path tracer's noise.
+// fire's structure (and the background through the smoke) from the path
+// tracer's noise.
 const uint GUIDE_MAX_STEPS = 4096u;
 
-void guide_march(vec3 o, vec3 d, out vec3 L, out vec3 T) {
-  L = vec3(0.0);
-  T = vec3(1.0);
-  SurfaceHit hit;
-  const bool surface = intersect_surfaces(o, d, INF, hit);
-  vec2 span[MEDIA_N];
-  bool any_hit;
-  media_spans(o, d, span, any_hit);
-  if (!any_hit) {
-    if (surface) T = vec3(0.0);
-    return;
-  }
+// The media part of the guide: emission and transmittance from the media
+// entry to t_end (the surface or sphere light, or INF).
+void guide_media(vec3 o, vec3 d, float t_end, vec2 span[MEDIA_N], inout vec3 L, inout vec3 T) {
   float t0 = INF, t1 = 0.0, h = INF;
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     if (!(span[i].y > max(span[i].x, 0.0))) continue;
@@ -31,7 +27,7 @@ void guide_march(vec3 o, vec3 d, out vec3 L, out vec3 T) {
     GpuMedium m = media[i];
     if (is_grid(m)) h = min(h, 1.0 / max(length(density_texel_dir(m.grid_slot, d)), 1e-30));
   }
-  if (surface) t1 = min(t1, hit.t);
+  t1 = min(t1, t_end);
   PathStats stats = PathStats(0.0, 0.0);
   float t = t0;
   for (uint n = 0u; n < GUIDE_MAX_STEPS && t < t1; ++n) {
@@ -58,5 +54,25 @@ void guide_march(vec3 o, vec3 d, out vec3 L, out vec3 T) {
     T *= tr;
     t += dt;
   }
-  if (surface) T = vec3(0.0);
+}
+
+void guide_march(vec3 o, vec3 d, out vec3 L, out vec3 T) {
+  L = vec3(0.0);
+  T = vec3(1.0);
+  SurfaceHit hit;
+  const bool surface = HAS_SURFACES && intersect_surfaces(o, d, INF, hit);
+  float t_end = surface ? hit.t : INF;
+  const uint light = LIGHT_COUNT > 0u ? intersect_sphere_lights(o, d, t_end) : LIGHT_COUNT;
+  vec2 span[MEDIA_N];
+  bool any_hit;
+  media_spans(o, d, span, any_hit);
+  if (any_hit) guide_media(o, d, t_end, span, L, T);
+  if (light < LIGHT_COUNT) {
+    L += T * sphere_light_radiance(analytic_lights[light], o + t_end * d, d);
+    T = vec3(0.0);
+  } else if (surface) {
+    T = vec3(0.0);
+  } else if (frame.transparent == 0u) {
+    L += T * escaped_radiance(d);
+  }
 }

@@ -190,14 +190,14 @@ Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std
 
 // The guided filter (docs/compositing.md "Denoiser"): the beauty in three
 // parts, each filtered as its noise and structure call for, then summed.
-//   emission: the ratio estimator E' = G·(g∗E)/(g∗G) per channel, G the
-//     guide (the expected emission, noise-free), g a Gaussian: the guide
-//     gives the structure, the noisy layer only a smooth correction;
+//   emission + background: the ratio estimator E' = G·(g∗E)/(g∗G) per
+//     channel, G the guide (the expected emission + background,
+//     noise-free), g a Gaussian: the guide gives the structure, the noisy
+//     layers only a smooth correction;
 //   surface: divided by the albedo (texture is not noise), à-trous with the
 //     features, multiplied back;
-//   the rest (scatter, background) and alpha: à-trous whose weight adds the
+//   the rest (scatter) and alpha: à-trous whose weight adds the
 //     guide's and the guide alpha's differences to the features.
-static float tune(const char* k, float d) { const char* v = getenv(k); return v ? float(atof(v)) : d; }  // TUNING HACK
 std::vector<vec4> Denoiser::run_guided(const Image& noisy, const std::vector<float>& var, const Features& f) {
   const size_t n = noisy.pixel_count();
   const Aovs& a = noisy.aovs;
@@ -214,7 +214,7 @@ std::vector<vec4> Denoiser::run_guided(const Image& noisy, const std::vector<flo
     for (int c = 0; c < 3; ++c) {
       const size_t k = i * 3 + c;
       rgb[c] = finite_or_0(noisy.rgb[k]);
-      E[i][c] = finite_or_0(a.emission[k]);
+      E[i][c] = finite_or_0(a.emission[k]) + finite_or_0(a.background[k]);
       al[c] = std::max(finite_or_0(a.albedo[k]), kMinAlbedo);
       S[i][c] = finite_or_0(a.surface[k]) / al[c];
       R[i][c] = rgb[c] - E[i][c] - finite_or_0(a.surface[k]);
@@ -226,21 +226,21 @@ std::vector<vec4> Denoiser::run_guided(const Image& noisy, const std::vector<flo
   }
   Pass blur;
   blur.blur = true;
-  blur.guide_sigmas = vec4(0.0f, 0.0f, 0.0f, tune("DN_RS", kRatioSigmaPx));
+  blur.guide_sigmas = vec4(0.0f, 0.0f, 0.0f, kRatioSigmaPx);
   const std::vector<vec4> bE = filter(w, h, E, var, Features{}, blur), bG = filter(w, h, G, var, Features{}, blur);
 
   const uint32_t feature_flags = gpu::DENOISE_USE_NORMAL_DEPTH | gpu::DENOISE_USE_ALBEDO | gpu::DENOISE_GUIDED_FEATURES;
   Pass ps;
-  ps.iterations = int(tune("DN_SIT", kSurfaceIterations));
+  ps.iterations = kSurfaceIterations;
   ps.flags = feature_flags;
-  ps.sigmas = vec4(tune("DN_SSL", kGuidedSigmaL), tune("DN_SN", kGuidedSigmaN), tune("DN_SZ", kGuidedSigmaZ), tune("DN_SA", kGuidedSigmaA));
+  ps.sigmas = vec4(kGuidedSigmaL, kGuidedSigmaN, kGuidedSigmaZ, kGuidedSigmaA);
   const std::vector<vec4> Sf = filter(w, h, S, var_s, f, ps);
 
   Pass pr = ps;
-  pr.iterations = int(tune("DN_RIT", kRestIterations));
-  pr.sigmas[0] = tune("DN_RSL", kGuidedSigmaL);
+  pr.iterations = kRestIterations;
+  pr.sigmas[0] = kGuidedSigmaL;
   pr.flags = feature_flags | gpu::DENOISE_USE_GUIDE;
-  pr.guide_sigmas = vec4(tune("DN_SG", kGuideSigma), tune("DN_TAU", kGuideFloor), tune("DN_SGA", kGuideAlphaSigma), 0.0f);
+  pr.guide_sigmas = vec4(kGuideSigma, kGuideFloor, kGuideAlphaSigma, 0.0f);
   const std::vector<vec4> Rf = filter(w, h, R, var, g, pr);
 
   std::vector<vec4> out(n);

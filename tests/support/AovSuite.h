@@ -160,37 +160,66 @@ TEST_P(Aovs, SphereLightFeaturesAreItsOutwardNormalAndDistance) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(img.aovs.background[p * 3 + c], img.rgb[p * 3 + c], 1e-5);
 }
 
-// The denoiser's guide is the expected `emission` layer (the ray march is
-// exact for a homogeneous medium: one step per chord) and its alpha the
-// expected alpha 1 − avg_c T_c: over the pixels, the mean of the pixelwise
-// differences layer − guide (noise only, as the guide has none) is within
-// 4 SE of 0, per channel. The sphere is chromatic and scatters, and half of
-// it stands in front of a plane, so the march must stop at the surface.
-TEST_P(Aovs, GuideIsTheExpectedEmissionLayerAndAlpha) {
-  const Scene s = aov_layers_scene(per_backend(64, 256), 11);
+// The denoiser's guide is the expected `emission` + `background` layers (the
+// ray march is exact for a homogeneous medium: one step per chord) and its
+// alpha the expected alpha 1 − avg_c T_c: over the pixels, the mean of the
+// pixelwise differences layers − guide (noise only, as the guide has none)
+// is within 4 SE of 0, per channel. The sphere is chromatic and scatters,
+// half of it stands in front of a plane, so the march must stop at the
+// surface, and the rest before the background, which it must attenuate. With
+// film.transparent the background is in neither.
+TEST_P(Aovs, GuideIsTheExpectedEmissionAndBackgroundLayersAndAlpha) {
+  for (const bool transparent : {false, true}) {
+    SCOPED_TRACE(transparent ? "film.transparent" : "background");
+    Scene s = aov_layers_scene(per_backend(64, 256), 11);
+    s.film.transparent = transparent;
+    const RenderResult r = render(s);
+    const Image img = image_from_render(r, false);
+    ASSERT_TRUE(img.aovs.has_guide());
+    ASSERT_TRUE(img.has_alpha());
+    const size_t n = img.pixel_count();
+    double guide_total = 0.0;
+    for (int c = 0; c < 4; ++c) {  // R, G, B of emission + background; 3: alpha
+      double sum = 0.0, sq = 0.0;
+      for (size_t i = 0; i < n; ++i) {
+        const size_t k = i * 3 + c;
+        const double d = c < 3 ? double(img.aovs.emission[k]) + img.aovs.background[k] - img.aovs.guide[k]
+                               : double(img.alpha[i]) - img.aovs.guide_alpha[i];
+        sum += d;
+        sq += d * d;
+        if (c < 3) guide_total += img.aovs.guide[k];
+      }
+      const double mean = sum / double(n), se = std::sqrt(std::max(sq / double(n) - mean * mean, 0.0) / double(n));
+      std::printf("%s channel %d: mean(layers - guide) %.4g, SE %.3g\n", transparent ? "transparent" : "opaque", c,
+                  mean, se);
+      EXPECT_LE(std::abs(mean), 4.0 * se + 1e-6) << "channel " << c;
+    }
+    EXPECT_GT(guide_total, 0.0);
+    // Deterministic up to the film positions: where the camera sees only the
+    // plane (the bottom row's corners) the guide is exactly 0, and where it
+    // sees only the background (the top row's corner), that (to rounding).
+    EXPECT_EQ(img.aovs.guide[(n - 1) * 3], 0.0f);
+    EXPECT_NEAR(img.aovs.guide[0], transparent ? 0.0 : s.background.x, 1e-6);
+  }
+}
+
+// A sphere light that the camera sees is in the guide too (the `background`
+// layer has it), and makes the guide's alpha 1 there.
+TEST_P(Aovs, GuideHasTheSphereLightsTheCameraSees) {
+  Scene s = aov_layers_scene(4, 2);
+  s.media.clear();
+  s.shapes.clear();
+  s.camera.position = {0.0, 0.0, 4.0};
+  s.camera.look_at = {0.0, 0.0, 0.0};
+  s.camera.up = {0, 1, 0};
+  s.camera.fov_deg = 10.0;  // the light fills the view
+  s.lights.push_back(sphere_light({0.0, 0.0, 0.0}, 1.0, glm::dvec3(2.0, 3.0, 4.0)));
   const RenderResult r = render(s);
   const Image img = image_from_render(r, false);
   ASSERT_TRUE(img.aovs.has_guide());
-  ASSERT_TRUE(img.has_alpha());
-  const size_t n = img.pixel_count();
-  double guide_total = 0.0;
-  for (int c = 0; c < 4; ++c) {  // R, G, B of the emission; 3: alpha
-    double sum = 0.0, sq = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-      const double d = c < 3 ? double(img.aovs.emission[i * 3 + c]) - img.aovs.guide[i * 3 + c]
-                             : double(img.alpha[i]) - img.aovs.guide_alpha[i];
-      sum += d;
-      sq += d * d;
-      if (c < 3) guide_total += img.aovs.guide[i * 3 + c];
-    }
-    const double mean = sum / double(n), se = std::sqrt(std::max(sq / double(n) - mean * mean, 0.0) / double(n));
-    std::printf("channel %d: mean(layer - guide) %.4g, SE %.3g\n", c, mean, se);
-    EXPECT_LE(std::abs(mean), 4.0 * se + 1e-6) << "channel " << c;
-  }
-  EXPECT_GT(guide_total, 0.0);
-  // Deterministic up to the film positions: where the camera sees only the
-  // plane (the bottom row's corners) the guide is exactly 0.
-  EXPECT_EQ(img.aovs.guide[(n - 1) * 3], 0.0f);
+  const size_t p = size_t(8) * r.width + 8;
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(img.aovs.guide[p * 3 + c], 2.0 + c, 1e-5);
+  EXPECT_NEAR(img.aovs.guide_alpha[p], 1.0, 1e-6);
 }
 
 // Without film.aovs nothing is accumulated.

@@ -754,28 +754,11 @@ void add_sample_aovs(const glm::dvec3& L, bool recorded, const WalkAov aov[3], d
   }
 }
 
-// The denoiser's guide along a camera ray (film.aovs; docs/compositing.md
-// "Denoiser"; the GPU's shaders/guide.glsl is written apart from this): the
-// media's emission that reaches the camera unscattered, ∫ T σaLe dt, up to
-// the first surface, and the transmittance T to the background (0 when a
-// surface ends the ray, as alpha is 1 there), by a midpoint ray march: steps
-// of at most one density texel where a vdb medium is present (a segment with
-// homogeneous media only is one step), each exact for constant coefficients,
-// L += T·E/σt·(1 − e^(−σt·Δt)), T ·= e^(−σt·Δt). No random numbers.
-void guide_march(const WalkScene& ws, const glm::dvec3& o, const glm::dvec3& d, Scratch& s, glm::dvec3& L,
-                 glm::dvec3& T) {
+// The media part of the guide: emission and transmittance along the spans
+// in s (ray_spans) up to t_end.
+void guide_media(const WalkScene& ws, const glm::dvec3& o, const glm::dvec3& d, double t_end, Scratch& s,
+                 glm::dvec3& L, glm::dvec3& T) {
   constexpr double inf = std::numeric_limits<double>::infinity();
-  L = glm::dvec3(0.0);
-  T = glm::dvec3(1.0);
-  double t_end = inf;
-  geometry::SurfaceHit hit;
-  const bool surface = !ws.surfaces.empty() && geometry::intersect(ws.surfaces, geometry::Ray{o, d}, inf, hit);
-  if (surface) t_end = hit.t;
-  ray_spans(ws.md, o, d, s.spans, s.cuts);
-  if (s.spans.empty()) {
-    if (surface) T = glm::dvec3(0.0);
-    return;
-  }
   double h = inf;  // ray parameter per density texel, the finest grid's
   for (const Span& sp : s.spans) {
     const MediumData& m = ws.md.media[sp.medium];
@@ -811,7 +794,37 @@ void guide_march(const WalkScene& ws, const glm::dvec3& o, const glm::dvec3& d, 
       }
     }
   }
-  if (surface) T = glm::dvec3(0.0);
+}
+
+// The denoiser's guide along a camera ray (film.aovs; docs/compositing.md
+// "Denoiser"; the GPU's shaders/guide.glsl is written apart from this): what
+// the ray sees unscattered, without random numbers. The media's emission
+// ∫ T σaLe dt up to the first surface or sphere light, by a midpoint ray
+// march: steps of at most one density texel where a vdb medium is present (a
+// segment with homogeneous media only is one step), each exact for constant
+// coefficients, L += T·E/σt·(1 − e^(−σt·Δt)), T ·= e^(−σt·Δt). Then T times
+// what ends the ray: a sphere light's radiance (from outside), the
+// background unless film.transparent, nothing at a surface; T is 0 at a
+// surface or sphere light, as alpha is 1 there.
+void guide_march(const WalkScene& ws, const glm::dvec3& o, const glm::dvec3& d, Scratch& s, glm::dvec3& L,
+                 glm::dvec3& T) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  L = glm::dvec3(0.0);
+  T = glm::dvec3(1.0);
+  geometry::SurfaceHit hit;
+  const bool surface = !ws.surfaces.empty() && geometry::intersect(ws.surfaces, geometry::Ray{o, d}, inf, hit);
+  const SphereLightHit sphere = intersect_sphere_lights(ws.lights, o, d, surface ? hit.t : inf);
+  const double t_end = sphere.light >= 0 ? sphere.t : surface ? hit.t : inf;
+  ray_spans(ws.md, o, d, s.spans, s.cuts);
+  guide_media(ws, o, d, t_end, s, L, T);
+  if (sphere.light >= 0) {
+    if (sphere.outside) L += T * ws.lights.analytic[sphere.light].value;
+    T = glm::dvec3(0.0);
+  } else if (surface) {
+    T = glm::dvec3(0.0);
+  } else if (!ws.transparent) {
+    for (int c = 0; c < 3; ++c) L[c] += T[c] * ws.escaped(d, c);
+  }
 }
 
 }  // namespace
