@@ -228,6 +228,57 @@ TEST(ImageIo, ExrRoundTripWithAovs) {
   fs::remove_all(dir);
 }
 
+// The denoiser's guide (guide.R/G/B/A) rides with the AOVs: read back bit for
+// bit; a file with some guide channels but not all, or a guide without the
+// AOVs, is refused with one line naming the file and the channels.
+TEST(ImageIo, ExrRoundTripWithTheGuide) {
+  auto dir = test::temp_dir("exrguide");
+  Image img = sample_image(true);
+  float v = 0.25f;
+  for (auto* layer : {&img.aovs.emission, &img.aovs.scatter, &img.aovs.surface, &img.aovs.background,
+                      &img.aovs.albedo, &img.aovs.normal, &img.aovs.guide})
+    for (int i = 0; i < 18; ++i) layer->push_back(v += 0.29f);
+  img.aovs.depth = {0.0f, 1.5f, 1e6f, 3.25f, 0.0f, 7.0f};
+  img.aovs.guide_alpha = {0.0f, 0.125f, 1.0f, 0.5f, 0.75f, 1.0f};
+  ASSERT_TRUE(img.aovs.has_guide());
+  write_image(dir / "guide.exr", img);
+  const Image back = read_image(dir / "guide.exr");
+  EXPECT_EQ(back.aovs.guide, img.aovs.guide);
+  EXPECT_EQ(back.aovs.guide_alpha, img.aovs.guide_alpha);
+  EXPECT_EQ(back.aovs.emission, img.aovs.emission);
+  {
+    Imf::InputFile f((dir / "guide.exr").c_str());
+    for (const char* n : {"guide.R", "guide.G", "guide.B", "guide.A"})
+      ASSERT_NE(f.header().channels().findChannel(n), nullptr) << n;
+  }
+  // A file with the given FLOAT channels, every value 1.
+  auto write_channels = [&](const fs::path& path, const std::vector<std::string>& names) {
+    Imf::Header h(1, 1);
+    for (const std::string& n : names) h.channels().insert(n, Imf::Channel(Imf::FLOAT));
+    std::vector<float> px(names.size(), 1.0f);
+    Imf::FrameBuffer fb;
+    for (size_t c = 0; c < names.size(); ++c)
+      fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char*)(px.data() + c), sizeof(float), sizeof(float)));
+    Imf::OutputFile out(path.c_str(), h);
+    out.setFrameBuffer(fb);
+    out.writePixels(1);
+  };
+  write_channels(dir / "noaovs.exr", {"R", "G", "B", "guide.R", "guide.G", "guide.B", "guide.A"});
+  std::string msg = expect_input_error([&] { read_image(dir / "noaovs.exr"); }, {"noaovs.exr", "guide", "emission"});
+  EXPECT_EQ(msg.find('\n'), std::string::npos);
+  std::vector<std::string> names = {"R", "G", "B", "emission.R", "emission.G", "emission.B", "scatter.R", "scatter.G",
+                                    "scatter.B", "surface.R", "surface.G", "surface.B", "background.R", "background.G",
+                                    "background.B", "albedo.R", "albedo.G", "albedo.B", "normal.X", "normal.Y",
+                                    "normal.Z", "depth.Z", "guide.R", "guide.G", "guide.B"};
+  write_channels(dir / "partial.exr", names);
+  msg = expect_input_error([&] { read_image(dir / "partial.exr"); }, {"partial.exr", "guide.A"});
+  EXPECT_EQ(msg.find('\n'), std::string::npos);
+  names.push_back("guide.A");
+  write_channels(dir / "whole.exr", names);
+  EXPECT_TRUE(read_image(dir / "whole.exr").aovs.has_guide());
+  fs::remove_all(dir);
+}
+
 // PNG: RGB unless the image is transparent; then RGBA with straight alpha,
 // the colour being RGB/A through the view transform.
 TEST(ImageIo, PngHasStraightAlphaOnlyWhenTransparent) {
