@@ -459,7 +459,8 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
       DenoiserSession denoiser;
       const double seconds = write_denoised(file, full, stops, scene.film.view, denoiser);
       one.commit();
-      std::cout << file.string() << ": denoised, " << format_seconds(seconds) << " s" << std::endl;
+      std::cout << file.string() << ": denoised with " << denoise_inputs(full, DenoiseOptions{}) << ", "
+                << format_seconds(seconds) << " s" << std::endl;
     }
     if (result.spp >= settings.spp)  // a finished render: one the user will look at
       if (const std::string w = film_look_warning(image, stops, scene.film.view, ext == ".png"); !w.empty())
@@ -550,16 +551,16 @@ int run_denoise(const DenoiseArgs& a) {
   options.iterations = a.iterations;
   options.sigma_l = a.sigma_l;
   options.use_features = a.features;
+  options.use_guide = !a.no_guide;
   options.device_index = a.device;
   const auto t1 = std::chrono::steady_clock::now();
   const Image clean = denoise(noisy, options, input.string());
   const auto t2 = std::chrono::steady_clock::now();
   write_image(output, clean);
-  const bool features = options.use_features && !noisy.aovs.albedo.empty();
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double filter = std::chrono::duration<double>(t2 - t1).count();
-  std::cout << output.string() << ": " << noisy.width << "x" << noisy.height << ", denoised "
-            << (features ? "with albedo, normal, depth" : "with beauty and variance only") << ", "
+  std::cout << output.string() << ": " << noisy.width << "x" << noisy.height << ", denoised with "
+            << denoise_inputs(noisy, options) << ", "
             << format_seconds(filter) << " s denoising, " << format_seconds(total) << " s in all" << std::endl;
   return 0;
 }

@@ -57,6 +57,7 @@ struct DenoiseArgs {
   int iterations = 1;
   float sigma_l = 1.5f;
   bool features = false;
+  bool no_guide = false;  // the plain filter even with the guide (implied by the three above)
   int device = -1;
 };
 int run_denoise(const DenoiseArgs& args);

@@ -123,12 +123,18 @@ int main(int argc, char** argv) {
   auto* denoise = app.add_subcommand("denoise", "Denoise a render (EXR with variance) into a new image");
   denoise->add_option("input", dn.input, "EXR written by render --variance (read only)")->required();
   denoise->add_option("-o,--output", dn.output, "Output image (.exr, or .png)")->required();
-  denoise->add_option("--iterations", dn.iterations, "À-trous iterations (default 1; n reach ±(2^(n+1) − 2) px)")
+  denoise->add_flag("--no-guide", dn.no_guide,
+                    "Use the plain à-trous filter even where the input has the AOVs and their guide (render --aovs), "
+                    "which otherwise choose the guided filter; implied by the three options below");
+  denoise->add_option("--iterations", dn.iterations,
+                      "Plain filter: à-trous iterations (default 1; n reach ±(2^(n+1) − 2) px)")
       ->check(CLI::Range(0, 12));
-  denoise->add_option("--sigma-l", dn.sigma_l, "Luminance edge-stopping, in standard deviations of the noise (default 1.5)")
+  denoise->add_option("--sigma-l", dn.sigma_l,
+                      "Plain filter: luminance edge-stopping, in standard deviations of the noise (default 1.5)")
       ->check(CLI::PositiveNumber);
   denoise->add_flag("--features", dn.features,
-                    "Also stop at edges in the albedo, normal and depth AOVs (off: they measured worse on the fires)");
+                    "Plain filter: also stop at edges in the albedo, normal and depth AOVs (off: they measured worse "
+                    "on the fires)");
   denoise->add_option("--device", dn.device, "Vulkan device index")->check(CLI::NonNegativeNumber);
 
   try {
@@ -159,7 +165,11 @@ int main(int argc, char** argv) {
     if (*devices) return run_devices(devices_device);
     if (*blackbody) return run_blackbody(bb);
     if (*compare) return run_compare(cmp);
-    if (*denoise) return run_denoise(dn);
+    if (*denoise) {
+      // The plain filter's settings ask for the plain filter.
+      dn.no_guide = dn.no_guide || denoise->count("--iterations") + denoise->count("--sigma-l") + denoise->count("--features") > 0;
+      return run_denoise(dn);
+    }
   } catch (const InputError& e) {
     std::cerr << "pyrolume: " << e.what() << "\n";
     return 2;

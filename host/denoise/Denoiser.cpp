@@ -145,10 +145,8 @@ Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std
   std::vector<float> var(n);
   for (size_t i = 0; i < n; ++i) var[i] = luminance_variance(&noisy.variance[i * 3]);
   const Aovs& a = noisy.aovs;
-  const bool have_features = a.albedo.size() == n * 3 && a.normal.size() == n * 3 && a.depth.size() == n;
-  const bool guided = options.use_guide && have_features && a.guide.size() == n * 3 && a.guide_alpha.size() == n &&
-                      a.emission.size() == n * 3 && a.surface.size() == n * 3;
-  const bool features = guided || (options.use_features && have_features);
+  const bool guided = denoise_uses_guide(noisy, options);
+  const bool features = guided || denoise_uses_features(noisy, options);
   Features f;
   if (features) {
     const std::vector<float> dz = depth_gradient(noisy);
@@ -262,6 +260,29 @@ Image DenoiserSession::run(const Image& noisy, const DenoiseOptions& options, co
     denoiser_ = std::make_unique<Denoiser>(*ctx_);
   }
   return denoiser_->run(noisy, options, name);
+}
+
+static bool has_features(const Image& img) {
+  const size_t n = img.pixel_count();
+  const Aovs& a = img.aovs;
+  return a.albedo.size() == n * 3 && a.normal.size() == n * 3 && a.depth.size() == n;
+}
+
+bool denoise_uses_guide(const Image& noisy, const DenoiseOptions& options) {
+  const size_t n = noisy.pixel_count();
+  const Aovs& a = noisy.aovs;
+  return options.use_guide && has_features(noisy) && a.guide.size() == n * 3 && a.guide_alpha.size() == n &&
+         a.emission.size() == n * 3 && a.surface.size() == n * 3 && a.background.size() == n * 3;
+}
+
+bool denoise_uses_features(const Image& noisy, const DenoiseOptions& options) {
+  return options.use_features && has_features(noisy);
+}
+
+std::string denoise_inputs(const Image& noisy, const DenoiseOptions& options) {
+  if (denoise_uses_guide(noisy, options)) return "the guided filter (light layers, features and guide)";
+  if (denoise_uses_features(noisy, options)) return "the plain filter (beauty, variance, albedo, normal, depth)";
+  return "the plain filter (beauty and variance)";
 }
 
 Image denoise(const Image& noisy, const DenoiseOptions& options, const std::string& name) {

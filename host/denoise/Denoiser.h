@@ -94,4 +94,12 @@ class DenoiserSession {
 // One image, on a DenoiserSession of its own.
 Image denoise(const Image& noisy, const DenoiseOptions& options = {}, const std::string& name = "image");
 
+// Which filter `options` runs on `noisy`: the guided one when use_guide and
+// the image has every AOV and the guide; else the plain à-trous, with the
+// albedo, normal and depth when use_features and the image has them.
+bool denoise_uses_guide(const Image& noisy, const DenoiseOptions& options);
+bool denoise_uses_features(const Image& noisy, const DenoiseOptions& options);
+// What that filter reads, in words, for the CLI's summary line.
+std::string denoise_inputs(const Image& noisy, const DenoiseOptions& options);
+
 }  // namespace pyrolume

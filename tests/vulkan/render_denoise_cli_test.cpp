@@ -44,6 +44,35 @@ TEST(CliRenderDenoise, WritesTheDenoisedImageBesideTheUntouchedRender) {
   std::filesystem::remove_all(dir);
 }
 
+// render --denoise renders the AOVs and their guide for the denoiser (not
+// into OUT), so it runs the guided filter; `pyrolume denoise` on a render
+// with --aovs does too, unless --no-guide or one of the plain filter's
+// settings (--iterations, --sigma-l, --features) asks for the plain one.
+// Each says which it ran, and the two give different images.
+TEST(CliRenderDenoise, TheGuidedFilterRunsWhereTheGuideIsAndThePlainOneWhenAsked) {
+  auto dir = temp_dir("clirenderguide");
+  write_file(dir / "s.json", kScene);
+  CliResult r = run_cli("render " + (dir / "s.json").string() + " -o " + (dir / "a.exr").string() + " --denoise");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("denoised with the guided filter"), std::string::npos) << r.out;
+  EXPECT_FALSE(read_image(dir / "a.exr").has_aovs());
+
+  r = run_cli("render " + (dir / "s.json").string() + " -o " + (dir / "b.exr").string() + " --aovs --variance");
+  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_TRUE(read_image(dir / "b.exr").aovs.has_guide());
+  const std::string in = (dir / "b.exr").string();
+  r = run_cli("denoise " + in + " -o " + (dir / "guided.exr").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("the guided filter"), std::string::npos) << r.out;
+  for (const std::string flags : {"--no-guide", "--iterations 1", "--sigma-l 1.5", "--features"}) {
+    r = run_cli("denoise " + in + " -o " + (dir / "plain.exr").string() + " " + flags);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("the plain filter"), std::string::npos) << flags << ": " << r.out;
+  }
+  EXPECT_NE(read_image(dir / "guided.exr").rgb, read_image(dir / "plain.exr").rgb);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(CliRenderDenoise, AovLayersInTheExrSumToItsRgb) {
   auto dir = temp_dir("clirenderaovs");
   write_file(dir / "s.json", kScene);

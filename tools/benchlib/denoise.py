@@ -2,11 +2,15 @@
 (issue 25: under 20 % of a 16-spp render's time at 1920×1080).
 
 For each scene: render it at --resolution (default 1920x1080 in this mode) and
---denoise-spp (16) with --variance, --render-reps times (the render's own
-"seconds" from --stats), then time `pyrolume denoise` on that EXR --reps times
-(the process's wall time: EXR read and write and the Vulkan device included;
-and the filter alone, as the command prints it). Medians go into the part of
-benchmarks.md between <!-- denoise:begin --> and <!-- denoise:end -->."""
+--denoise-spp (16) with --variance, --render-reps times, with and without
+--aovs (the render's own "seconds" from --stats). `render --denoise` renders
+with the AOVs, as the guided filter reads them and their guide, so the render
+with AOVs is what the denoiser's time is set against, and the one without shows
+what the AOVs and the guide cost. Then time `pyrolume denoise` on the EXR with
+AOVs --reps times (the process's wall time: EXR read and write and the Vulkan
+device included; and the filter alone, as the command prints it). Medians go
+into the part of benchmarks.md between <!-- denoise:begin --> and
+<!-- denoise:end -->."""
 
 import os
 import re
@@ -43,11 +47,17 @@ def run(args, argv):
             log(f"bench: --denoise: no scene {scene}")
             return 2
         exr = os.path.join(work, f"{name}_{args.width}x{args.height}_{args.denoise_spp}spp.exr")
-        render_s = []
+        plain = os.path.join(work, f"{name}_{args.width}x{args.height}_{args.denoise_spp}spp_plain.exr")
+        render_s, plain_s = [], []
         for rep in range(args.render_reps):
-            stats = render(args, scene, exr, exr + ".stats.json", "vulkan", args.denoise_spp, 1 + rep, variance=True)
+            stats = render(args, scene, plain, plain + ".stats.json", "vulkan", args.denoise_spp, 1 + rep,
+                           variance=True)
+            plain_s.append(stats["seconds"])
+            stats = render(args, scene, exr, exr + ".stats.json", "vulkan", args.denoise_spp, 1 + rep, variance=True,
+                           aovs=True)
             render_s.append(stats["seconds"])
-            log(f"bench: {name}: render {rep + 1}/{args.render_reps}: {stats['seconds']:.1f} s")
+            log(f"bench: {name}: render {rep + 1}/{args.render_reps}: {plain_s[-1]:.1f} s, "
+                f"{stats['seconds']:.1f} s with --aovs")
         walls, filters = [], []
         for rep in range(args.reps):
             wall, filt = time_denoise(args, exr, os.path.join(work, f"{name}_denoised.exr"))
@@ -55,16 +65,18 @@ def run(args, argv):
             filters.append(filt)
             log(f"bench: {name}: denoise {rep + 1}/{args.reps}: {wall:.2f} s ({filt:.2f} s filtering)")
         r, w, f = statistics.median(render_s), statistics.median(walls), statistics.median(filters)
-        rows.append((name, r, render_s, w, walls, f, 100.0 * w / r))
+        rows.append((name, statistics.median(plain_s), plain_s, r, render_s, w, walls, f, 100.0 * w / r))
     mi = machine_info(args.pyrolume)
     lines = [BEGIN, "",
              f"`tools/bench {' '.join(argv)}`, {args.width}×{args.height}, {args.denoise_spp} spp; "
              f"{mi['cpu']}, {mi['nproc']} cores, {mi['devices'] or 'device unknown'}; "
              f"load {' / '.join(f'{x:.2f}' for x in os.getloadavg())} at the end; medians (every run in brackets).", "",
-             "| scene | render, s | `pyrolume denoise`, s (wall) | filter alone, s | denoise / render |",
-             "|---|---|---|---|---|"]
-    for name, r, rs, w, ws, f, pct in rows:
-        lines.append(f"| {name} | {r:.1f} [{', '.join(f'{x:.1f}' for x in rs)}] | "
+             "| scene | render, s | render with --aovs, s | `pyrolume denoise`, s (wall) | filter alone, s "
+             "| denoise / render with --aovs |",
+             "|---|---|---|---|---|---|"]
+    for name, p, ps, r, rs, w, ws, f, pct in rows:
+        lines.append(f"| {name} | {p:.1f} [{', '.join(f'{x:.1f}' for x in ps)}] | "
+                     f"{r:.1f} [{', '.join(f'{x:.1f}' for x in rs)}] | "
                      f"{w:.2f} [{', '.join(f'{x:.2f}' for x in ws)}] | {f:.2f} | {pct:.1f} % |")
     lines += ["", END]
     block = "\n".join(lines)

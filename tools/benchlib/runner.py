@@ -47,13 +47,15 @@ def code_stamp(pyrolume):
     return "\n".join(parts)
 
 
-def render(args, scene_path, out_exr, stats_path, backend, spp, seed, variance=False, size=None):
+def render(args, scene_path, out_exr, stats_path, backend, spp, seed, variance=False, size=None, aovs=False):
     width, height = size or (args.width, args.height)
     cmd = [args.pyrolume, "render", scene_path, "-o", out_exr, "--backend", backend, "--spp", str(spp),
            "--width", str(width), "--height", str(height), "--seed", str(seed),
            "--stats", stats_path]
     if variance:
         cmd.append("--variance")
+    if aovs:
+        cmd.append("--aovs")
     if args.device is not None and backend == "vulkan":
         cmd += ["--device", str(args.device)]
     t0 = time.monotonic()
