@@ -19,6 +19,11 @@
 // dimmed alone: its energy stays in the image (without it, the 16-spp fires
 // lost ~2 % of their mean). The host (host/denoise/Denoiser.cpp)
 // runs it for i = 0, 1, 2, ...; docs/compositing.md "Denoiser".
+// The guided filter (Denoiser::run_guided) runs the same kernel with its own
+// weights (DENOISE_GUIDED_FEATURES: relative depth, normalized normals,
+// albedo only between surfaces; DENOISE_USE_GUIDE: the guide's relative
+// luminance and alpha differences) and one more kind of pass,
+// DENOISE_PASS_BLUR: a separable Gaussian, the ratio estimator's window.
 #extension GL_GOOGLE_include_directive : require
 
 #include "shared/denoise_types.h"
@@ -101,6 +106,12 @@ void main() {
   if (use_guide) g_p = guide[ip];
   const float guide_l_p = luminance(g_p.rgb);
   const bool surface_p = use_nz && on_surface(nz_p.xyz);
+  if (((flags & DENOISE_ONLY_SURFACES) != 0u && !surface_p) ||
+      ((flags & DENOISE_SKIP_EMPTY) != 0u && cp == vec4(0.0) && g_p.a == 0.0)) {
+    color_out[ip] = cp;
+    var_out[ip] = var_in[ip];
+    return;
+  }
 
   // B3 spline (1/16, 1/4, 3/8, 1/4, 1/16) scaled to 1 at the centre; the
   // centre tap has weight 1.

@@ -194,8 +194,13 @@ Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std
 //     layers only a smooth correction;
 //   surface: divided by the albedo (texture is not noise), à-trous with the
 //     features, multiplied back;
-//   the rest (scatter) and alpha: à-trous whose weight adds the
-//     guide's and the guide alpha's differences to the features.
+//   scatter and alpha: à-trous whose weight adds the guide's and the guide
+//     alpha's differences to the features.
+// The layers sum to the beauty (the AOVs' contract), so the three parts do.
+// Each à-trous pass leaves alone the pixels its weights would not change
+// much and that cost the most time: the surface pass all but surfaces, the
+// scatter pass those with no scatter, alpha or guide alpha (open sky):
+// together a third of the time at 1080p (docs/benchmarks.md "Denoiser").
 std::vector<vec4> Denoiser::run_guided(const Image& noisy, const std::vector<float>& var, const Features& f) {
   const size_t n = noisy.pixel_count();
   const Aovs& a = noisy.aovs;
@@ -208,14 +213,13 @@ std::vector<vec4> Denoiser::run_guided(const Image& noisy, const std::vector<flo
     g.guide[i] = vec4(finite_or_0(a.guide[i * 3]), finite_or_0(a.guide[i * 3 + 1]), finite_or_0(a.guide[i * 3 + 2]),
                       finite_or_0(a.guide_alpha[i]));
     G[i] = vec4(g.guide[i][0], g.guide[i][1], g.guide[i][2], 0.0f);
-    vec4 rgb(0.0f), al(0.0f);
+    vec4 al(0.0f);
     for (int c = 0; c < 3; ++c) {
       const size_t k = i * 3 + c;
-      rgb[c] = finite_or_0(noisy.rgb[k]);
       E[i][c] = finite_or_0(a.emission[k]) + finite_or_0(a.background[k]);
       al[c] = std::max(finite_or_0(a.albedo[k]), kMinAlbedo);
       S[i][c] = finite_or_0(a.surface[k]) / al[c];
-      R[i][c] = rgb[c] - E[i][c] - finite_or_0(a.surface[k]);
+      R[i][c] = finite_or_0(a.scatter[k]);
     }
     albedo[i] = al;
     R[i][3] = noisy.has_alpha() ? finite_or_0(noisy.alpha[i]) : 1.0f;
@@ -230,14 +234,14 @@ std::vector<vec4> Denoiser::run_guided(const Image& noisy, const std::vector<flo
   const uint32_t feature_flags = gpu::DENOISE_USE_NORMAL_DEPTH | gpu::DENOISE_USE_ALBEDO | gpu::DENOISE_GUIDED_FEATURES;
   Pass ps;
   ps.iterations = kSurfaceIterations;
-  ps.flags = feature_flags;
+  ps.flags = feature_flags | gpu::DENOISE_ONLY_SURFACES;
   ps.sigmas = vec4(kGuidedSigmaL, kGuidedSigmaN, kGuidedSigmaZ, kGuidedSigmaA);
   const std::vector<vec4> Sf = filter(w, h, S, var_s, f, ps);
 
   Pass pr = ps;
   pr.iterations = kRestIterations;
   pr.sigmas[0] = kGuidedSigmaL;
-  pr.flags = feature_flags | gpu::DENOISE_USE_GUIDE;
+  pr.flags = feature_flags | gpu::DENOISE_USE_GUIDE | gpu::DENOISE_SKIP_EMPTY;
   pr.guide_sigmas = vec4(kGuideSigma, kGuideFloor, kGuideAlphaSigma, 0.0f);
   const std::vector<vec4> Rf = filter(w, h, R, var, g, pr);
 
@@ -281,8 +285,10 @@ bool denoise_uses_features(const Image& noisy, const DenoiseOptions& options) {
 
 std::string denoise_inputs(const Image& noisy, const DenoiseOptions& options) {
   if (denoise_uses_guide(noisy, options)) return "the guided filter (light layers, features and guide)";
-  if (denoise_uses_features(noisy, options)) return "the plain filter (beauty, variance, albedo, normal, depth)";
-  return "the plain filter (beauty and variance)";
+  const char* hint = options.use_guide ? "; renders with --aovs get the guided filter" : "";
+  if (denoise_uses_features(noisy, options))
+    return std::string("the plain filter (beauty, variance, albedo, normal, depth") + (noisy.aovs.has_guide() ? "" : hint) + ")";
+  return std::string("the plain filter (beauty and variance") + (noisy.aovs.has_guide() ? "" : hint) + ")";
 }
 
 Image denoise(const Image& noisy, const DenoiseOptions& options, const std::string& name) {

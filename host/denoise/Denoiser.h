@@ -1,9 +1,14 @@
 #pragma once
-// The denoiser: an edge-avoiding à-trous wavelet filter (Dammertz et al. 2010)
-// with SVGF's variance-guided edge-stopping (Schied et al. 2017), in GLSL
-// (shaders/denoise.comp) on the Vulkan device the renderer uses. It reads the
-// beauty, its variance of the mean and, when present, the albedo, normal and
-// depth AOVs (docs/compositing.md "Denoiser").
+// The denoiser, in GLSL (shaders/denoise.comp) on the Vulkan device the
+// renderer uses (docs/compositing.md "Denoiser"). Two filters:
+//   guided, for renders with the AOVs and their guide (the ray-marched
+//     expected emission + background): the ratio estimator (Heitz et al.
+//     2018) for those layers, albedo-demodulated à-trous for the surfaces,
+//     guide-weighted à-trous for the rest;
+//   plain: an edge-avoiding à-trous wavelet filter (Dammertz et al. 2010)
+//     with SVGF's variance-guided edge-stopping (Schied et al. 2017) on the
+//     beauty, its variance of the mean and optionally the albedo, normal and
+//     depth AOVs.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -17,11 +22,12 @@
 namespace pyrolume {
 
 struct DenoiseOptions {
+  // The plain filter's settings (the guided filter has its own, below).
   // À-trous iterations; iteration i spaces its 5×5 taps 2^i pixels apart, so
   // n reach ±(2^(n+1) − 2) pixels. 1 measured best on the 16-spp fires
   // without AOVs (relMSE; more iterations blur the fire's and the terrain's
   // texture, which the noisy luminance cannot tell from noise: docs/compositing.md
-  // "Denoiser"). Retune once the renders carry AOVs.
+  // "Denoiser").
   int iterations = 1;
   // Edge-stopping parameters, SVGF's names and defaults (σ_a is ours: the
   // albedo, which SVGF demodulates instead).

@@ -44,6 +44,12 @@ PYRO_CONST uint DENOISE_GUIDED_FEATURES = 16;
 // σ = guide_sigmas.w pixels, out to 2σ rounded up: the ratio estimator's
 // window.
 PYRO_CONST uint DENOISE_PASS_BLUR = 32;
+// Pixels the pass leaves as they are (their colour and variance copied):
+// those that are not surfaces (the surface layer's pass: its weights never mix
+// a surface with anything else), and those whose colour and guide are all 0
+// (nothing on the ray to filter). Both only save time.
+PYRO_CONST uint DENOISE_ONLY_SURFACES = 64;
+PYRO_CONST uint DENOISE_SKIP_EMPTY = 128;
 
 // Push constants of one à-trous iteration.
 struct DenoiseConstants {
