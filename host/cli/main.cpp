@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/Commands.h"
+#include "image/AtomicFile.h"
 #include "preview/Preview.h"
 #include "render/Render.h"
 #include "util/Error.h"
@@ -23,11 +24,12 @@ std::atomic<int> g_signal{0};
 // The first SIGINT/SIGTERM asks the render to stop (within the pass in
 // flight, which is dropped) and save the passes finished; a second one (the
 // user will not wait for the save) exits at once with the same status,
-// saving nothing more.
+// saving nothing more and removing the temp files of a save in progress.
 extern "C" void on_signal(int sig) {
   if (g_cancel.exchange(true)) {
     static const char msg[] = "pyrolume: second signal: exiting without saving\n";
     [[maybe_unused]] ssize_t n = write(2, msg, sizeof msg - 1);
+    pyrolume::remove_pending_temp_files();
     _exit(128 + sig);
   }
   g_signal = sig;

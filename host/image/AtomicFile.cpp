@@ -23,6 +23,36 @@ std::string errno_text(int e) { return e ? std::strerror(e) : "unknown error"; }
 // The commit group of this thread, if any (OutputCommit).
 thread_local OutputCommit* active_commit = nullptr;
 
+// The temp files not yet renamed into place, for remove_pending_temp_files:
+// fixed slots of plain characters, as a signal handler may read nothing else.
+// A slot is free (0), being filled or emptied (1), or holds a path (2).
+struct PendingTemp {
+  std::atomic<int> state{0};
+  char path[4096];
+};
+PendingTemp pending_temps[64];
+
+void remember_temp(const fs::path& tmp) {
+  const std::string& p = tmp.native();
+  if (p.size() >= sizeof(PendingTemp::path)) return;  // too long to keep: left to the normal cleanup
+  for (PendingTemp& slot : pending_temps) {
+    int expected = 0;
+    if (!slot.state.compare_exchange_strong(expected, 1)) continue;
+    std::memcpy(slot.path, p.c_str(), p.size() + 1);
+    slot.state.store(2);
+    return;
+  }
+}
+
+void forget_temp(const fs::path& tmp) {
+  for (PendingTemp& slot : pending_temps) {
+    if (slot.state.load() != 2 || tmp.native() != slot.path) continue;
+    int expected = 2;
+    if (slot.state.compare_exchange_strong(expected, 1)) slot.state.store(0);
+    return;
+  }
+}
+
 // `path` with every symlink in its last component followed (up to 40 hops, as
 // the kernel allows): the file that would really be written. A dangling link
 // leads to the missing path it names, which is then created.
@@ -235,10 +265,12 @@ void write_file_atomic(const fs::path& dest, const std::function<void(std::ostre
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
   if (fd < 0) throw input_error(file, "", open_failure_reason(target, errno));
   ::close(fd);
+  remember_temp(tmp);
 
   auto discard = [&] {
     std::error_code ec;
     fs::remove(tmp, ec);
+    forget_temp(tmp);
   };
   try {
     {
@@ -266,6 +298,7 @@ void write_file_atomic(const fs::path& dest, const std::function<void(std::ostre
     std::error_code ec;
     fs::rename(tmp, target, ec);
     if (ec) throw input_error(file, "", "cannot replace: " + ec.message());
+    forget_temp(tmp);
   } catch (...) {
     discard();
     throw;
@@ -282,7 +315,9 @@ OutputCommit::~OutputCommit() {
   active_commit = outer_;
   for (const Staged& s : staged_) {
     std::error_code ec;
-    if (!s.stream) fs::remove(s.tmp, ec);
+    if (s.stream) continue;
+    fs::remove(s.tmp, ec);
+    forget_temp(s.tmp);
   }
 }
 
@@ -300,14 +335,22 @@ void OutputCommit::commit() {
       std::error_code ec;
       fs::rename(s.tmp, s.target, ec);
       if (ec) throw input_error(s.dest.string(), "", "cannot replace: " + ec.message());
+      forget_temp(s.tmp);
     } catch (...) {
       for (size_t j = i; j < staged.size(); ++j) {
         std::error_code ec;
-        if (!staged[j].stream) fs::remove(staged[j].tmp, ec);
+        if (staged[j].stream) continue;
+        fs::remove(staged[j].tmp, ec);
+        forget_temp(staged[j].tmp);
       }
       throw;
     }
   }
+}
+
+void remove_pending_temp_files() noexcept {
+  for (PendingTemp& slot : pending_temps)
+    if (slot.state.load() == 2) ::unlink(slot.path);
 }
 
 }  // namespace pyrolume

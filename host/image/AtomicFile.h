@@ -53,6 +53,12 @@ void write_file_atomic(const std::filesystem::path& dest, const std::function<vo
 // Convenience for text outputs (stats JSON, CSV).
 void write_text_atomic(const std::filesystem::path& dest, const std::string& text);
 
+// Removes every temp file of this process that is not yet renamed into place
+// (write_file_atomic's, and those an OutputCommit holds). Async-signal-safe
+// (it only calls unlink): for a signal handler that exits at once, so that a
+// second Ctrl-C during a save leaves no hidden ".NAME.tmp-PID-N" file behind.
+void remove_pending_temp_files() noexcept;
+
 // The outputs of one command, all or none: while an OutputCommit is alive on
 // this thread, write_file_atomic (and so write_image, write_text_atomic)
 // leaves each finished temp file in place, and commit() renames them all (and

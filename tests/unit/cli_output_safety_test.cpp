@@ -233,6 +233,33 @@ TEST(OutputCommit, OutputsAppearTogetherOrNotAtAll) {
   fs::remove_all(dir);
 }
 
+// What a second Ctrl-C during a save calls before it exits (host/cli/main.cpp
+// on_signal): the temp files not yet renamed into place go; outputs already
+// in place, and outputs written after, stay.
+TEST(OutputCommit, PendingTempFilesAreRemovedAtOnce) {
+  auto dir = temp_dir("pendingtemps");
+  write_text_atomic(dir / "done.json", "in place");
+  {
+    OutputCommit group;
+    write_text_atomic(dir / "a.json", "staged");
+    write_text_atomic(dir / "b.json", "staged");
+    ASSERT_EQ(listing(dir).size(), 3u) << "two hidden temp files beside done.json";
+    remove_pending_temp_files();
+    EXPECT_EQ(listing(dir), std::vector<std::string>{"done.json"});
+  }  // the group then finds nothing to remove
+  EXPECT_EQ(listing(dir), std::vector<std::string>{"done.json"});
+  {
+    OutputCommit group;
+    write_text_atomic(dir / "a.json", "new a");
+    group.commit();
+  }
+  remove_pending_temp_files();  // nothing pending: nothing removed
+  EXPECT_EQ(read_file(dir / "a.json"), "new a");
+  EXPECT_EQ(read_file(dir / "done.json"), "in place");
+  EXPECT_EQ(listing(dir).size(), 2u);
+  fs::remove_all(dir);
+}
+
 TEST(OutputCommit, NothingButARegularFileIsReplaced) {
   auto dir = temp_dir("replace-kinds");
   fs::create_directory(dir / "folder.json");
