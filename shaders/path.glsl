@@ -114,9 +114,6 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   return path_event(p, span, event, c, rho, temperature_value, rng, stats);
 }
 
-// Start p as a camera ray through pixel `pixel` for sample `k`, with that
-// sample's random stream (p is filled in place: PathState holds arrays sized
-// by a specialisation constant, which GLSL cannot copy).
 // The camera ray's direction through film point pixel + jitter (jitter in [0,1)²).
 vec3 camera_direction(uvec2 pixel, vec2 jitter) {
   vec2 ndc = vec2(2.0 * (float(pixel.x) + jitter.x) / float(frame.width) - 1.0,
@@ -126,6 +123,9 @@ vec3 camera_direction(uvec2 pixel, vec2 jitter) {
                    ndc.y * tan_half * frame.camera_up);
 }
 
+// Start p as a camera ray through pixel `pixel` for sample `k`, with that
+// sample's random stream (p is filled in place: PathState holds arrays sized
+// by a specialisation constant, which GLSL cannot copy).
 void camera_path(uvec2 pixel, uint k, out uint rng, inout PathState p) {
   uint width = frame.width, height = frame.height;
   rng = rng_init(frame.seed, frame.frame_index, pixel.y * width + pixel.x, k);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <stdexcept>
 #include <vector>
 
@@ -18,6 +17,9 @@ namespace {
 using gpu::vec4;
 
 float finite_or_0(float v) { return std::isfinite(v) ? v : 0.0f; }
+
+// Pixel i's alpha, or 1 for an image without one.
+float alpha_or_1(const Image& img, size_t i) { return img.has_alpha() ? finite_or_0(img.alpha[i]) : 1.0f; }
 
 // Variance of the mean of the luminance l = Σ w_c·c from the per-channel
 // variances. The channels' covariances are not stored; they are nearly
@@ -159,12 +161,11 @@ Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std
                             finite_or_0(a.albedo[i * 3 + 2]), dz[i]);
     }
   }
-  auto alpha_at = [&](size_t i) { return noisy.has_alpha() ? finite_or_0(noisy.alpha[i]) : 1.0f; };
   std::vector<vec4> color(n);
   if (!guided) {
     for (size_t i = 0; i < n; ++i)
       color[i] = vec4(finite_or_0(noisy.rgb[i * 3]), finite_or_0(noisy.rgb[i * 3 + 1]), finite_or_0(noisy.rgb[i * 3 + 2]),
-                      alpha_at(i));
+                      alpha_or_1(noisy, i));
     Pass p;
     p.iterations = options.iterations;
     p.flags = features ? (gpu::DENOISE_USE_NORMAL_DEPTH | gpu::DENOISE_USE_ALBEDO) : 0u;
@@ -207,12 +208,11 @@ std::vector<vec4> Denoiser::run_guided(const Image& noisy, const std::vector<flo
   const int w = noisy.width, h = noisy.height;
   Features g = f;
   g.guide.resize(n);
-  std::vector<vec4> E(n), G(n), S(n), R(n), albedo(n);
+  std::vector<vec4> E(n), S(n), R(n), albedo(n);
   std::vector<float> var_s(n);
   for (size_t i = 0; i < n; ++i) {
     g.guide[i] = vec4(finite_or_0(a.guide[i * 3]), finite_or_0(a.guide[i * 3 + 1]), finite_or_0(a.guide[i * 3 + 2]),
                       finite_or_0(a.guide_alpha[i]));
-    G[i] = vec4(g.guide[i][0], g.guide[i][1], g.guide[i][2], 0.0f);
     vec4 al(0.0f);
     for (int c = 0; c < 3; ++c) {
       const size_t k = i * 3 + c;
@@ -222,13 +222,14 @@ std::vector<vec4> Denoiser::run_guided(const Image& noisy, const std::vector<flo
       R[i][c] = finite_or_0(a.scatter[k]);
     }
     albedo[i] = al;
-    R[i][3] = noisy.has_alpha() ? finite_or_0(noisy.alpha[i]) : 1.0f;
+    R[i][3] = alpha_or_1(noisy, i);
     const float l = 0.2126f * al[0] + 0.7152f * al[1] + 0.0722f * al[2];
     var_s[i] = var[i] / (l * l);
   }
   Pass blur;
   blur.blur = true;
   blur.guide_sigmas = vec4(0.0f, 0.0f, 0.0f, kRatioSigmaPx);
+  const std::vector<vec4>& G = g.guide;  // its alpha is blurred along, unused
   const std::vector<vec4> bE = filter(w, h, E, var, Features{}, blur), bG = filter(w, h, G, var, Features{}, blur);
 
   const uint32_t feature_flags = gpu::DENOISE_USE_NORMAL_DEPTH | gpu::DENOISE_USE_ALBEDO | gpu::DENOISE_GUIDED_FEATURES;
@@ -240,7 +241,6 @@ std::vector<vec4> Denoiser::run_guided(const Image& noisy, const std::vector<flo
 
   Pass pr = ps;
   pr.iterations = kRestIterations;
-  pr.sigmas[0] = kGuidedSigmaL;
   pr.flags = feature_flags | gpu::DENOISE_USE_GUIDE | gpu::DENOISE_SKIP_EMPTY;
   pr.guide_sigmas = vec4(kGuideSigma, kGuideFloor, kGuideAlphaSigma, 0.0f);
   const std::vector<vec4> Rf = filter(w, h, R, var, g, pr);
@@ -285,10 +285,10 @@ bool denoise_uses_features(const Image& noisy, const DenoiseOptions& options) {
 
 std::string denoise_inputs(const Image& noisy, const DenoiseOptions& options) {
   if (denoise_uses_guide(noisy, options)) return "the guided filter (light layers, features and guide)";
-  const char* hint = options.use_guide ? "; renders with --aovs get the guided filter" : "";
-  if (denoise_uses_features(noisy, options))
-    return std::string("the plain filter (beauty, variance, albedo, normal, depth") + (noisy.aovs.has_guide() ? "" : hint) + ")";
-  return std::string("the plain filter (beauty and variance") + (noisy.aovs.has_guide() ? "" : hint) + ")";
+  const std::string reads =
+      denoise_uses_features(noisy, options) ? "beauty, variance, albedo, normal, depth" : "beauty and variance";
+  const bool could_guide = options.use_guide && !noisy.aovs.has_guide();
+  return "the plain filter (" + reads + (could_guide ? "; renders with --aovs get the guided filter" : "") + ")";
 }
 
 Image denoise(const Image& noisy, const DenoiseOptions& options, const std::string& name) {

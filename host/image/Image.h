@@ -24,10 +24,11 @@ struct Aovs {
   std::vector<float> albedo, normal;
   std::vector<float> depth;  // one per pixel
   // The denoiser's guide, averaged over the pixel's samples (empty in files
-  // written before it existed): the media's emission reaching the camera
-  // unscattered along each camera ray, by a deterministic ray march (the
-  // expected `emission` layer, without its noise), and the expected alpha of
-  // that ray (guide_alpha, one per pixel). docs/compositing.md "Denoiser".
+  // written before it existed): what each camera ray sees unscattered (the
+  // media's emission, then the background or a sphere light through them),
+  // by a deterministic ray march (the expected `emission` + `background`
+  // layers, without their noise), and the expected alpha of that ray
+  // (guide_alpha, one per pixel). docs/compositing.md "The guide".
   std::vector<float> guide, guide_alpha;
   bool has_guide() const { return !guide.empty(); }
 
