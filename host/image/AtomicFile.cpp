@@ -53,6 +53,13 @@ void forget_temp(const fs::path& tmp) {
   }
 }
 
+// Removes a temp file that will not be renamed into place.
+void remove_temp(const fs::path& tmp) {
+  std::error_code ec;
+  fs::remove(tmp, ec);
+  forget_temp(tmp);
+}
+
 // `path` with every symlink in its last component followed (up to 40 hops, as
 // the kernel allows): the file that would really be written. A dangling link
 // leads to the missing path it names, which is then created.
@@ -267,11 +274,6 @@ void write_file_atomic(const fs::path& dest, const std::function<void(std::ostre
   ::close(fd);
   remember_temp(tmp);
 
-  auto discard = [&] {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    forget_temp(tmp);
-  };
   try {
     {
       std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
@@ -300,7 +302,7 @@ void write_file_atomic(const fs::path& dest, const std::function<void(std::ostre
     if (ec) throw input_error(file, "", "cannot replace: " + ec.message());
     forget_temp(tmp);
   } catch (...) {
-    discard();
+    remove_temp(tmp);
     throw;
   }
 }
@@ -313,12 +315,8 @@ OutputCommit::OutputCommit() : outer_(active_commit) { active_commit = this; }
 
 OutputCommit::~OutputCommit() {
   active_commit = outer_;
-  for (const Staged& s : staged_) {
-    std::error_code ec;
-    if (s.stream) continue;
-    fs::remove(s.tmp, ec);
-    forget_temp(s.tmp);
-  }
+  for (const Staged& s : staged_)
+    if (!s.stream) remove_temp(s.tmp);
 }
 
 void OutputCommit::commit() {
@@ -337,12 +335,8 @@ void OutputCommit::commit() {
       if (ec) throw input_error(s.dest.string(), "", "cannot replace: " + ec.message());
       forget_temp(s.tmp);
     } catch (...) {
-      for (size_t j = i; j < staged.size(); ++j) {
-        std::error_code ec;
-        if (staged[j].stream) continue;
-        fs::remove(staged[j].tmp, ec);
-        forget_temp(staged[j].tmp);
-      }
+      for (size_t j = i; j < staged.size(); ++j)
+        if (!staged[j].stream) remove_temp(staged[j].tmp);
       throw;
     }
   }
