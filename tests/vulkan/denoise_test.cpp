@@ -39,12 +39,14 @@ class DenoiseGpu : public ::testing::Test {
   std::unique_ptr<Denoiser> denoiser_;
 };
 
+// The test images' colour: every value is a level times this.
+constexpr float kTint[3] = {1.0f, 0.8f, 0.6f};
+
 // An image whose pixel (x, y) has the true colour truth(x, y) · tint plus
 // Gaussian noise of standard deviation sigma(x, y) · tint per channel, and
 // that noise's variance as the variance of the mean.
 template <class Truth, class Sigma>
 Image noisy_image(int w, int h, Truth truth, Sigma sigma, uint32_t seed) {
-  const float tint[3] = {1.0f, 0.8f, 0.6f};
   Image img = make_image(w, h, true);
   img.alpha.assign(img.pixel_count(), 1.0f);
   std::mt19937 rng(seed);
@@ -52,8 +54,8 @@ Image noisy_image(int w, int h, Truth truth, Sigma sigma, uint32_t seed) {
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
       for (int c = 0; c < 3; ++c) {
-        const float s = sigma(x, y) * tint[c];
-        img.at(x, y, c) = truth(x, y) * tint[c] + s * N(rng);
+        const float s = sigma(x, y) * kTint[c];
+        img.at(x, y, c) = truth(x, y) * kTint[c] + s * N(rng);
         img.var_at(x, y, c) = s * s;
       }
   return img;
@@ -90,6 +92,40 @@ Spread spread(const Image& img, int c, Keep keep) {
   return {m, std::sqrt(std::max(s2 / n - m * m, 0.0)), n};
 }
 
+// The edge tests' image: two noisy halves of levels 1 and 3 (× tint, noise
+// σ = 20 % of each level), 256 rows, the edge between columns 47 and 48.
+constexpr int kEdgeImageWidth = 96, kEdgeImageRows = 256, kEdgeColumn = 48;
+float edge_level(int x) { return x < kEdgeColumn ? 1.0f : 3.0f; }
+Image noisy_edge_image() {
+  return noisy_image(
+      kEdgeImageWidth, kEdgeImageRows, [](int x, int) { return edge_level(x); },
+      [](int x, int) { return 0.2f * edge_level(x); }, 7);
+}
+
+// Every column `edge_width` or more whole pixels from the edge has its mean
+// within 4 standard errors (of the noisy column's mean, σ/√rows) of its
+// side's true value, and every column 8 px or more from it is denoised
+// (spread under a third of the input's). Returns the largest |z| checked.
+double expect_edge_holds(const Image& noisy, const Image& out, int edge_width) {
+  double worst = 0.0;
+  for (int x = 0; x < kEdgeImageWidth; ++x) {
+    const int d = x < kEdgeColumn ? kEdgeColumn - 1 - x : x - kEdgeColumn;  // whole pixels between x and the edge
+    for (int c = 0; c < 3; ++c) {
+      const Spread in = spread(noisy, c, [&](int px, int) { return px == x; });
+      const Spread den = spread(out, c, [&](int px, int) { return px == x; });
+      const double t = edge_level(x) * kTint[c];
+      const double z = (den.mean - t) / (0.2 * t / std::sqrt(double(kEdgeImageRows)));
+      if (d >= edge_width) {
+        EXPECT_LT(std::abs(z), 4.0) << "column " << x << " (" << d << " px from the edge) channel " << c << ": "
+                                    << den.mean << " vs " << t;
+        worst = std::max(worst, std::abs(z));
+      }
+      if (d >= 8) EXPECT_LT(den.sd, in.sd / 3.0) << "column " << x << " channel " << c;
+    }
+  }
+  return worst;
+}
+
 }  // namespace
 
 // A 96×96 emissive square (value 2 · tint, noise σ = 20 % of it) on a black,
@@ -109,10 +145,9 @@ TEST_F(DenoiseGpu, FlatSquareStaysFlatAtItsValue) {
   EXPECT_FALSE(out.has_variance());
   ASSERT_TRUE(out.has_alpha());
   auto interior = [&](int x, int y) { return x >= lo + 4 && x < hi - 4 && y >= lo + 4 && y < hi - 4; };
-  const float tint[3] = {1.0f, 0.8f, 0.6f};
   for (int c = 0; c < 3; ++c) {
     const Spread in = spread(noisy, c, interior), den = spread(out, c, interior);
-    const double truth = 2.0 * tint[c], se = in.sd / std::sqrt(double(in.n));
+    const double truth = 2.0 * kTint[c], se = in.sd / std::sqrt(double(in.n));
     EXPECT_LT(den.sd, 0.2 * in.sd) << "channel " << c << ": spread " << den.sd << " vs input " << in.sd;
     EXPECT_LT(std::abs(den.mean - truth), 4.0 * se) << "channel " << c << ": mean " << den.mean << " vs " << truth;
     EXPECT_LT(se, 0.005 * truth / 2.0) << "not informative at 0.5 %";
@@ -128,7 +163,7 @@ TEST_F(DenoiseGpu, FlatSquareStaysFlatAtItsValue) {
       const int d = std::max({lo - x, x - (hi - 1), lo - y, y - (hi - 1)});  // px outside the square
       if (d <= 0) continue;
       for (int c = 0; c < 3; ++c)
-        ASSERT_LT(std::abs(out.at(x, y, c)), (d >= 10 ? 1e-4f : 0.02f) * 2.0f * tint[c]) << x << "," << y;
+        ASSERT_LT(std::abs(out.at(x, y, c)), (d >= 10 ? 1e-4f : 0.02f) * 2.0f * kTint[c]) << x << "," << y;
       ASSERT_FLOAT_EQ(out.alpha[size_t(y) * w + x], 1.0f);
     }
 }
@@ -138,27 +173,10 @@ TEST_F(DenoiseGpu, FlatSquareStaysFlatAtItsValue) {
 // errors (of the noisy column's mean, σ/√rows) of its side's true value, and
 // is denoised (spread under a third of the input's from 8 px on).
 TEST_F(DenoiseGpu, SharpEdgeStaysSharp) {
-  const int w = 96, h = 256, edge = 48, kEdgeWidth = 4;
-  auto truth = [&](int x, int) { return x < edge ? 1.0f : 3.0f; };
-  Image noisy = noisy_image(w, h, truth, [&](int x, int y) { return 0.2f * truth(x, y); }, 7);
-  Image out = denoiser_->run(noisy, tested());
-  double worst = 0.0;
-  for (int x = 0; x < w; ++x) {
-    const int d = x < edge ? edge - 1 - x : x - edge;  // whole pixels between x and the edge
-    for (int c = 0; c < 3; ++c) {
-      const Spread in = spread(noisy, c, [&](int px, int) { return px == x; });
-      const Spread den = spread(out, c, [&](int px, int) { return px == x; });
-      const double t = truth(x, 0) * (c == 0 ? 1.0 : c == 1 ? 0.8 : 0.6);
-      const double z = (den.mean - t) / (0.2 * t / std::sqrt(double(h)));
-      if (d >= kEdgeWidth) {
-        EXPECT_LT(std::abs(z), 4.0) << "column " << x << " (" << d << " px from the edge) channel " << c << ": "
-                                    << den.mean << " vs " << t;
-        worst = std::max(worst, std::abs(z));
-      }
-      if (d >= 8) EXPECT_LT(den.sd, in.sd / 3.0) << "column " << x << " channel " << c;
-    }
-  }
-  RecordProperty("worst_z_beyond_edge_width", std::to_string(worst));
+  constexpr int kEdgeWidth = 4;
+  const Image noisy = noisy_edge_image();
+  const Image out = denoiser_->run(noisy, tested());
+  RecordProperty("worst_z_beyond_edge_width", std::to_string(expect_edge_holds(noisy, out, kEdgeWidth)));
 }
 
 // Two surfaces of the same noisy brightness level... almost: 1 and 1.3 (noise
@@ -226,7 +244,6 @@ void add_guided_aovs(Image& img, Layer layer, const std::vector<float>& truth) {
 // close to the square.
 TEST_F(DenoiseGpu, GuidedFlatSquareStaysFlatAtItsValue) {
   const int w = 128, h = 128, lo = 16, hi = 112;
-  const float tint[3] = {1.0f, 0.8f, 0.6f};
   auto inside = [&](int x, int y) { return x >= lo && x < hi && y >= lo && y < hi; };
   Image noisy = noisy_image(
       w, h, [&](int x, int y) { return inside(x, y) ? 2.0f : 0.0f; },
@@ -234,13 +251,13 @@ TEST_F(DenoiseGpu, GuidedFlatSquareStaysFlatAtItsValue) {
   std::vector<float> truth(noisy.pixel_count() * 3);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      for (int c = 0; c < 3; ++c) truth[noisy.index(x, y, c)] = inside(x, y) ? 2.0f * tint[c] : 0.0f;
+      for (int c = 0; c < 3; ++c) truth[noisy.index(x, y, c)] = inside(x, y) ? 2.0f * kTint[c] : 0.0f;
   add_guided_aovs(noisy, Layer::Emission, truth);
   const Image out = denoiser_->run(noisy, DenoiseOptions{});
   auto interior = [&](int x, int y) { return x >= lo + 4 && x < hi - 4 && y >= lo + 4 && y < hi - 4; };
   for (int c = 0; c < 3; ++c) {
     const Spread in = spread(noisy, c, interior), den = spread(out, c, interior);
-    const double t = 2.0 * tint[c], se = in.sd / std::sqrt(double(in.n));
+    const double t = 2.0 * kTint[c], se = in.sd / std::sqrt(double(in.n));
     EXPECT_LT(den.sd, 0.2 * in.sd) << "channel " << c << ": spread " << den.sd << " vs input " << in.sd;
     EXPECT_LT(std::abs(den.mean - t), 4.0 * se) << "channel " << c << ": mean " << den.mean << " vs " << t;
     RecordProperty("guided_spread_ratio_" + std::to_string(c), std::to_string(den.sd / in.sd));
@@ -259,36 +276,18 @@ TEST_F(DenoiseGpu, GuidedFlatSquareStaysFlatAtItsValue) {
 // filter's edge (SharpEdgeStaysSharp). Both are denoised from 8 px on
 // (spread under a third of the input's).
 TEST_F(DenoiseGpu, GuidedSharpEdgeStaysSharp) {
-  const int w = 96, h = 256, edge = 48;
-  const float tint[3] = {1.0f, 0.8f, 0.6f};
-  auto truth = [&](int x, int) { return x < edge ? 1.0f : 3.0f; };
   for (const Layer layer : {Layer::Emission, Layer::Surface}) {
     const int edge_width = layer == Layer::Emission ? 0 : 4;
     SCOPED_TRACE(layer == Layer::Emission ? "emission" : "surface");
-    Image noisy = noisy_image(w, h, truth, [&](int x, int y) { return 0.2f * truth(x, y); }, 7);
+    Image noisy = noisy_edge_image();
     std::vector<float> exact(noisy.pixel_count() * 3);
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x)
-        for (int c = 0; c < 3; ++c) exact[noisy.index(x, y, c)] = truth(x, y) * tint[c];
+    for (int y = 0; y < noisy.height; ++y)
+      for (int x = 0; x < noisy.width; ++x)
+        for (int c = 0; c < 3; ++c) exact[noisy.index(x, y, c)] = edge_level(x) * kTint[c];
     add_guided_aovs(noisy, layer, exact);
     const Image out = denoiser_->run(noisy, DenoiseOptions{});
-    double worst = 0.0;
-    for (int x = 0; x < w; ++x) {
-      const int d = x < edge ? edge - 1 - x : x - edge;
-      for (int c = 0; c < 3; ++c) {
-        const Spread in = spread(noisy, c, [&](int px, int) { return px == x; });
-        const Spread den = spread(out, c, [&](int px, int) { return px == x; });
-        const double t = truth(x, 0) * tint[c];
-        const double z = (den.mean - t) / (0.2 * t / std::sqrt(double(h)));
-        if (d >= edge_width) {
-          EXPECT_LT(std::abs(z), 4.0) << "column " << x << " (" << d << " px from the edge) channel " << c << ": "
-                                      << den.mean << " vs " << t;
-          worst = std::max(worst, std::abs(z));
-        }
-        if (d >= 8) EXPECT_LT(den.sd, in.sd / 3.0) << "column " << x << " channel " << c;
-      }
-    }
-    RecordProperty(std::string(layer == Layer::Emission ? "emission" : "surface") + "_worst_z", std::to_string(worst));
+    RecordProperty(std::string(layer == Layer::Emission ? "emission" : "surface") + "_worst_z",
+                   std::to_string(expect_edge_holds(noisy, out, edge_width)));
   }
 }
 
