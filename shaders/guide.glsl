@@ -33,7 +33,7 @@ void guide_media(vec3 o, vec3 d, float t_end, vec2 span[MEDIA_N], inout vec3 L, 
   for (uint n = 0u; n < GUIDE_MAX_STEPS && t < t1; ++n) {
     float t_next;
     bool ahead;
-    const float majorant = majorant_at(o, d, t, span, t_next, ahead);
+    const float majorant = majorant_at(o, d, t, span, false, t_next, ahead);
     if (!ahead) break;
     t_next = min(t_next, t1);
     if (!(majorant > 0.0)) {  // nothing here up to t_next

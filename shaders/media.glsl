@@ -108,7 +108,11 @@ void media_spans(vec3 o, vec3 d, out vec2 span[MEDIA_N], out bool any_hit) {
 // Majorant of grid medium m over the DDA cell the ray is in at t, and the t at
 // which the ray leaves that cell. Stateless: the cell is found at t + a small
 // nudge along the ray, so a point on a face belongs to the cell being entered.
-float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, float t_span_end, inout float t_next) {
+// With `line` and the grid's line rates (the line estimator; docs/rendering.md
+// "Emission estimators"): the larger of the density majorant and the cell's
+// rate, so the tentative collisions, where the collision estimator collects
+// emission, come at least as often as the emission asks for.
+float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, float t_span_end, bool line, inout float t_next) {
   uint slot = m.grid_slot;
   vec3 u = density_texel(slot, o + t * d);
   vec3 du = density_texel_dir(slot, d);
@@ -124,11 +128,14 @@ float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, float t_span_end, inou
   vec3 bound = (vec3(cell) + step(vec3(0.0), du)) * cs;
   vec3 tx = (bound - u) * inv_du;  // ±inf on axes the ray runs parallel to
   vec3 t_axis = t + mix(tx, vec3(INF), isnan(tx));  // where the ray crosses each axis' next face
-  uint index = offset + uint((cell.z * res.y + cell.y) * res.x + cell.x);
+  const uint local = uint((cell.z * res.y + cell.y) * res.x + cell.x);
+  uint index = offset + local;
   float majorant = majorants[index];
   if (majorant > 0.0) {
     t_next = min(t_next, max(min3(t_axis), t + min_step));
-    return majorant * grids[slot].majorant_scale;
+    const float sigma_bar = majorant * grids[slot].majorant_scale;
+    const uint rates = grids[slot].line_rate_offset;
+    return line && rates != 0u ? max(sigma_bar, majorants[rates + local]) : sigma_bar;
   }
   // An empty cell: walk the DDA on to the first non-empty cell (or out of the
   // grid) right here, so a run of empty cells costs one tracking step.
@@ -193,8 +200,9 @@ vec3 emission_at(vec3 x, float t, vec2 span[MEDIA_N], float rho[MEDIA_N], float 
   return E;
 }
 
-// Local majorant over [t, t_next): sum over the media present of their bound.
-float majorant_at(vec3 o, vec3 d, float t, vec2 span[MEDIA_N], out float t_next, out bool any_ahead) {
+// Local majorant over [t, t_next): sum over the media present of their bound
+// (with `line`, grids' line rates included: grid_majorant).
+float majorant_at(vec3 o, vec3 d, float t, vec2 span[MEDIA_N], bool line, out float t_next, out bool any_ahead) {
   float sigma_bar = 0.0;
   t_next = INF;
   any_ahead = false;
@@ -208,8 +216,13 @@ float majorant_at(vec3 o, vec3 d, float t, vec2 span[MEDIA_N], out float t_next,
     }
     t_next = min(t_next, s.y);
     GpuMedium m = media[i];
-    if (is_grid(m)) sigma_bar += grid_majorant(m, o, d, t, s.y, t_next);
-    else sigma_bar += max3(m.sigma_a + m.sigma_s);
+    if (is_grid(m)) sigma_bar += grid_majorant(m, o, d, t, s.y, line, t_next);
+    else {
+      // A homogeneous medium's line rate: line_points along the ray's chord through it.
+      const float chord = s.y - max(s.x, 0.0);
+      const float sigma_t = max3(m.sigma_a + m.sigma_s);
+      sigma_bar += line && m.line_points > 0.0 && chord > 0.0 ? max(sigma_t, m.line_points / chord) : sigma_t;
+    }
   }
   return sigma_bar;
 }

@@ -17,7 +17,7 @@ vec3 transmittance(vec3 o, vec3 d, bool ratio, inout uint rng, inout PathStats s
   for (;;) {
     float t_next;
     bool any_ahead;
-    float sigma_bar = majorant_at(o, d, t, span, t_next, any_ahead);
+    float sigma_bar = majorant_at(o, d, t, span, false, t_next, any_ahead);
     if (!any_ahead || isinf(t_next)) return T;
     if (sigma_bar <= 0.0) { t = t_next; continue; }
     float dt = sample_free_flight(sigma_bar, rng_next(rng));
@@ -85,7 +85,7 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
     if (event == EVENT_NONE) do {
       float t_next;
       bool any_ahead;
-      sigma_bar = majorant_at(p.o, p.d, p.t, span, t_next, any_ahead);
+      sigma_bar = majorant_at(p.o, p.d, p.t, span, COLLISION_ESTIMATOR, t_next, any_ahead);
       if (!any_ahead) t_next = INF;
       // Media beyond the closest surface do not matter: free flights end there.
       const float t_surface = p.has_hit ? p.hit.t : INF;
@@ -107,7 +107,8 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
       x = p.o + p.t * p.d;
       coefficients_at(x, p.t, span, sigma_a, sigma_s, rho, temperature_value, stats);
       if (HAS_EMISSION && COLLISION_ESTIMATOR && !p.skip_segment) {
-        // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision.
+        // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision;
+        // the line estimator is this one with sigma_bar raised to the line rates (grid_majorant).
         // With next-event estimation the ray's own MIS weight (light rays: 1). A skipped
         // segment (ratio-tracked continuation) was already collected: no lookup.
         vec3 e = emission_at(x, p.t, span, rho, temperature_value);

@@ -36,7 +36,8 @@ LightCandidates light_candidates(const Scene& scene) {
   return c;
 }
 
-LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs) {
+LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs,
+                             bool thin_emission) {
   const Integrator& in = scene.integrator;
   if (const std::optional<IntegratorConflict> c = integrator_conflict(in, !scene.lights.empty()))
     throw std::invalid_argument("integrator." + c->key + ": " + c->reason);
@@ -68,8 +69,9 @@ LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, cons
     if (power[i] > 0.0) s.p_light[i] = distant ? far_share * power[i] / far_power : near_share * power[i] / near_power;
   }
   s.strategy = !s.any() ? LightStrategy::Bsdf : (in.light_only ? LightStrategy::LightOnly : LightStrategy::Mis);
-  s.estimator = in.emission_estimator.value_or(s.strategy == LightStrategy::Bsdf ? EmissionEstimator::Absorption
-                                                                                 : EmissionEstimator::Collision);
+  s.estimator = in.emission_estimator.value_or(thin_emission                     ? EmissionEstimator::Line
+                                               : s.strategy == LightStrategy::Bsdf ? EmissionEstimator::Absorption
+                                                                                   : EmissionEstimator::Collision);
   s.p_continue_own =
       s.strategy == LightStrategy::Bsdf ? 1.0 : 1.0 - in.guided_continuation.value_or(1.0 - kContinueOwn);
   s.surface_light_samples = s.strategy == LightStrategy::Bsdf ? 1 : in.surface_light_samples;

@@ -55,7 +55,8 @@ struct LightSelection {
   std::vector<double> p_light;
   LightStrategy strategy = LightStrategy::Bsdf;
   // What both backends render with: the file's estimator, or for "auto" the
-  // collision estimator with light sampling (what MIS is written for) and
+  // line estimator where a medium's emission is thin (emission_is_thin), else
+  // the collision estimator with light sampling (what MIS is written for) and
   // the absorption estimator without (the fastest for BSDF/phase sampling).
   EmissionEstimator estimator = EmissionEstimator::Absorption;
   // With next-event estimation, the probability that a vertex's continuation
@@ -99,9 +100,11 @@ struct LightSelection {
 //
 // Strategy: Mis (LightOnly with integrator.light_only) when at least one light
 // is sampled, otherwise Bsdf. Estimator: as the file says, "auto" resolved by
-// the strategy. Throws std::invalid_argument for integrator keys that
+// thin_emission (some medium's emission_is_thin, host/render/LineEstimator.h)
+// and the strategy. Throws std::invalid_argument for integrator keys that
 // contradict each other (integrator_conflict; the loader refuses such files).
-LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs);
+LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs,
+                             bool thin_emission = false);
 
 // Power heuristic, β = 2 (Veach 1997, eq. 9.13), for the strategy with pdf
 // p_this against p_other; 1 when p_other is 0.

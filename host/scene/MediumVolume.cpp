@@ -2,7 +2,15 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "color/Blackbody.h"
+
 namespace pyrolume {
+
+glm::dvec3 homogeneous_le(const Emission& e) {
+  if (e.rgb) return *e.rgb * e.scale;
+  if (e.temperature_k) return color::blackbody_rgb(*e.temperature_k, e.blackbody, e.observer, e.adapt_to_k) * e.scale;
+  return glm::dvec3(0.0);
+}
 
 glm::dmat4 medium_transform_matrix(const Transform& t) {
   glm::dmat4 M(1.0);

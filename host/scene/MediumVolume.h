@@ -14,6 +14,10 @@ namespace pyrolume {
 // then rotate about X, Y, Z (degrees, right-handed), then translate.
 glm::dmat4 medium_transform_matrix(const Transform& t);
 
+// A homogeneous medium's emitted radiance Le: emission.scale times its rgb or
+// the blackbody colour of its temperature_k (0 without either).
+glm::dvec3 homogeneous_le(const Emission& e);
+
 // Whether a medium's emission needs its temperature grid.
 bool needs_temperature_grid(const Medium& m);
 

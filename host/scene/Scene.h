@@ -84,14 +84,17 @@ struct Film {
   bool aovs = false;
 };
 
-// How emission in media is collected: at absorptions only, or at every
-// tentative collision (docs/rendering.md "Emission estimators").
-enum class EmissionEstimator { Absorption, Collision };
+// How emission in media is collected: at absorptions only, at every
+// tentative collision, or at tentative collisions plus points along the ray
+// at a rate set by the emission (docs/rendering.md "Emission estimators").
+enum class EmissionEstimator { Absorption, Collision, Line };
 // Per-cell majorants walked by DDA, or one bound per grid (integrator.majorant).
 enum class Majorant { Grid, Global };
 
 // Their names in the scene file and in --stats.
-inline const char* to_string(EmissionEstimator e) { return e == EmissionEstimator::Collision ? "collision" : "absorption"; }
+inline const char* to_string(EmissionEstimator e) {
+  return e == EmissionEstimator::Line ? "line" : e == EmissionEstimator::Collision ? "collision" : "absorption";
+}
 inline const char* to_string(Majorant m) { return m == Majorant::Global ? "global" : "grid"; }
 
 struct Integrator {
@@ -110,7 +113,8 @@ struct Integrator {
   // Debug: next-event estimation only, no BSDF/phase-found light (docs/mis.md);
   // asks for light sampling as "mis": true does.
   bool light_only = false;
-  // The file's "absorption" | "collision"; unset: "auto", which is
+  // The file's "absorption" | "collision" | "line"; unset: "auto", which is
+  // line where a medium's emission is thin (host/render/LineEstimator.h), else
   // collision where lights are sampled (what MIS needs), otherwise absorption.
   // LightSelection::estimator is the value a render uses.
   std::optional<EmissionEstimator> emission_estimator;

@@ -513,7 +513,8 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
     s.integrator.ratio_tracked_continuation =
         i.boolean("ratio_tracked_continuation", s.integrator.ratio_tracked_continuation);
     s.integrator.emission_estimator = i.optional_choice(
-        "emission_estimator", "auto", {EmissionEstimator::Absorption, EmissionEstimator::Collision}, "auto");
+        "emission_estimator", "auto",
+        {EmissionEstimator::Absorption, EmissionEstimator::Collision, EmissionEstimator::Line}, "auto");
     if (const std::optional<IntegratorConflict> c = integrator_conflict(s.integrator)) i.fail(c->key, c->reason);
     s.integrator.majorant = i.enum_choice("majorant", Majorant::Grid, {Majorant::Grid, Majorant::Global});
     if (i.has("majorant_grid")) {

@@ -123,7 +123,7 @@ struct GpuMedium {
   vec3 box_min;        // box
   uint grid_slot;      // grid: its GpuGrid, textures and emission light
   vec3 box_max;        // box
-  float unused;
+  float line_points;   // homogeneous, with the line estimator: collection points per chord (host/render/LineEstimator.h), else 0
 };
 
 // A grid medium's textures and majorant grid (192 bytes). "Texel coordinates"
@@ -148,7 +148,10 @@ struct GpuGrid {
   float lut_scale;  // the blackbody LUT's coordinate s = ln(T)·lut_scale + lut_offset
   float lut_offset;
   float t_min_k;    // the LUT's lower end: no emission below
-  float unused2;
+  // With the line estimator: cell (0,0,0)'s index in the majorant buffer of
+  // the line rates (host/render/LineEstimator.h), per unit world length; 0:
+  // this grid's emission is collected at its density majorant's collisions.
+  uint line_rate_offset;
   uvec3 majorant_res;     // cells
   uint majorant_offset;   // cell (0,0,0)'s index in the majorant buffer
   vec3 majorant_cell;     // cell size in texels
@@ -277,7 +280,7 @@ static_assert(sizeof(GpuMedium) == 96);
 PYRO_OFFSET(GpuMedium, shape, 12); PYRO_OFFSET(GpuMedium, sigma_s, 16); PYRO_OFFSET(GpuMedium, g, 28);
 PYRO_OFFSET(GpuMedium, emission, 32); PYRO_OFFSET(GpuMedium, emission_mode, 44); PYRO_OFFSET(GpuMedium, center, 48);
 PYRO_OFFSET(GpuMedium, radius, 60); PYRO_OFFSET(GpuMedium, box_min, 64); PYRO_OFFSET(GpuMedium, grid_slot, 76);
-PYRO_OFFSET(GpuMedium, box_max, 80); PYRO_OFFSET(GpuMedium, unused, 92);
+PYRO_OFFSET(GpuMedium, box_max, 80); PYRO_OFFSET(GpuMedium, line_points, 92);
 static_assert(sizeof(GpuGrid) == 192);
 PYRO_OFFSET(GpuGrid, density_row1, 16); PYRO_OFFSET(GpuGrid, density_row2, 32);
 PYRO_OFFSET(GpuGrid, density_dims, 48); PYRO_OFFSET(GpuGrid, density_scale, 60);
@@ -286,7 +289,7 @@ PYRO_OFFSET(GpuGrid, temperature_row2, 96); PYRO_OFFSET(GpuGrid, temperature_dim
 PYRO_OFFSET(GpuGrid, unused0, 124); PYRO_OFFSET(GpuGrid, temperature_offset, 128);
 PYRO_OFFSET(GpuGrid, temperature_scale, 132); PYRO_OFFSET(GpuGrid, cutoff_k, 136); PYRO_OFFSET(GpuGrid, unused1, 140);
 PYRO_OFFSET(GpuGrid, lut_scale, 144); PYRO_OFFSET(GpuGrid, lut_offset, 148); PYRO_OFFSET(GpuGrid, t_min_k, 152);
-PYRO_OFFSET(GpuGrid, unused2, 156); PYRO_OFFSET(GpuGrid, majorant_res, 160);
+PYRO_OFFSET(GpuGrid, line_rate_offset, 156); PYRO_OFFSET(GpuGrid, majorant_res, 160);
 PYRO_OFFSET(GpuGrid, majorant_offset, 172); PYRO_OFFSET(GpuGrid, majorant_cell, 176);
 PYRO_OFFSET(GpuGrid, majorant_scale, 188);
 static_assert(sizeof(FrameConstants) == 128);

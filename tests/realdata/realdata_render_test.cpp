@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "backends/Backends.h"
+#include "render/SceneSetup.h"
 #include "render/cpu/CpuRenderer.h"
 #include "scene/MediumVolume.h"
 #include "support/AnalyticScenes.h"
@@ -163,6 +164,25 @@ TEST_F(RealRender, Blender279FireWithHeat) {
   s.integrator.max_depth = 4;
   s.integrator.emission_estimator = EmissionEstimator::Collision;
   compare(s, 4096, 1536, "blender 2.79 fire");
+}
+
+// The thin, hot version of the same fire as a user writes it (issue 23):
+// density ×0.02, emission ×100, everything else the file's and the scene
+// defaults', camera framed automatically. "auto" picks the line estimator on
+// both backends, and they agree pixel by pixel.
+TEST_F(RealRender, ThinHotBlenderFireWithTheDefaultEstimator) {
+  const std::string text = R"({"media": [{"type": "vdb", "file": ")" +
+                           (dir / "blender279_fire_frame075.vdb").string() +
+                           R"(", "density_scale": 0.02, "emission": {"scale": 100}}],
+                              "film": {"width": 32, "height": 48}})";
+  Scene s = parse_scene(text, "thin_fire.json");
+  complete_scene(s, 0, true);
+  s.film.spp = 64;
+  const RenderResult g = backend_->render(s, settings_for(s), {});
+  EXPECT_EQ(g.emission_estimator, "line");
+  CpuRenderer cpu;
+  EXPECT_EQ(cpu.render(s, RenderSettings{.width = 4, .height = 4, .spp = 1}, {}).emission_estimator, "line");
+  compare(s, 2048, 1024, "thin hot blender 2.79 fire, default estimator");
 }
 
 // Blender 5.0 Mantaflow smoke, tiny (14×14×15 active voxels), z up, all

@@ -100,6 +100,34 @@ inline Scene absorbing_box_scene(int width = 40, int height = 32, int spp = 1024
   return s;
 }
 
+// Thin, hot media (issue 23): σa·d ≪ 1 with Le large, so L ≈ Le·σa·d comes
+// from emission the collision estimator would rarely meet. The integrator is
+// left at "auto", which must pick the line estimator (docs/rendering.md).
+// (e) A sphere, σa·2r = 0.004 … 0.016, chromatic.
+inline Scene thin_sphere_scene(int width = 40, int height = 32, int spp = 256) {
+  Scene s = analytic_base_scene(width, height, spp);
+  s.background = {0.05, 0.1, 0.2};
+  s.media.push_back(homogeneous_sphere("flame", {-0.4, 0.3, 0.0}, 1.0, {0.002, 0.004, 0.008}, {0, 0, 0}, 0.0,
+                                       glm::dvec3(1.0, 0.6, 0.3), 200.0));
+  return s;
+}
+
+// (f) A slab 0.1 thick across the view, seen a little obliquely (σa·d = 0.002 …
+// 0.005 along the normal); or, with optical_depth, the same slab at σa·d =
+// optical_depth per channel and Le = 1/optical_depth (L ≈ 1).
+inline Scene thin_slab_scene(int width = 40, int height = 32, int spp = 256, double optical_depth = 0.0) {
+  Scene s = analytic_base_scene(width, height, spp);
+  s.camera.position = {0.6, 0.4, -5.0};
+  s.camera.look_at = {0.0, 0.0, 0.0};
+  s.background = {0.15, 0.05, 0.02};
+  const double d = 0.1;
+  const glm::dvec3 sigma_a = optical_depth > 0.0 ? glm::dvec3(optical_depth / d) : glm::dvec3(0.02, 0.03, 0.05);
+  const double scale = optical_depth > 0.0 ? 1.0 / optical_depth : 500.0;
+  s.media.push_back(homogeneous_box("slab", {-1.5, -1.0, -0.5 * d}, {1.2, 1.1, 0.5 * d}, sigma_a, {0, 0, 0}, 0.0,
+                                    glm::dvec3(1.0, 0.8, 0.6), scale));
+  return s;
+}
+
 // A scattering, absorbing, emissive sphere rendered with max_depth = 0: every
 // path that would scatter ends with 0, so scattering acts as pure extinction and
 // single_collision_exact() holds with σt = σa + σs.

@@ -71,6 +71,33 @@ TEST_P(Analytic, TransparentSphereRgbAndAlphaMatchClosedForms) {
   EXPECT_FALSE(wrong.ok) << wrong.summary();
 }
 
+// Thin, hot media with the scene's default estimator ("auto": the line
+// estimator, which each backend reports).
+TEST_P(Analytic, ThinEmissiveSphereMatchesClosedFormByDefault) {
+  const Scene s = thin_sphere_scene();
+  EXPECT_EQ(render(thin_sphere_scene(8, 8, 1)).emission_estimator, "line");
+  expect_single_collision_closed_form(s);
+}
+
+TEST_P(Analytic, ThinEmissiveSlabMatchesClosedFormByDefault) {
+  const Scene s = thin_slab_scene();
+  EXPECT_EQ(render(thin_slab_scene(8, 8, 1)).emission_estimator, "line");
+  expect_single_collision_closed_form(s);
+}
+
+// The hard case: optical depth 1e-6 across the slab, emission 1e6 (L ≈ 1).
+// One camera ray in a million would meet a collision.
+TEST_P(Analytic, OpticalDepthOneInAMillionWithEmissionOfAMillion) {
+  const Scene s = thin_slab_scene(40, 32, 64, 1e-6);
+  RenderResult r = render(s);
+  EXPECT_EQ(r.emission_estimator, "line");
+  EXPECT_EQ(r.nonfinite_samples, 0u);
+  ZTestReport rep = ztest_against_exact(r, single_collision_exact(s), pooled());
+  EXPECT_TRUE(rep.ok) << rep.summary();
+  EXPECT_LE(rep.se_bias, 0.0025) << rep.summary();
+  std::printf("%s\n", rep.summary().c_str());
+}
+
 TEST_P(Analytic, MaxDepthZeroTreatsScatteringAsExtinction) {
   Scene s = depth0_sphere_scene();
   RenderResult r = render(s);

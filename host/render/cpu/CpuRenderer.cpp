@@ -21,6 +21,7 @@
 #include "light/EnvironmentMap.h"
 #include "light/LightSelection.h"
 #include "render/Limits.h"
+#include "render/LineEstimator.h"
 #include "render/SceneChecks.h"
 #include "render/cpu/Intersect.h"
 #include "render/cpu/Media.h"
@@ -199,6 +200,24 @@ double emitted_at(const MediaData& md, int c, const glm::dvec3& x, Scratch& s) {
     e += m.is_vdb() ? grid_sigma_a_Le(m, i, c, x, s.rho[j], s.Le_cache) : m.sigma_a_Le[c];
   }
   return e;
+}
+
+// The line estimator's second process (walk_channel), this reference's own
+// rule, not the GPU's per-cell rates: in a grid medium a point every
+// 1/kLinePointsPerVoxel voxels on average, over the whole medium; in a
+// homogeneous one kLinePointsPerWidth across its smallest extent.
+constexpr double kLinePointsPerVoxel = 0.25, kLinePointsPerWidth = 8.0;
+double line_rate(const MediumData& m) {
+  if (!m.is_vdb()) {
+    const glm::dvec3 e = m.bounds.max - m.bounds.min;
+    const double width = m.bounds.kind == Bounds::Kind::Sphere ? 2.0 * m.bounds.radius : std::min({e.x, e.y, e.z});
+    return width > 0.0 ? kLinePointsPerWidth / width : 0.0;
+  }
+  if (!m.volume || m.volume->density.grid.empty()) return 0.0;
+  const glm::dmat4& to_world = m.volume->density.grid.index_to_world;
+  const double voxel = std::min({glm::length(glm::dvec3(to_world[0])), glm::length(glm::dvec3(to_world[1])),
+                                 glm::length(glm::dvec3(to_world[2]))});
+  return kLinePointsPerVoxel / voxel;
 }
 
 // The MIS state of the ray being tracked (docs/mis.md): the solid-angle pdf
@@ -593,14 +612,29 @@ double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg3
       const double b = std::min(s.cuts[k + 1], t_surf);
       const double sigma_maj = media_present(md, s.spans, a, s.cuts[k + 1], c, s.present);
       if (!(sigma_maj > 0.0)) continue;
+      // The line estimator's second process of collection points, of rate
+      // line_rate; each point of either process collects 1/(σ̄ + line_rate).
+      double line_rate = 0.0;
+      if (collision_estimator)
+        for (const int i : s.present) line_rate += md.media[i].line_rate;
+      const double collect_rate = sigma_maj + line_rate;
       for (double t = a;;) {
-        t += sample_free_flight(sigma_maj, rng.uniform());
+        const double t_flight = t + sample_free_flight(sigma_maj, rng.uniform());
+        // The path is alive on [t, t_flight): collect there.
+        if (line_rate > 0.0 && w_ray > 0.0)
+          for (double t_line = t + sample_free_flight(line_rate, rng.uniform()); t_line < std::min(t_flight, b);
+               t_line += sample_free_flight(line_rate, rng.uniform())) {
+            double sigma_a, sigma_s;
+            coefficients_at(md, c, o + t_line * d, s, cnt, sigma_a, sigma_s);
+            if (sigma_a > 0.0) L += beta * w_ray * emitted_at(md, c, o + t_line * d, s) / collect_rate;
+          }
+        t = t_flight;
         if (!(t < b)) break;  // memoryless: restart the flight at b
         const glm::dvec3 x = o + t * d;
         double sigma_a, sigma_s;
         coefficients_at(md, c, x, s, cnt, sigma_a, sigma_s);
         if (exceeds_majorant(sigma_a + sigma_s, sigma_maj)) ++cnt.majorant_violations;
-        if (collision_estimator && sigma_a > 0.0) L += beta * w_ray * emitted_at(md, c, x, s) / sigma_maj;
+        if (collision_estimator && sigma_a > 0.0) L += beta * w_ray * emitted_at(md, c, x, s) / collect_rate;
         if (role == WalkRole::LightRay) {
           beta *= std::max(0.0, 1.0 - (sigma_a + sigma_s) / sigma_maj);
           if (beta < kRatioTrackingRouletteBelow) {
@@ -911,7 +945,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   // and one copy of them for a checkpoint.
   check_accumulation_fits_memory(scene.file.string(), settings.width, settings.height, 3 * 8 * sizeof(double));
   check_scene_ranges(scene);
-  const MediaData media = prepare_media(scene);  // loads the vdb media's grids
+  MediaData media = prepare_media(scene);  // loads the vdb media's grids
   for (size_t i = 0; i < media.media.size(); ++i)
     if (media.media[i].volume) check_loaded_medium(scene, i, *media.media[i].volume);
   const geometry::Surfaces surfaces = geometry::build_surfaces(scene);  // meshes, textures, BVH
@@ -936,7 +970,14 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
         cdfs[i] = EmissionCdf::build_light(scene.media[i], *media.media[i].volume);
         if (!cdfs[i]->empty()) lights.cdf[i] = &*cdfs[i];
       }
-  lights.selection = select_lights(scene, environment ? &*environment : nullptr, lights.cdf);
+  // The media the line estimator collects (the file's "line", or "auto"'s choice).
+  std::vector<const StoredVolume*> volumes(scene.media.size(), nullptr);
+  for (size_t i = 0; i < scene.media.size(); ++i) volumes[i] = media.media[i].volume.get();
+  const std::vector<bool> line = line_media(scene, volumes);
+  lights.selection = select_lights(scene, environment ? &*environment : nullptr, lights.cdf,
+                                   std::find(line.begin(), line.end(), true) != line.end());
+  for (size_t i = 0; i < scene.media.size(); ++i)
+    if (line[i]) media.media[i].line_rate = line_rate(media.media[i]);
   for (const Light& l : scene.lights) {
     AnalyticLight a;
     a.light = l;
@@ -949,7 +990,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
     if (l.type == Light::Type::Spot) a.cone = spot_cone(l);
     lights.analytic.push_back(a);
   }
-  const bool collision_estimator = lights.selection.estimator == EmissionEstimator::Collision;
+  const bool collision_estimator = lights.selection.estimator != EmissionEstimator::Absorption;
   const WalkScene walk_scene{media,     surfaces,           environment ? &*environment : nullptr, scene.background,
                              max_depth, collision_estimator, lights, scene.film.transparent};
   RenderResult res;

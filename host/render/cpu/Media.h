@@ -50,6 +50,10 @@ struct MediumData {
   bool emits_temperature = false;  // Le from the temperature grid
   TemperatureMapping temperature;
   Emission emission;
+  // With the line estimator (docs/rendering.md "Emission estimators"): the
+  // rate, per unit length, of the points at which the walk collects this
+  // medium's emission besides its tentative collisions; 0: collisions only.
+  double line_rate = 0.0;
 
   bool is_vdb() const { return type == Medium::Type::Vdb; }
 };

@@ -4,6 +4,7 @@
 
 #include "color/Blackbody.h"
 #include "color/EmissionModel.h"
+#include "render/LineEstimator.h"
 #include "scene/MediumVolume.h"
 #include "util/Error.h"
 #include "volume/MajorantGrid.h"
@@ -16,12 +17,6 @@ static_assert(kMaxEmittedRadiance == gpu::MAX_EMITTED_RADIANCE);
 namespace {
 gpu::vec3 v3(glm::dvec3 v) { return gpu::vec3(float(v.x), float(v.y), float(v.z)); }
 double max3(glm::dvec3 v) { return std::max(v.x, std::max(v.y, v.z)); }
-
-glm::dvec3 homogeneous_le(const Emission& e) {
-  if (e.rgb) return *e.rgb * e.scale;
-  if (e.temperature_k) return color::blackbody_rgb(*e.temperature_k, e.blackbody, e.observer, e.adapt_to_k) * e.scale;
-  return glm::dvec3(0.0);
-}
 
 // Rows of the affine world -> texel map: u = index − origin + 0.5 (texel i's
 // centre, OpenVDB's integer index point, sits at u = i + 0.5).
@@ -168,12 +163,17 @@ bool every_temperature_fits_density(const std::vector<GpuGridSource>& sources, u
 }
 }  // namespace
 
-GpuScene pack_gpu_media(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes, bool with_luts) {
+GpuScene pack_gpu_media(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes, bool with_luts,
+                        const std::vector<bool>& line) {
   GpuScene out;
+  out.line_media = line;
+  out.line_media.resize(scene.media.size(), false);
   for (size_t i = 0; i < scene.media.size(); ++i) {
     const Medium& m = scene.media[i];
     if (m.type == Medium::Type::Homogeneous) {
       out.media.push_back(pack_analytic_medium(m));
+      // Its line rate comes from each ray's chord (shaders/media.glsl majorant_at).
+      if (out.line_media[i]) out.media.back().line_points = float(kLinePointsPerCell);
       out.has_analytic = true;
       out.has_emission = out.has_emission || max3(glm::dvec3(out.media.back().emission)) > 0.0;
     } else {
@@ -195,22 +195,30 @@ void add_majorant_cells(const Scene& scene, GpuScene& g) {
   g.majorants.clear();
   for (size_t slot = 0; slot < g.grids.size(); ++slot) {
     // Majorant cells over the stored (rounded) density.
-    const DenseGrid& density = g.grid_sources[slot].density->grid;
-    const glm::ivec3 res = scene.integrator.majorant == Majorant::Global
-                               ? glm::ivec3(1)
-                               : scene.integrator.majorant_grid.value_or(default_majorant_resolution(density.dims));
-    const MajorantGrid mg = build_majorant_grid(density, res);
+    const GpuGridSource& src = g.grid_sources[slot];
+    const DenseGrid& density = src.density->grid;
+    const MajorantGrid mg = build_majorant_grid(density, majorant_resolution(scene.integrator, density.dims));
     gpu::GpuGrid& grid = g.grids[slot];
     grid.majorant_res = gpu::uvec3(uint32_t(mg.res.x), uint32_t(mg.res.y), uint32_t(mg.res.z));
     grid.majorant_offset = uint32_t(g.majorants.size());
     grid.majorant_cell = v3(mg.cell_size);
     g.majorants.insert(g.majorants.end(), mg.max_density.begin(), mg.max_density.end());
+    // The line estimator's rates, for the media it collects (g.line_media).
+    grid.line_rate_offset = 0;
+    if (src.medium >= g.line_media.size() || !g.line_media[src.medium]) continue;
+    const DenseGrid* temperature = src.temperature && !src.temperature->grid.empty() ? &src.temperature->grid : nullptr;
+    const LineRates rates = line_rates(scene.media[src.medium], density, temperature, mg);
+    grid.line_rate_offset = uint32_t(g.majorants.size());
+    g.majorants.insert(g.majorants.end(), rates.rate.begin(), rates.rate.end());
   }
 }
 
 GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes, bool with_luts,
                          uint64_t max_texture_bytes) {
-  GpuScene out = pack_gpu_media(scene, volumes, with_luts);
+  std::vector<const StoredVolume*> by_medium(scene.media.size(), nullptr);
+  for (size_t i = 0; i < volumes.size() && i < by_medium.size(); ++i)
+    if (volumes[i]) by_medium[i] = &*volumes[i];
+  GpuScene out = pack_gpu_media(scene, volumes, with_luts, line_media(scene, by_medium));
   add_majorant_cells(scene, out);
   out.temperature_in_density = every_temperature_fits_density(out.grid_sources, max_texture_bytes);
   return out;
@@ -223,6 +231,7 @@ void keep_baked_grid_fields(const gpu::GpuGrid& baked, gpu::GpuGrid& grid) {
   grid.majorant_res = baked.majorant_res;
   grid.majorant_offset = baked.majorant_offset;
   grid.majorant_cell = baked.majorant_cell;
+  grid.line_rate_offset = baked.line_rate_offset;
 }
 
 void set_blackbody_lut(gpu::GpuGrid& grid, const color::BlackbodyLutParams& p) {

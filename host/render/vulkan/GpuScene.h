@@ -25,7 +25,9 @@ struct GpuScene {
   std::vector<gpu::GpuMedium> media;
   std::vector<gpu::GpuGrid> grids;
   std::vector<GpuGridSource> grid_sources;  // per slot, same order as grids
-  std::vector<float> majorants;             // every grid's cells, at GpuGrid::majorant_offset
+  std::vector<float> majorants;             // every grid's cells, at GpuGrid::majorant_offset (and line rates)
+  // Per scene medium: its emission is collected by the line estimator (line_media).
+  std::vector<bool> line_media;
   bool has_grids = false, has_scattering = false, has_emission = false;
   bool has_analytic = false;  // a sphere or box medium
   // Every emitting grid's temperature goes into its density texture's second
@@ -62,14 +64,16 @@ GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<Sto
                          uint64_t max_texture_bytes = std::numeric_limits<uint64_t>::max());
 // The media and grid headers alone (no majorant cells: GpuGrid majorant_res,
 // majorant_offset and majorant_cell stay 0; temperature_in_density false):
-// all that a live edit of a medium's parameters changes.
+// all that a live edit of a medium's parameters changes. `line`: per scene
+// medium, collected by the line estimator (line_media; missing: false).
 GpuScene pack_gpu_media(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes,
-                        bool with_luts = true);
+                        bool with_luts = true, const std::vector<bool>& line = {});
 // Each grid's majorant cells (from its density as stored and the scene's
-// integrator.majorant settings) into g.majorants, and where they lie into its GpuGrid.
+// integrator.majorant settings) into g.majorants, and where they lie into its
+// GpuGrid; for the media g.line_media names, their line rates after them.
 void add_majorant_cells(const Scene& scene, GpuScene& g);
 // The fields of a GpuGrid that describe what the session baked (the blackbody
-// LUT's coordinates, the majorant cells' geometry), copied from `baked`.
+// LUT's coordinates, the majorant cells' geometry and line rates), copied from `baked`.
 void keep_baked_grid_fields(const gpu::GpuGrid& baked, gpu::GpuGrid& grid);
 // The grid's blackbody LUT coordinate map (GpuGrid lut_scale, lut_offset, t_min_k).
 void set_blackbody_lut(gpu::GpuGrid& grid, const color::BlackbodyLutParams& p);

@@ -204,7 +204,7 @@ std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const S
           {gpu::SPEC_HAS_SCATTERING, flag(g.has_scattering && scene.integrator.max_depth > 0)},
           {gpu::SPEC_HAS_EMISSION, flag(g.has_emission)},
           {gpu::SPEC_TEMPERATURE_IN_DENSITY, flag(g.temperature_in_density)},
-          {gpu::SPEC_COLLISION_ESTIMATOR, flag(lights.estimator == EmissionEstimator::Collision)},
+          {gpu::SPEC_COLLISION_ESTIMATOR, flag(lights.estimator != EmissionEstimator::Absorption)},
           {gpu::SPEC_DEBUG_MODE, settings.debug_mode},
           {gpu::SPEC_MEDIUM_COUNT, uint32_t(g.media.size())},
           {gpu::SPEC_GRID_COUNT, uint32_t(g.grids.size())},
@@ -456,7 +456,8 @@ RenderSession::EmissionLights RenderSession::build_emission_lights(
       cdfs[src.medium] = EmissionCdf::build_light(m, *volumes[src.medium]);
       if (!cdfs[src.medium]->empty()) by_medium[src.medium] = &*cdfs[src.medium];
     }
-  out.selection = select_lights(scene, environment_ ? &*environment_ : nullptr, by_medium);
+  const bool thin = std::find(g.line_media.begin(), g.line_media.end(), true) != g.line_media.end();
+  out.selection = select_lights(scene, environment_ ? &*environment_ : nullptr, by_medium, thin);
   out.analytic = pack_gpu_lights(scene, out.selection);
   if (out.selection.strategy == LightStrategy::Bsdf) return out;
   // By grid slot: the CDFs next-event estimation may pick.
@@ -487,7 +488,7 @@ void RenderSession::upload_constants(const Scene& scene) {
   // Only the headers: the blackbody LUTs and majorant cells stay as baked (an
   // edit changes neither the emission's mode nor the grids), so they are not
   // rebuilt; the majorant scale, which follows the coefficients, is.
-  GpuScene now = pack_gpu_media(scene, volumes_, /*with_luts=*/false);
+  GpuScene now = pack_gpu_media(scene, volumes_, /*with_luts=*/false, gpu_scene_.line_media);
   for (size_t i = 0; i < now.grids.size() && i < gpu_scene_.grids.size(); ++i)
     keep_baked_grid_fields(gpu_scene_.grids[i], now.grids[i]);
   const gpu::FrameConstants frame = build_frame_constants(scene, settings_, uint32_t(now.media.size()), light_selection_);

@@ -1,0 +1,118 @@
+#include "render/LineEstimator.h"
+
+#include <algorithm>
+#include <climits>
+
+#include "color/ColorSpace.h"
+#include "light/EmissionCdf.h"
+#include "scene/MediumVolume.h"
+
+namespace pyrolume {
+
+glm::ivec3 majorant_resolution(const Integrator& in, glm::ivec3 dims) {
+  if (in.majorant == Majorant::Global) return glm::ivec3(1);
+  return in.majorant_grid.value_or(default_majorant_resolution(dims));
+}
+
+namespace {
+double max3(const glm::dvec3& v) { return std::max({v.x, v.y, v.z}); }
+}  // namespace
+
+LineRates line_rates(const Medium& m, const DenseGrid& density, const DenseGrid* temperature, const MajorantGrid& mg) {
+  LineRates out;
+  const size_t n = size_t(mg.res.x) * size_t(mg.res.y) * size_t(mg.res.z);
+  out.rate.assign(n, 0.0f);
+  if (!m.emission.emits()) return out;
+  const EmissionCdf cells = EmissionCdf::build(density, temperature, EmissionParams::from_medium(m));
+  if (cells.empty()) return out;
+  out.power = cells.power();
+
+  // E_c: emission cell (i, j, k) spans texel coordinates [i + 0.5, i + 1.5)
+  // per axis (EmissionCdf.h); it overlaps majorant cells floor(a / size) …
+  // ceil(b / size) − 1, clamped to the grid.
+  std::vector<double> E(n, 0.0);
+  const glm::ivec3 C = cells.cells();
+  for (int k = 0; k < C.z; ++k)
+    for (int j = 0; j < C.y; ++j)
+      for (int i = 0; i < C.x; ++i) {
+        const double w = cells.cell_weight({i, j, k});
+        if (!(w > 0.0)) continue;
+        const glm::dvec3 a = glm::dvec3(i, j, k) + 0.5, b = a + 1.0;
+        const glm::ivec3 lo = glm::clamp(glm::ivec3(glm::floor(a / mg.cell_size)), glm::ivec3(0), mg.res - 1);
+        const glm::ivec3 hi = glm::clamp(glm::ivec3(glm::ceil(b / mg.cell_size)) - 1, glm::ivec3(0), mg.res - 1);
+        for (int z = lo.z; z <= hi.z; ++z)
+          for (int y = lo.y; y <= hi.y; ++y)
+            for (int x = lo.x; x <= hi.x; ++x) {
+              double& e = E[(size_t(z) * mg.res.y + y) * mg.res.x + x];
+              e = std::max(e, w);
+            }
+      }
+
+  // World length of a cell edge along each axis (cell_size texels of one voxel each).
+  glm::dvec3 edge;
+  for (int a = 0; a < 3; ++a) edge[a] = mg.cell_size[a] * glm::length(glm::dvec3(density.index_to_world[a]));
+  const double r = kLinePointsPerCell / std::min({edge.x, edge.y, edge.z});
+  const double sigma_scale = max3(m.sigma_a + m.sigma_s) * m.density_scale;
+  glm::ivec3 lo(INT_MAX), hi(INT_MIN);  // the emissive cells' bounding box
+  double weighted = 0.0, total = 0.0;
+  for (int z = 0; z < mg.res.z; ++z)
+    for (int y = 0; y < mg.res.y; ++y)
+      for (int x = 0; x < mg.res.x; ++x) {
+        const size_t c = (size_t(z) * mg.res.y + y) * mg.res.x + x;
+        if (!(E[c] > 0.0)) continue;
+        out.rate[c] = float(r);
+        lo = glm::min(lo, glm::ivec3(x, y, z));
+        hi = glm::max(hi, glm::ivec3(x, y, z));
+        weighted += E[c] * double(mg.max_density[c]) * sigma_scale;
+        total += E[c];
+      }
+  if (!(total > 0.0)) return out;
+  const glm::dvec3 across = glm::dvec3(hi - lo + 1) * edge;
+  out.collisions_across = weighted / total * std::min({across.x, across.y, across.z});
+  return out;
+}
+
+bool homogeneous_emission_is_thin(const Medium& m) {
+  if (m.type != Medium::Type::Homogeneous || !m.emission.emits() || !(max3(m.sigma_a) > 0.0)) return false;
+  const glm::dvec3 extent = m.bounds.max - m.bounds.min;
+  const double width = m.bounds.kind == Bounds::Kind::Sphere ? 2.0 * m.bounds.radius
+                                                               : std::min({extent.x, extent.y, extent.z});
+  return max3(m.sigma_a + m.sigma_s) * width < kThinCollisionsAcross;
+}
+
+std::vector<bool> line_media(const Scene& scene, const std::vector<const StoredVolume*>& volumes) {
+  const size_t n = scene.media.size();
+  const std::optional<EmissionEstimator> asked = scene.integrator.emission_estimator;
+  std::vector<bool> line(n, false);
+  if (asked && *asked != EmissionEstimator::Line) return line;
+  std::vector<double> power(n, 0.0);
+  double total = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const Medium& m = scene.media[i];
+    if (!m.emission.emits()) continue;
+    if (m.type == Medium::Type::Homogeneous) {
+      const glm::dvec3 e = m.bounds.max - m.bounds.min;
+      const double r = m.bounds.radius;
+      const double volume = m.bounds.kind == Bounds::Kind::Sphere ? 4.0 / 3.0 * 3.14159265358979323846 * r * r * r
+                                                                   : e.x * e.y * e.z;
+      power[i] = color::srgb_luminance(m.sigma_a * homogeneous_le(m.emission)) * volume;
+      line[i] = asked || homogeneous_emission_is_thin(m);
+    } else {
+      const StoredVolume* vol = i < volumes.size() ? volumes[i] : nullptr;
+      if (!vol || vol->density.grid.empty()) continue;
+      const DenseGrid& density = vol->density.grid;
+      const DenseGrid* temperature =
+          vol->temperature && !vol->temperature->grid.empty() ? &vol->temperature->grid : nullptr;
+      const LineRates rates =
+          line_rates(m, density, temperature, build_majorant_grid(density, majorant_resolution(scene.integrator, density.dims)));
+      power[i] = rates.power;
+      line[i] = asked || rates.thin();
+    }
+    total += std::max(0.0, power[i]);
+  }
+  if (!asked)
+    for (size_t i = 0; i < n; ++i) line[i] = line[i] && power[i] >= kLineMinPowerShare * total;
+  return line;
+}
+
+}  // namespace pyrolume
