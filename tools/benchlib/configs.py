@@ -49,6 +49,8 @@ def configs_for(scene, quick):
     if not scene.has_grid:
         return [Config("vulkan"), Config("cpu")]
     out = [Config("vulkan", e, m) for e in ("absorption", "collision") for m in ("grid", "global")]
+    # Further estimators a scene asks for ("line", "auto": its default) with the majorant grid.
+    out += [Config("vulkan", e, "grid") for e in scene.estimators if e not in ("absorption", "collision")]
     # The CPU reference is 2–5× slower: quick mode runs it with one estimator only.
     cpu_estimators = ("collision",) if quick else ("absorption", "collision")
     out += [Config("cpu", e, "global") for e in cpu_estimators]

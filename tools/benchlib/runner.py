@@ -87,9 +87,13 @@ def compare(args, a, ref):
 
 def reference(args, work, scene, code):
     """The scene's high-spp reference (Vulkan unless --ref-backend cpu), cached by
-    content hash. Collision estimator and majorant grid: the fastest to converge."""
+    content hash. The collision estimator and the majorant grid, the fastest to
+    converge; on scenes that bench the line estimator, the scene's default
+    ("auto"), which picks it there (a collision reference's own noise would
+    floor the line estimator's error)."""
     b = args.ref_backend
-    config = Config(b, "collision", "grid" if b == "vulkan" else "global") if scene.has_grid else Config(b)
+    estimator = "auto" if "auto" in scene.estimators else "collision"
+    config = Config(b, estimator, "grid" if b == "vulkan" else "global") if scene.has_grid else Config(b)
     data = scene_for_config(scene, config)
     h = hashlib.sha256()
     h.update(json.dumps(data, sort_keys=True).encode())

@@ -13,12 +13,15 @@ from .common import REPO, file_stamp, load_json, log, write_json_if_changed
 
 
 class Scene:
-    def __init__(self, name, data, base_dir, source, note=""):
+    def __init__(self, name, data, base_dir, source, note="", estimators=("absorption", "collision")):
         self.name = name
         self.data = data            # scene JSON as a dict
         self.base_dir = base_dir    # folder its relative paths resolve against
         self.source = source        # where it came from, for the markdown
         self.note = note
+        # The emission estimators its grid configs render with ("auto": the
+        # scene's default, the key left out).
+        self.estimators = estimators
 
     @property
     def has_grid(self):
@@ -184,6 +187,21 @@ def real_vdb_scene(pyrolume, path, work, aspect):
                  f"read in place; camera frames the density grid's world bbox, {up} up")
 
 
+def thin_fire_scene(path, work):
+    """Issue 23's thin, hot flame: the Blender 2.79 fire as a user writes it,
+    density ×0.02 and emission ×100, everything else the defaults (camera
+    framed automatically, integrator "auto")."""
+    data = {"media": [{"type": "vdb", "file": os.path.abspath(path), "density_scale": 0.02,
+                       "emission": {"scale": 100}}]}
+    scene_dir = os.path.join(work, "scenes")
+    os.makedirs(scene_dir, exist_ok=True)
+    write_json_if_changed(os.path.join(scene_dir, "blender_thin_fire.json"), data)
+    return Scene("blender_thin_fire", data, scene_dir,
+                 os.path.basename(path) + " (real data, read in place), density ×0.02, emission ×100",
+                 "the shortest scene file: camera framed automatically, integrator \"auto\"",
+                 estimators=("absorption", "collision", "line", "auto"))
+
+
 def explosion_scene(generator, work, resolution):
     """The procedural explosion: gen_fire_vdb --sparse (a thin noisy shell with
     large empty regions, the majorant grid's showcase), rendered with fire.json's
@@ -266,6 +284,9 @@ def collect_scenes(args, work):
                 scenes.append(real_vdb_scene(args.pyrolume, os.path.join(data_dir, fn), work, aspect))
             except (RuntimeError, subprocess.CalledProcessError) as e:
                 skipped.append((fn, f"could not make a scene: {e}"))
+        fire = os.path.join(data_dir, "blender279_fire_frame075.vdb")
+        if want("blender_thin_fire") and os.path.exists(fire):
+            scenes.append(thin_fire_scene(fire, work))
     elif want("real"):
         skipped.append(("real VDBs", f"{data_dir} absent"))
     return scenes, skipped
@@ -277,7 +298,10 @@ def scene_for_config(scene, config):
     _absolutise(data, scene.base_dir)
     if config.estimator is not None:
         integ = data.setdefault("integrator", {})
-        integ["emission_estimator"] = config.estimator
+        if config.estimator == "auto":
+            integ.pop("emission_estimator", None)
+        else:
+            integ["emission_estimator"] = config.estimator
         integ["majorant"] = config.majorant
         if config.mis is not None:
             integ["mis"] = config.mis
