@@ -37,7 +37,7 @@ LightCandidates light_candidates(const Scene& scene) {
 }
 
 LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs,
-                             bool thin_emission) {
+                             bool line_media) {
   const Integrator& in = scene.integrator;
   if (const std::optional<IntegratorConflict> c = integrator_conflict(in, !scene.lights.empty()))
     throw std::invalid_argument("integrator." + c->key + ": " + c->reason);
@@ -69,7 +69,7 @@ LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, cons
     if (power[i] > 0.0) s.p_light[i] = distant ? far_share * power[i] / far_power : near_share * power[i] / near_power;
   }
   s.strategy = !s.any() ? LightStrategy::Bsdf : (in.light_only ? LightStrategy::LightOnly : LightStrategy::Mis);
-  s.estimator = in.emission_estimator.value_or(thin_emission                     ? EmissionEstimator::Line
+  s.estimator = in.emission_estimator.value_or(line_media                        ? EmissionEstimator::Line
                                                : s.strategy == LightStrategy::Bsdf ? EmissionEstimator::Absorption
                                                                                    : EmissionEstimator::Collision);
   s.p_continue_own =

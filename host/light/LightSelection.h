@@ -55,7 +55,7 @@ struct LightSelection {
   std::vector<double> p_light;
   LightStrategy strategy = LightStrategy::Bsdf;
   // What both backends render with: the file's estimator, or for "auto" the
-  // line estimator where a medium's emission is thin (emission_is_thin), else
+  // line estimator where it collects some medium (line_media), else
   // the collision estimator with light sampling (what MIS is written for) and
   // the absorption estimator without (the fastest for BSDF/phase sampling).
   EmissionEstimator estimator = EmissionEstimator::Absorption;
@@ -100,11 +100,11 @@ struct LightSelection {
 //
 // Strategy: Mis (LightOnly with integrator.light_only) when at least one light
 // is sampled, otherwise Bsdf. Estimator: as the file says, "auto" resolved by
-// thin_emission (some medium's emission_is_thin, host/render/LineEstimator.h)
-// and the strategy. Throws std::invalid_argument for integrator keys that
+// line_media (the line estimator collects some medium: line_media() in
+// host/render/LineEstimator.h) and the strategy. Throws std::invalid_argument for integrator keys that
 // contradict each other (integrator_conflict; the loader refuses such files).
 LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs,
-                             bool thin_emission = false);
+                             bool line_media = false);
 
 // Power heuristic, β = 2 (Veach 1997, eq. 9.13), for the strategy with pdf
 // p_this against p_other; 1 when p_other is 0.

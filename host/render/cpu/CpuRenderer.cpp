@@ -525,6 +525,10 @@ constexpr double kScatterRouletteBelow = 0.1;
 //  - "collision" (pbrt-v4 §14.2, VolPathIntegrator: beta · σa · Le / σ_maj at
 //    every majorant sample): at EVERY tentative collision add β Σ σa_i Le_i(x)/σ̄,
 //    then absorb (end), scatter or continue; escaping adds β · background.
+//  - "line" (docs/rendering.md "The line estimator"): the collision estimator,
+//    plus a second Poisson process of rate ℓ = Σ line_rate of the media present
+//    drawn between consecutive tentative collisions (where the walk is
+//    certainly alive); every point of either process adds β Σ σa_i Le_i(x)/(σ̄ + ℓ).
 // Scattering picks medium i's HG lobe with probability σs_i/σs (mixture phase
 // function). Medium scatterings and surface bounces count together toward
 // max_depth: the (max_depth+1)-th ends the path with nothing more (the
