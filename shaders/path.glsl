@@ -128,9 +128,11 @@ vec3 camera_direction(uvec2 pixel, vec2 jitter) {
 // by a specialisation constant, which GLSL cannot copy).
 void camera_path(uvec2 pixel, uint k, out uint rng, inout PathState p) {
   uint width = frame.width, height = frame.height;
-  rng = rng_init(frame.seed, frame.frame_index, pixel.y * width + pixel.x, k);
-  // Box filter: jitter uniformly inside the pixel; pixel (0,0) is top-left.
-  vec2 jitter = vec2(rng_next(rng), rng_next(rng));
+  const uint pixel_index = pixel.y * width + pixel.x;
+  rng = rng_init(frame.seed, frame.frame_index, pixel_index, k);
+  // Box filter: a point inside the pixel, uniform for each sample but
+  // stratified across the pixel's samples; pixel (0,0) is top-left.
+  vec2 jitter = film_jitter(frame.seed, frame.frame_index, pixel_index, k);
   p.o = frame.camera_position;
   p.d = camera_direction(pixel, jitter);
   p.w = vec3(1.0);

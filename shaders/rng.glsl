@@ -22,4 +22,18 @@ float rng_next(inout uint state) {
   word = (word >> 22u) ^ word;
   return float(word >> 8u) * (1.0 / 16777216.0);
 }
+// Sample k's point in its pixel: the k-th point of the R2 sequence (Roberts
+// 2018: k·(1/g, 1/g²) mod 1, g the plastic number, in 32-bit fixed point so
+// it stays exact for any k), shifted by one random offset per pixel
+// (Cranley–Patterson rotation). Each point alone is uniform in the pixel (the
+// offset is), so the pixel mean stays unbiased; together a pixel's first N
+// points cover it far more evenly than N independent ones, and the pixel's
+// spatial variation stops adding noise. Keyed on (seed, frame, pixel) only,
+// so every sample is still reproducible on its own.
+vec2 film_jitter(uint seed, uint frame, uint pixel, uint k) {
+  const uint rx = pcg_hash(pcg_hash(pixel ^ pcg_hash(frame ^ pcg_hash(seed))) ^ 0x2545f491u);
+  const uint ry = pcg_hash(rx);
+  const uvec2 u = uvec2(k * 3242174889u + rx, k * 2447445414u + ry);
+  return vec2(u >> 8u) * (1.0 / 16777216.0);
+}
 #endif
