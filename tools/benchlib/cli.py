@@ -29,6 +29,7 @@ Typical use:
   tools/bench --resolution 1920x1080 --spp-max 64 --scenes terrain_explosion \
               --configs 'vulkan/*' --device 1 --out-dir docs/gpu   # on a real GPU
   tools/bench --list                        # scenes and configs, render nothing
+  tools/bench --cycles                      # against Blender Cycles at equal error (needs `blender`)
 
 Only the Python standard library is used, plus matplotlib for the plot (the
 plot is skipped with a warning when matplotlib is missing).
@@ -45,7 +46,7 @@ import shutil
 import statistics
 import time
 
-from . import denoise
+from . import cycles, denoise
 from .common import REPO, log
 from .configs import configs_for
 from .plot import plot
@@ -87,6 +88,10 @@ def parse_args(argv):
                     help="time `pyrolume denoise` against the render it cleans (default scenes "
                          "fire_ground,terrain_explosion at 1920x1080; benchlib/denoise.py)")
     ap.add_argument("--denoise-spp", type=int, default=16, help="with --denoise: spp of the render (default 16)")
+    ap.add_argument("--cycles", action="store_true",
+                    help="pyrolume against Blender Cycles at equal error on the Blender 2.79 fire "
+                         "(needs `blender` and --data-dir; benchlib/cycles.py)")
+    ap.add_argument("--cycles-threads", type=int, default=2, help="with --cycles: Cycles' CPU threads (default 2)")
     ap.add_argument("--render-reps", type=int, default=1,
                     help="with --denoise: renders per scene (default 1; the denoise runs --reps times)")
     args = ap.parse_args(argv)
@@ -125,6 +130,8 @@ def main(argv):
     os.makedirs(work, exist_ok=True)
     if args.denoise:
         return denoise.run(args, argv)
+    if args.cycles:
+        return cycles.run(args)
 
     scenes, skipped = collect_scenes(args, work)
     cfg_filter = [c.strip() for c in args.configs.split(",")] if args.configs else None

@@ -10,8 +10,8 @@ Run headless:
 
 Scene, built from empty factory settings: a black world; one Volume object that reads
 the VDB file in place (grids in their own transform, object at the origin); a Principled
-Volume material with Blender's defaults except for the density attribute, temperature
-attribute, Temperature and Blackbody Intensity given here; a pinhole camera with a
+Volume material with Blender's defaults except for the density attribute, Density,
+Color (grey), temperature attribute, Temperature and Blackbody Intensity given here; a pinhole camera with a
 vertical field of view. Cycles on the CPU with a fixed seed, adaptive sampling, denoising
 and clamping off, a Box pixel filter 1 pixel wide, full-precision volume grids, linear
 interpolation, automatic step size.
@@ -52,6 +52,10 @@ def parse_args():
                    help="Cycles light paths: volume bounces")
     p.add_argument("--density-attr", default="density", help="Density Attribute (grid name)")
     p.add_argument("--temp-attr", default="heat", help="Temperature Attribute (grid name)")
+    p.add_argument("--density", type=float, default=1.0, help="Density socket (multiplies the attribute)")
+    p.add_argument("--color", type=float, default=0.5,
+                   help="Color socket, grey: with the default black Absorption Color, scattering = "
+                        "density * color and absorption = density * (1 - color), so the albedo is color")
     p.add_argument("--temperature", type=float, default=1000.0, help="Temperature socket, K")
     p.add_argument("--blackbody", type=float, default=1.0, help="Blackbody Intensity")
     p.add_argument("--cam-pos", type=float, nargs=3, required=True, metavar=("X", "Y", "Z"))
@@ -75,6 +79,8 @@ def build_material(a):
     nt.links.new(pv.outputs["Volume"], out.inputs["Volume"])
     pv.inputs["Density Attribute"].default_value = a.density_attr
     pv.inputs["Temperature Attribute"].default_value = a.temp_attr
+    pv.inputs["Density"].default_value = a.density
+    pv.inputs["Color"].default_value = (a.color, a.color, a.color, 1.0)
     pv.inputs["Temperature"].default_value = a.temperature
     pv.inputs["Blackbody Intensity"].default_value = a.blackbody
     mat.cycles.volume_interpolation = "LINEAR"
