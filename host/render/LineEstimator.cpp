@@ -52,6 +52,7 @@ LineRates line_rates(const Medium& m, const DenseGrid& density, const DenseGrid*
   glm::dvec3 edge;
   for (int a = 0; a < 3; ++a) edge[a] = mg.cell_size[a] * glm::length(glm::dvec3(density.index_to_world[a]));
   const double r = kLinePointsPerCell / std::min({edge.x, edge.y, edge.z});
+  if (!std::isfinite(r) || !(r > 0.0)) return out;  // a degenerate transform: collisions only
   const double sigma_scale = max3(m.sigma_a + m.sigma_s) * m.density_scale;
   glm::ivec3 lo(INT_MAX), hi(INT_MIN);  // the emissive cells' bounding box
   double weighted = 0.0, total = 0.0;

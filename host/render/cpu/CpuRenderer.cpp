@@ -217,7 +217,7 @@ double line_rate(const MediumData& m) {
   const glm::dmat4& to_world = m.volume->density.grid.index_to_world;
   const double voxel = std::min({glm::length(glm::dvec3(to_world[0])), glm::length(glm::dvec3(to_world[1])),
                                  glm::length(glm::dvec3(to_world[2]))});
-  return kLinePointsPerVoxel / voxel;
+  return voxel > 0.0 ? kLinePointsPerVoxel / voxel : 0.0;
 }
 
 // The MIS state of the ray being tracked (docs/mis.md): the solid-angle pdf
