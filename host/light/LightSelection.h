@@ -101,8 +101,9 @@ struct LightSelection {
 // Strategy: Mis (LightOnly with integrator.light_only) when at least one light
 // is sampled, otherwise Bsdf. Estimator: as the file says, "auto" resolved by
 // line_media (the line estimator collects some medium: line_media() in
-// host/render/LineEstimator.h) and the strategy. Throws std::invalid_argument for integrator keys that
-// contradict each other (integrator_conflict; the loader refuses such files).
+// host/render/LineEstimator.h) and the strategy. Throws std::invalid_argument
+// for integrator keys that contradict each other (integrator_conflict; the
+// loader refuses such files).
 LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs,
                              bool line_media = false);
 

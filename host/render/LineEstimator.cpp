@@ -75,45 +75,43 @@ LineRates line_rates(const Medium& m, const DenseGrid& density, const DenseGrid*
 
 bool homogeneous_emission_is_thin(const Medium& m) {
   if (m.type != Medium::Type::Homogeneous || !m.emission.emits() || !(max3(m.sigma_a) > 0.0)) return false;
-  const glm::dvec3 extent = m.bounds.max - m.bounds.min;
-  const double width = m.bounds.kind == Bounds::Kind::Sphere ? 2.0 * m.bounds.radius
-                                                               : std::min({extent.x, extent.y, extent.z});
-  return max3(m.sigma_a + m.sigma_s) * width < kThinCollisionsAcross;
+  return max3(m.sigma_a + m.sigma_s) * m.bounds.smallest_extent() < kThinCollisionsAcross;
 }
 
-std::vector<bool> line_media(const Scene& scene, const std::vector<const StoredVolume*>& volumes) {
+LineMedia line_media(const Scene& scene, const std::vector<const StoredVolume*>& volumes) {
   const size_t n = scene.media.size();
   const std::optional<EmissionEstimator> asked = scene.integrator.emission_estimator;
-  std::vector<bool> line(n, false);
-  if (asked && *asked != EmissionEstimator::Line) return line;
+  LineMedia out;
+  out.line.assign(n, false);
+  out.rates.resize(n);
+  if (asked && *asked != EmissionEstimator::Line) return out;
   std::vector<double> power(n, 0.0);
   double total = 0.0;
   for (size_t i = 0; i < n; ++i) {
     const Medium& m = scene.media[i];
     if (!m.emission.emits()) continue;
     if (m.type == Medium::Type::Homogeneous) {
-      const glm::dvec3 e = m.bounds.max - m.bounds.min;
-      const double r = m.bounds.radius;
-      const double volume = m.bounds.kind == Bounds::Kind::Sphere ? 4.0 / 3.0 * 3.14159265358979323846 * r * r * r
-                                                                   : e.x * e.y * e.z;
-      power[i] = color::srgb_luminance(m.sigma_a * homogeneous_le(m.emission)) * volume;
-      line[i] = asked || homogeneous_emission_is_thin(m);
+      power[i] = color::srgb_luminance(m.sigma_a * homogeneous_le(m.emission)) * m.bounds.volume();
+      out.line[i] = asked || homogeneous_emission_is_thin(m);
     } else {
       const StoredVolume* vol = i < volumes.size() ? volumes[i] : nullptr;
       if (!vol || vol->density.grid.empty()) continue;
       const DenseGrid& density = vol->density.grid;
       const DenseGrid* temperature =
           vol->temperature && !vol->temperature->grid.empty() ? &vol->temperature->grid : nullptr;
-      const LineRates rates =
+      LineRates rates =
           line_rates(m, density, temperature, build_majorant_grid(density, majorant_resolution(scene.integrator, density.dims)));
       power[i] = rates.power;
-      line[i] = asked || rates.thin();
+      out.line[i] = asked || rates.thin();
+      out.rates[i] = std::move(rates.rate);
     }
     total += std::max(0.0, power[i]);
   }
-  if (!asked)
-    for (size_t i = 0; i < n; ++i) line[i] = line[i] && power[i] >= kLineMinPowerShare * total;
-  return line;
+  for (size_t i = 0; i < n; ++i) {
+    if (!asked) out.line[i] = out.line[i] && power[i] >= kLineMinPowerShare * total;
+    if (!out.line[i]) out.rates[i].clear();
+  }
+  return out;
 }
 
 }  // namespace pyrolume

@@ -8,6 +8,7 @@
 // cell that can emit: each ray's emission integral then gets at least
 // kLinePointsPerCell points per cell width it crosses, wherever it emits, so
 // its relative variance is about the same along every ray.
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -57,18 +58,25 @@ glm::ivec3 majorant_resolution(const Integrator& in, glm::ivec3 dims);
 
 // A homogeneous medium (constant emission) is one cell: each ray gets
 // kLinePointsPerCell points along its chord through it (shaders/media.glsl
-// majorant_at). Its emission is thin where it emits and σt times its smallest
-// extent (a sphere's diameter, a box's shortest edge) is below
-// kThinCollisionsAcross.
+// majorant_at). Its emission is thin where it emits and σt times its
+// Bounds::smallest_extent is below kThinCollisionsAcross.
 bool homogeneous_emission_is_thin(const Medium& m);
 
-// Per scene medium, whether its emission is collected with the line
-// estimator: every emitting medium where the file asks for "line"; with
-// "auto", the media whose emission is thin (grid media on the majorant grid
-// the GPU uses) and that give at least kLineMinPowerShare of the emitted
-// power (Y(σa·Le) over the medium's volume; for grids the emission bound's).
-// volumes[i]: medium i's grids (null for homogeneous media). The scene's
-// estimator is "line" where any medium is (select_lights).
-std::vector<bool> line_media(const Scene& scene, const std::vector<const StoredVolume*>& volumes);
+struct LineMedia {
+  // Per scene medium, whether the line estimator collects its emission.
+  std::vector<bool> line;
+  // Per scene medium: a grid medium's LineRates::rate where `line` holds
+  // (on the majorant grid the GPU builds: majorant_resolution), else empty.
+  std::vector<std::vector<float>> rates;
+  bool any() const { return std::find(line.begin(), line.end(), true) != line.end(); }
+};
+
+// Which media the line estimator collects: every emitting medium where the
+// file asks for "line"; with "auto", the media whose emission is thin and that
+// give at least kLineMinPowerShare of the emitted power (Y(σa·Le) over the
+// medium's volume; for grids the emission bound's integral). volumes[i]:
+// medium i's grids (null for homogeneous media). The scene's estimator is
+// "line" where any medium is (select_lights).
+LineMedia line_media(const Scene& scene, const std::vector<const StoredVolume*>& volumes);
 
 }  // namespace pyrolume

@@ -2,6 +2,7 @@
 // The scene as parsed and validated from scene JSON (format v1, docs/scene-format.md).
 // Units: lengths in scene units, sigma in 1/scene-unit, temperatures in kelvin,
 // radiance linear sRGB.
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -140,6 +141,16 @@ struct Bounds {
   glm::dvec3 center{0.0};
   double radius = 1.0;
   glm::dvec3 min{0.0}, max{0.0};
+
+  // A sphere's diameter, a box's shortest edge: the thinnest a medium is.
+  double smallest_extent() const {
+    const glm::dvec3 e = max - min;
+    return kind == Kind::Sphere ? 2.0 * radius : std::min({e.x, e.y, e.z});
+  }
+  double volume() const {
+    const glm::dvec3 e = max - min;
+    return kind == Kind::Sphere ? 4.0 / 3.0 * 3.14159265358979323846 * radius * radius * radius : e.x * e.y * e.z;
+  }
 };
 
 struct Emission {

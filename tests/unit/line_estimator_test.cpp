@@ -56,12 +56,12 @@ Scene scene_of(std::vector<Medium> media) {
 // σt·3.2 = 4.8 collisions across the dense block, 0.048 across the thin one.
 TEST(LineEstimator, ThinGridsAreCollectedByTheLineEstimatorAndDenseOnesAreNot) {
   const StoredVolume v = block_volume();
-  EXPECT_EQ(line_media(scene_of({block_medium(1.0, 1.0)}), {&v}), std::vector<bool>{false});
-  EXPECT_EQ(line_media(scene_of({block_medium(0.01, 100.0)}), {&v}), std::vector<bool>{true});
+  EXPECT_EQ(line_media(scene_of({block_medium(1.0, 1.0)}), {&v}).line, std::vector<bool>{false});
+  EXPECT_EQ(line_media(scene_of({block_medium(0.01, 100.0)}), {&v}).line, std::vector<bool>{true});
   // Without emission there is nothing to collect.
   Medium dark = block_medium(0.01, 100.0);
   dark.emission = Emission{};
-  EXPECT_EQ(line_media(scene_of({dark}), {&v}), std::vector<bool>{false});
+  EXPECT_EQ(line_media(scene_of({dark}), {&v}).line, std::vector<bool>{false});
 }
 
 TEST(LineEstimator, CollisionsAcrossAreTheMajorantTimesTheEmissionsDepth) {
@@ -83,9 +83,9 @@ TEST(LineEstimator, AFaintThinMediumBesideABrightOneIsLeftToCollisions) {
   const Medium bright = test::homogeneous_sphere("bright", {5, 0, 0}, 1.0, glm::dvec3(0.01), glm::dvec3(0.0), 0.0,
                                                  glm::dvec3(1.0), 1000.0);
   // The thin block emits 1/1000 of the sphere's power: not worth its points.
-  EXPECT_EQ(line_media(scene_of({bright, block_medium(0.01, 0.1)}), {nullptr, &v}), (std::vector<bool>{true, false}));
+  EXPECT_EQ(line_media(scene_of({bright, block_medium(0.01, 0.1)}), {nullptr, &v}).line, (std::vector<bool>{true, false}));
   // About as bright as the sphere (Y(σa·Le)·volume: 42 against 32): both.
-  EXPECT_EQ(line_media(scene_of({bright, block_medium(0.01, 150.0)}), {nullptr, &v}),
+  EXPECT_EQ(line_media(scene_of({bright, block_medium(0.01, 150.0)}), {nullptr, &v}).line,
             (std::vector<bool>{true, true}));
 }
 
@@ -108,11 +108,11 @@ TEST(LineEstimator, TheFilesChoiceWins) {
   const StoredVolume v = block_volume();
   Scene dense = scene_of({block_medium(1.0, 1.0)});
   dense.integrator.emission_estimator = EmissionEstimator::Line;
-  EXPECT_EQ(line_media(dense, {&v}), std::vector<bool>{true});
+  EXPECT_EQ(line_media(dense, {&v}).line, std::vector<bool>{true});
   Scene thin = scene_of({block_medium(0.01, 100.0)});
   for (EmissionEstimator e : {EmissionEstimator::Collision, EmissionEstimator::Absorption}) {
     thin.integrator.emission_estimator = e;
-    EXPECT_EQ(line_media(thin, {&v}), std::vector<bool>{false}) << to_string(e);
+    EXPECT_EQ(line_media(thin, {&v}).line, std::vector<bool>{false}) << to_string(e);
   }
 }
 

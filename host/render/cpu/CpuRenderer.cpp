@@ -209,8 +209,7 @@ double emitted_at(const MediaData& md, int c, const glm::dvec3& x, Scratch& s) {
 constexpr double kLinePointsPerVoxel = 0.25, kLinePointsPerWidth = 8.0;
 double line_rate(const MediumData& m) {
   if (!m.is_vdb()) {
-    const glm::dvec3 e = m.bounds.max - m.bounds.min;
-    const double width = m.bounds.kind == Bounds::Kind::Sphere ? 2.0 * m.bounds.radius : std::min({e.x, e.y, e.z});
+    const double width = m.bounds.smallest_extent();
     return width > 0.0 ? kLinePointsPerWidth / width : 0.0;
   }
   if (!m.volume || m.volume->density.grid.empty()) return 0.0;
@@ -977,11 +976,10 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
   // The media the line estimator collects (the file's "line", or "auto"'s choice).
   std::vector<const StoredVolume*> volumes(scene.media.size(), nullptr);
   for (size_t i = 0; i < scene.media.size(); ++i) volumes[i] = media.media[i].volume.get();
-  const std::vector<bool> line = line_media(scene, volumes);
-  lights.selection = select_lights(scene, environment ? &*environment : nullptr, lights.cdf,
-                                   std::find(line.begin(), line.end(), true) != line.end());
+  const LineMedia line = line_media(scene, volumes);
+  lights.selection = select_lights(scene, environment ? &*environment : nullptr, lights.cdf, line.any());
   for (size_t i = 0; i < scene.media.size(); ++i)
-    if (line[i]) media.media[i].line_rate = line_rate(media.media[i]);
+    if (line.line[i]) media.media[i].line_rate = line_rate(media.media[i]);
   for (const Light& l : scene.lights) {
     AnalyticLight a;
     a.light = l;

@@ -166,14 +166,14 @@ bool every_temperature_fits_density(const std::vector<GpuGridSource>& sources, u
 GpuScene pack_gpu_media(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes, bool with_luts,
                         const std::vector<bool>& line) {
   GpuScene out;
-  out.line_media = line;
-  out.line_media.resize(scene.media.size(), false);
+  out.line.line = line;
+  out.line.line.resize(scene.media.size(), false);
   for (size_t i = 0; i < scene.media.size(); ++i) {
     const Medium& m = scene.media[i];
     if (m.type == Medium::Type::Homogeneous) {
       out.media.push_back(pack_analytic_medium(m));
       // Its line rate comes from each ray's chord (shaders/media.glsl majorant_at).
-      if (out.line_media[i]) out.media.back().line_points = float(kLinePointsPerCell);
+      if (out.line.line[i]) out.media.back().line_points = float(kLinePointsPerCell);
       out.has_analytic = true;
       out.has_emission = out.has_emission || max3(glm::dvec3(out.media.back().emission)) > 0.0;
     } else {
@@ -203,13 +203,13 @@ void add_majorant_cells(const Scene& scene, GpuScene& g) {
     grid.majorant_offset = uint32_t(g.majorants.size());
     grid.majorant_cell = v3(mg.cell_size);
     g.majorants.insert(g.majorants.end(), mg.max_density.begin(), mg.max_density.end());
-    // The line estimator's rates, for the media it collects (g.line_media).
+    // The line estimator's rates, for the grid media it collects (computed on
+    // this same majorant grid by line_media).
     grid.line_rate_offset = 0;
-    if (src.medium >= g.line_media.size() || !g.line_media[src.medium]) continue;
-    const DenseGrid* temperature = src.temperature && !src.temperature->grid.empty() ? &src.temperature->grid : nullptr;
-    const LineRates rates = line_rates(scene.media[src.medium], density, temperature, mg);
+    if (src.medium >= g.line.rates.size() || g.line.rates[src.medium].empty()) continue;
+    const std::vector<float>& rates = g.line.rates[src.medium];
     grid.line_rate_offset = uint32_t(g.majorants.size());
-    g.majorants.insert(g.majorants.end(), rates.rate.begin(), rates.rate.end());
+    g.majorants.insert(g.majorants.end(), rates.begin(), rates.end());
   }
 }
 
@@ -218,7 +218,9 @@ GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<Sto
   std::vector<const StoredVolume*> by_medium(scene.media.size(), nullptr);
   for (size_t i = 0; i < volumes.size() && i < by_medium.size(); ++i)
     if (volumes[i]) by_medium[i] = &*volumes[i];
-  GpuScene out = pack_gpu_media(scene, volumes, with_luts, line_media(scene, by_medium));
+  LineMedia line = line_media(scene, by_medium);
+  GpuScene out = pack_gpu_media(scene, volumes, with_luts, line.line);
+  out.line.rates = std::move(line.rates);
   add_majorant_cells(scene, out);
   out.temperature_in_density = every_temperature_fits_density(out.grid_sources, max_texture_bytes);
   return out;

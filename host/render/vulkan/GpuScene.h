@@ -7,6 +7,7 @@
 
 #include "color/BlackbodyLut.h"
 #include "light/LightSelection.h"
+#include "render/LineEstimator.h"
 #include "render/Render.h"
 #include "scene/Scene.h"
 #include "shared/gpu_types.h"
@@ -26,8 +27,8 @@ struct GpuScene {
   std::vector<gpu::GpuGrid> grids;
   std::vector<GpuGridSource> grid_sources;  // per slot, same order as grids
   std::vector<float> majorants;             // every grid's cells, at GpuGrid::majorant_offset (and line rates)
-  // Per scene medium: its emission is collected by the line estimator (line_media).
-  std::vector<bool> line_media;
+  // Which media the line estimator collects, and the grid media's rates.
+  LineMedia line;
   bool has_grids = false, has_scattering = false, has_emission = false;
   bool has_analytic = false;  // a sphere or box medium
   // Every emitting grid's temperature goes into its density texture's second
@@ -70,7 +71,7 @@ GpuScene pack_gpu_media(const Scene& scene, const std::vector<std::optional<Stor
                         bool with_luts = true, const std::vector<bool>& line = {});
 // Each grid's majorant cells (from its density as stored and the scene's
 // integrator.majorant settings) into g.majorants, and where they lie into its
-// GpuGrid; for the media g.line_media names, their line rates after them.
+// GpuGrid; for the grid media with line rates (g.line.rates), the rates after them.
 void add_majorant_cells(const Scene& scene, GpuScene& g);
 // The fields of a GpuGrid that describe what the session baked (the blackbody
 // LUT's coordinates, the majorant cells' geometry and line rates), copied from `baked`.

@@ -456,8 +456,7 @@ RenderSession::EmissionLights RenderSession::build_emission_lights(
       cdfs[src.medium] = EmissionCdf::build_light(m, *volumes[src.medium]);
       if (!cdfs[src.medium]->empty()) by_medium[src.medium] = &*cdfs[src.medium];
     }
-  const bool thin = std::find(g.line_media.begin(), g.line_media.end(), true) != g.line_media.end();
-  out.selection = select_lights(scene, environment_ ? &*environment_ : nullptr, by_medium, thin);
+  out.selection = select_lights(scene, environment_ ? &*environment_ : nullptr, by_medium, g.line.any());
   out.analytic = pack_gpu_lights(scene, out.selection);
   if (out.selection.strategy == LightStrategy::Bsdf) return out;
   // By grid slot: the CDFs next-event estimation may pick.
@@ -488,7 +487,7 @@ void RenderSession::upload_constants(const Scene& scene) {
   // Only the headers: the blackbody LUTs and majorant cells stay as baked (an
   // edit changes neither the emission's mode nor the grids), so they are not
   // rebuilt; the majorant scale, which follows the coefficients, is.
-  GpuScene now = pack_gpu_media(scene, volumes_, /*with_luts=*/false, gpu_scene_.line_media);
+  GpuScene now = pack_gpu_media(scene, volumes_, /*with_luts=*/false, gpu_scene_.line.line);
   for (size_t i = 0; i < now.grids.size() && i < gpu_scene_.grids.size(); ++i)
     keep_baked_grid_fields(gpu_scene_.grids[i], now.grids[i]);
   const gpu::FrameConstants frame = build_frame_constants(scene, settings_, uint32_t(now.media.size()), light_selection_);
