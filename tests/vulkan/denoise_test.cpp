@@ -102,6 +102,35 @@ Image noisy_edge_image() {
       [](int x, int) { return 0.2f * edge_level(x); }, 7);
 }
 
+// The flat-square tests' image: a 96×96 emissive square of value 2 (× tint,
+// noise σ = 20 % of it) at [16, 112)² in a 128×128 black, noise-free image.
+constexpr int kSquareSize = 128, kSquareLo = 16, kSquareHi = 112;
+bool in_square(int x, int y) { return x >= kSquareLo && x < kSquareHi && y >= kSquareLo && y < kSquareHi; }
+Image noisy_square_image() {
+  return noisy_image(
+      kSquareSize, kSquareSize, [](int x, int y) { return in_square(x, y) ? 2.0f : 0.0f; },
+      [](int x, int y) { return in_square(x, y) ? 0.4f : 0.0f; }, 25);
+}
+
+// Inside the square, 4 px from its sides, the denoised image is flat (its
+// spread under a fifth of the input's) and its mean is the true value within
+// 4 standard errors of the noisy mean, which must be under 0.25 % (so a 1 %
+// bias would be seen). Records each channel's spread ratio as
+// `property`_<channel>.
+void expect_square_flat(const Image& noisy, const Image& out, const std::string& property) {
+  auto interior = [](int x, int y) {
+    return x >= kSquareLo + 4 && x < kSquareHi - 4 && y >= kSquareLo + 4 && y < kSquareHi - 4;
+  };
+  for (int c = 0; c < 3; ++c) {
+    const Spread in = spread(noisy, c, interior), den = spread(out, c, interior);
+    const double truth = 2.0 * kTint[c], se = in.sd / std::sqrt(double(in.n));
+    EXPECT_LT(den.sd, 0.2 * in.sd) << "channel " << c << ": spread " << den.sd << " vs input " << in.sd;
+    EXPECT_LT(std::abs(den.mean - truth), 4.0 * se) << "channel " << c << ": mean " << den.mean << " vs " << truth;
+    EXPECT_LT(se, 0.005 * truth / 2.0) << "not informative at 0.5 %";
+    ::testing::Test::RecordProperty(property + "_" + std::to_string(c), std::to_string(den.sd / in.sd));
+  }
+}
+
 // Every column `edge_width` or more whole pixels from the edge has its mean
 // within 4 standard errors (of the noisy column's mean, σ/√rows) of its
 // side's true value, and every column 8 px or more from it is denoised
@@ -134,25 +163,14 @@ double expect_edge_holds(const Image& noisy, const Image& out, int edge_width) {
 // value within 4 standard errors of the noisy mean (SE ≈ 0.23 % here, so a
 // 1 % bias would be seen); the background stays (nearly) black.
 TEST_F(DenoiseGpu, FlatSquareStaysFlatAtItsValue) {
-  const int w = 128, h = 128, lo = 16, hi = 112;
-  auto inside = [&](int x, int y) { return x >= lo && x < hi && y >= lo && y < hi; };
-  Image noisy = noisy_image(
-      w, h, [&](int x, int y) { return inside(x, y) ? 2.0f : 0.0f; },
-      [&](int x, int y) { return inside(x, y) ? 0.4f : 0.0f; }, 25);
+  const int w = kSquareSize, h = kSquareSize, lo = kSquareLo, hi = kSquareHi;
+  const Image noisy = noisy_square_image();
   Image out = denoiser_->run(noisy, tested());
   ASSERT_EQ(out.width, w);
   ASSERT_EQ(out.height, h);
   EXPECT_FALSE(out.has_variance());
   ASSERT_TRUE(out.has_alpha());
-  auto interior = [&](int x, int y) { return x >= lo + 4 && x < hi - 4 && y >= lo + 4 && y < hi - 4; };
-  for (int c = 0; c < 3; ++c) {
-    const Spread in = spread(noisy, c, interior), den = spread(out, c, interior);
-    const double truth = 2.0 * kTint[c], se = in.sd / std::sqrt(double(in.n));
-    EXPECT_LT(den.sd, 0.2 * in.sd) << "channel " << c << ": spread " << den.sd << " vs input " << in.sd;
-    EXPECT_LT(std::abs(den.mean - truth), 4.0 * se) << "channel " << c << ": mean " << den.mean << " vs " << truth;
-    EXPECT_LT(se, 0.005 * truth / 2.0) << "not informative at 0.5 %";
-    RecordProperty("spread_ratio_" + std::to_string(c), std::to_string(den.sd / in.sd));
-  }
+  expect_square_flat(noisy, out, "spread_ratio");
   // The noise-free background around the square: the weight between a
   // noise-free pixel and a noisy one is measured against the noisy one's
   // noise, so a trace of the square spreads out (docs/compositing.md
@@ -243,28 +261,17 @@ void add_guided_aovs(Image& img, Layer layer, const std::vector<float>& truth) {
 // background around it stays exactly black (the guide is 0 there), however
 // close to the square.
 TEST_F(DenoiseGpu, GuidedFlatSquareStaysFlatAtItsValue) {
-  const int w = 128, h = 128, lo = 16, hi = 112;
-  auto inside = [&](int x, int y) { return x >= lo && x < hi && y >= lo && y < hi; };
-  Image noisy = noisy_image(
-      w, h, [&](int x, int y) { return inside(x, y) ? 2.0f : 0.0f; },
-      [&](int x, int y) { return inside(x, y) ? 0.4f : 0.0f; }, 25);
+  Image noisy = noisy_square_image();
   std::vector<float> truth(noisy.pixel_count() * 3);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < 3; ++c) truth[noisy.index(x, y, c)] = inside(x, y) ? 2.0f * kTint[c] : 0.0f;
+  for (int y = 0; y < noisy.height; ++y)
+    for (int x = 0; x < noisy.width; ++x)
+      for (int c = 0; c < 3; ++c) truth[noisy.index(x, y, c)] = in_square(x, y) ? 2.0f * kTint[c] : 0.0f;
   add_guided_aovs(noisy, Layer::Emission, truth);
   const Image out = denoiser_->run(noisy, DenoiseOptions{});
-  auto interior = [&](int x, int y) { return x >= lo + 4 && x < hi - 4 && y >= lo + 4 && y < hi - 4; };
-  for (int c = 0; c < 3; ++c) {
-    const Spread in = spread(noisy, c, interior), den = spread(out, c, interior);
-    const double t = 2.0 * kTint[c], se = in.sd / std::sqrt(double(in.n));
-    EXPECT_LT(den.sd, 0.2 * in.sd) << "channel " << c << ": spread " << den.sd << " vs input " << in.sd;
-    EXPECT_LT(std::abs(den.mean - t), 4.0 * se) << "channel " << c << ": mean " << den.mean << " vs " << t;
-    RecordProperty("guided_spread_ratio_" + std::to_string(c), std::to_string(den.sd / in.sd));
-  }
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      if (!inside(x, y))
+  expect_square_flat(noisy, out, "guided_spread_ratio");
+  for (int y = 0; y < out.height; ++y)
+    for (int x = 0; x < out.width; ++x)
+      if (!in_square(x, y))
         for (int c = 0; c < 3; ++c) ASSERT_EQ(out.at(x, y, c), 0.0f) << x << "," << y;
 }
 
