@@ -230,6 +230,16 @@ TEST_F(LightResolution, UnsampledGridGetsNoProbability) {
   EXPECT_EQ(a.strategy, LightStrategy::Bsdf);
 }
 
+// An estimator the loader does not know is refused in one line that names
+// the file and the key and lists the values it takes, "line" among them.
+TEST_F(LightResolution, UnknownEstimatorIsRefusedNamingTheValues) {
+  const std::string msg = parse_error(R"({"emission_estimator": "lines"})");
+  EXPECT_NE(msg.find("bad.json: integrator.emission_estimator: "), std::string::npos) << msg;
+  for (const char* value : {"\"auto\"", "\"absorption\"", "\"collision\"", "\"line\"", "\"lines\""})
+    EXPECT_NE(msg.find(value), std::string::npos) << value << " missing from: " << msg;
+  EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+}
+
 // Keys that contradict each other: the file is refused at load, naming the
 // key; the same Scene built in code is refused by select_lights.
 TEST_F(LightResolution, ContradictionsAreRefused) {
@@ -251,7 +261,9 @@ TEST_F(LightResolution, ContradictionsAreRefused) {
   // Consistent choices load.
   for (const char* ok : {R"({"mis": true, "emission_estimator": "collision"})", R"({"mis": true})",
                          R"({"mis": false, "emission_estimator": "absorption"})", R"({"emission_estimator": "absorption"})",
-                         R"({"light_only": true, "mis": true})", R"({"light_only": true})"})
+                         R"({"light_only": true, "mis": true})", R"({"light_only": true})",
+                         R"({"mis": true, "emission_estimator": "line"})",
+                         R"({"light_only": true, "emission_estimator": "line"})"})
     EXPECT_EQ(parse_error(ok), "") << ok;
 
   Scene s = fire_over_plane();
