@@ -99,6 +99,14 @@ bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, 
       return ray_ends(p);
     }
   }
+  // A medium's real collision scatters whenever it can (implicit capture,
+  // path_track): the absorption estimator collects here what an absorption
+  // would have, as its expected value sigma_a·Le / (sigma_bar·(P_a + P_s)),
+  // p_s being P_a + P_s. Every real collision of the path adds its share,
+  // each weighted by the scattering that led to it, instead of one
+  // all-or-nothing sample where the path happens to be absorbed.
+  if (!surface && HAS_EMISSION && !COLLISION_ESTIMATOR)
+    p.L += p.w * emission_at(x, p.t, span, rho, temperature_value) / (sigma_bar * p_s);
   return scatter_vertex(p, surface, x, sigma_s, sigma_bar, p_s, rho, rng, stats);
 }
 

@@ -135,11 +135,12 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
       float c = sigma_bar * avg3(p.w);
       p_a = avg3(sigma_a * p.w) / c;
       p_s = HAS_SCATTERING ? avg3(sigma_s * p.w) / c : 0.0;
-      // With next-event estimation a real collision scatters whenever it can
-      // (docs/mis.md "No absorption events"): the collision estimator has already
-      // collected the emission here, and the scattering's weight
-      // sigma_s / (sigma_bar·(P_a + P_s)) keeps the expectation.
-      if (NEE && COLLISION_ESTIMATOR && p_s > 0.0) {
+      // A real collision scatters whenever it can (implicit capture,
+      // docs/mis.md "No absorption events"): the scattering's weight
+      // sigma_s / (sigma_bar·(P_a + P_s)) keeps the expectation, and the
+      // emission an absorption here would have collected is collected as its
+      // expected value, by the collision estimator already or by path_event.
+      if (p_s > 0.0) {
         p_s += p_a;
         p_a = 0.0;
       }

@@ -121,18 +121,16 @@ bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float
     ++p.depth;
     const float w_before = max3(p.w);
     p.w *= sigma_s / (sigma_bar * p_s);
-    if (NEE && COLLISION_ESTIMATOR) {
-      // Russian roulette for what absorption no longer ends: once the factors
-      // that kept this path alive have lowered its weight below
-      // SCATTER_ROULETTE_BELOW of what it was, survive with probability
-      // survival / SCATTER_ROULETTE_BELOW, reweighted.
-      p.survival *= max3(p.w) / w_before;
-      const float q_survive = p.survival / SCATTER_ROULETTE_BELOW;
-      if (q_survive < 1.0) {
-        if (rng_next(rng) >= q_survive) return true;
-        p.w /= q_survive;
-        p.survival = SCATTER_ROULETTE_BELOW;
-      }
+    // Russian roulette for what absorption no longer ends: once the factors
+    // that kept this path alive have lowered its weight below
+    // SCATTER_ROULETTE_BELOW of what it was, survive with probability
+    // survival / SCATTER_ROULETTE_BELOW, reweighted.
+    p.survival *= max3(p.w) / w_before;
+    const float q_survive = p.survival / SCATTER_ROULETTE_BELOW;
+    if (q_survive < 1.0) {
+      if (rng_next(rng) >= q_survive) return true;
+      p.w /= q_survive;
+      p.survival = SCATTER_ROULETTE_BELOW;
     }
     // Phase function of the mixture f = Σ_i share_i·HG_i, share_i = σs_i/σs (per
     // channel): sample lobe i with q_i ∝ avg(share_i ⊙ w); the direction's pdf
