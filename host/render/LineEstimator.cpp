@@ -9,9 +9,14 @@
 
 namespace pyrolume {
 
-glm::ivec3 majorant_resolution(const Integrator& in, glm::ivec3 dims) {
+glm::ivec3 majorant_resolution(const Integrator& in, const Medium& m, const DenseGrid& density) {
   if (in.majorant == Majorant::Global) return glm::ivec3(1);
-  return in.majorant_grid.value_or(default_majorant_resolution(dims));
+  if (in.majorant_grid) return *in.majorant_grid;
+  const glm::dvec3 sigma_t = m.sigma_a + m.sigma_s;
+  const double albedo = sigma_t.x + sigma_t.y + sigma_t.z > 0.0
+                            ? (m.sigma_s.x + m.sigma_s.y + m.sigma_s.z) / (sigma_t.x + sigma_t.y + sigma_t.z)
+                            : 0.0;
+  return choose_majorant_resolution(density, std::max({sigma_t.x, sigma_t.y, sigma_t.z}) * m.density_scale, albedo);
 }
 
 namespace {
@@ -100,7 +105,7 @@ LineMedia line_media(const Scene& scene, const std::vector<const StoredVolume*>&
       const DenseGrid* temperature =
           vol->temperature && !vol->temperature->grid.empty() ? &vol->temperature->grid : nullptr;
       LineRates rates =
-          line_rates(m, density, temperature, build_majorant_grid(density, majorant_resolution(scene.integrator, density.dims)));
+          line_rates(m, density, temperature, build_majorant_grid(density, majorant_resolution(scene.integrator, m, density)));
       power[i] = rates.power;
       out.line[i] = asked || rates.thin();
       out.rates[i] = std::move(rates.rate);

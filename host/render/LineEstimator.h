@@ -51,10 +51,11 @@ struct LineRates {
 // cell weight, Y(σa·Le)), which is also the weight above.
 LineRates line_rates(const Medium& m, const DenseGrid& density, const DenseGrid* temperature, const MajorantGrid& mg);
 
-// The majorant grid's resolution for a density texture of `dims` texels:
-// one cell with integrator.majorant "global", else integrator.majorant_grid or
-// default_majorant_resolution.
-glm::ivec3 majorant_resolution(const Integrator& in, glm::ivec3 dims);
+// The majorant grid's resolution for medium m's density texture: one cell
+// with integrator.majorant "global", else integrator.majorant_grid, else the
+// cheapest for tracking (choose_majorant_resolution, with m's σt per unit
+// density and its albedo).
+glm::ivec3 majorant_resolution(const Integrator& in, const Medium& m, const DenseGrid& density);
 
 // A homogeneous medium (constant emission) is one cell: each ray gets
 // kLinePointsPerCell points along its chord through it (shaders/media.glsl

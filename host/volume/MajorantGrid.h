@@ -30,3 +30,28 @@ glm::ivec3 default_majorant_resolution(glm::ivec3 dims);
 MajorantGrid build_majorant_grid(const DenseGrid& density, glm::ivec3 res);
 
 }  // namespace pyrolume
+
+namespace pyrolume {
+
+// The majorant grid is a trade: finer cells bound the density more tightly
+// (fewer tentative collisions, each a density lookup) but a ray crosses more
+// of them (each crossing one more step of the free-flight loop). What a ray
+// costs, in density lookups, for a candidate grid: delta tracking of kCostRays
+// random rays (a uniform random line through the texture, from where it
+// enters; isotropic in world space), each continuing after a real collision
+// with probability `albedo` (up to kCostBounces times) in a new isotropic
+// direction. Empty cells cost kEmptyCellCost (the GPU walks runs of them in
+// one step), other cells kCellCost. Deterministic: a fixed random sequence.
+inline constexpr int kCostRays = 2048, kCostBounces = 8;
+inline constexpr double kCellCost = 0.5, kEmptyCellCost = 0.05;
+double tracking_cost(const DenseGrid& density, const MajorantGrid& m, double sigma_t_per_density, double albedo);
+
+// The cheapest of the resolutions ceil(dims/16)·2^j, j = 0..3 (16, 8, 4 and 2
+// texels per cell, while the grid stays within kMaxMajorantCells) by
+// tracking_cost; the coarsest, default_majorant_resolution, on ties. Each is
+// the next one's cells max-pooled 2×2×2, which is exactly the grid
+// build_majorant_grid makes at that resolution.
+inline constexpr size_t kMaxMajorantCells = size_t(1) << 21;
+glm::ivec3 choose_majorant_resolution(const DenseGrid& density, double sigma_t_per_density, double albedo);
+
+}  // namespace pyrolume

@@ -9,6 +9,7 @@
 #include "scene/Scene.h"
 #include "support/TestSupport.h"
 #include "support/VdbScenes.h"
+#include "render/LineEstimator.h"
 #include "volume/MajorantGrid.h"
 #include "volume/StoredVolume.h"
 
@@ -82,6 +83,82 @@ TEST(MajorantGrid, UsesTheRoundedHalfValues) {
   EXPECT_GT(g.grid.values[21], 0.3f);
   MajorantGrid m = build_majorant_grid(g.grid, glm::ivec3(1));
   EXPECT_EQ(m.at(0, 0, 0), g.grid.values[21]);
+}
+
+// A 64³ texture (unit voxels, one texel of zero padding) filled by f(x, y, z).
+template <class F>
+DenseGrid field_grid(F f) {
+  DenseGrid g;
+  g.dims = glm::ivec3(64);
+  g.values.assign(g.texel_count(), 0.0f);
+  for (int k = 1; k < 63; ++k)
+    for (int j = 1; j < 63; ++j)
+      for (int i = 1; i < 63; ++i) g.values[(size_t(k) * 64 + j) * 64 + i] = f(i + 0.5, j + 0.5, k + 0.5);
+  g.max_value = 1.0f;
+  return g;
+}
+
+// Where the default cells already bound the density tightly (a uniform dense
+// block), finer cells only add DDA steps: the cost model keeps the default.
+TEST(MajorantChoice, KeepsTheDefaultWhereTheDefaultIsTight) {
+  const DenseGrid block = field_grid([](double, double, double) { return 1.0f; });
+  EXPECT_EQ(choose_majorant_resolution(block, 1.0, 0.5), default_majorant_resolution(block.dims));
+  const MajorantGrid coarse = build_majorant_grid(block, default_majorant_resolution(block.dims));
+  const MajorantGrid fine = build_majorant_grid(block, default_majorant_resolution(block.dims) * 4);
+  EXPECT_LT(tracking_cost(block, coarse, 1.0, 0.5), tracking_cost(block, fine, 1.0, 0.5));
+}
+
+// A dense shell 2 texels thick (radius 24, empty inside): a 16³ cell it
+// crosses is bounded by the shell's density but mostly empty, so most
+// tentative collisions there are null. Finer cells cost less, and the cost
+// model picks them; the density lookups it saves are real (the
+// simulated cost falls by more than a third).
+TEST(MajorantChoice, PicksFinerCellsForAThinDenseShell) {
+  const DenseGrid shell = field_grid([](double x, double y, double z) {
+    const double r = glm::length(glm::dvec3(x, y, z) - 32.0);
+    return std::abs(r - 24.0) < 1.0 ? 1.0f : 0.0f;
+  });
+  const glm::ivec3 def = default_majorant_resolution(shell.dims), chosen = choose_majorant_resolution(shell, 4.0, 0.0);
+  EXPECT_GT(chosen.x, def.x);
+  EXPECT_EQ(chosen.x, chosen.y);
+  EXPECT_EQ(chosen.x, chosen.z);
+  const double c_def = tracking_cost(shell, build_majorant_grid(shell, def), 4.0, 0.0);
+  const double c_chosen = tracking_cost(shell, build_majorant_grid(shell, chosen), 4.0, 0.0);
+  EXPECT_LT(c_chosen, 0.67 * c_def) << "default " << c_def << ", chosen " << c_chosen;
+  // Deterministic: the same choice every time (the same image every run).
+  EXPECT_EQ(choose_majorant_resolution(shell, 4.0, 0.0), chosen);
+}
+
+// choose_majorant_resolution max-pools each candidate into the next coarser
+// one; that is exactly build_majorant_grid at the coarser resolution (cell c
+// of res r spans cells 2c and 2c + 1 of res 2r, and its texel footprint is
+// the union of theirs).
+TEST(MajorantChoice, MaxPoolingEqualsBuildingTheCoarserGrid) {
+  Medium m = test::vdb_file_medium(std::filesystem::path(PYROLUME_SOURCE_DIR) / "assets/volumes/fire.vdb");
+  const DenseGrid& g = load_stored_volume(m).density.grid;
+  const glm::ivec3 r = default_majorant_resolution(g.dims);
+  const MajorantGrid fine = build_majorant_grid(g, r * 2), coarse = build_majorant_grid(g, r);
+  int differ = 0;
+  for (int z = 0; z < r.z; ++z)
+    for (int y = 0; y < r.y; ++y)
+      for (int x = 0; x < r.x; ++x) {
+        float mx = 0.0f;
+        for (int c = 0; c < 8; ++c) mx = std::max(mx, fine.at(2 * x + (c & 1), 2 * y + (c >> 1 & 1), 2 * z + (c >> 2)));
+        differ += mx != coarse.at(x, y, z);
+      }
+  EXPECT_EQ(differ, 0);
+}
+
+// What the file says wins: integrator.majorant_grid, and "global" (one cell).
+TEST(MajorantChoice, TheFilesChoiceWins) {
+  const DenseGrid shell = field_grid([](double x, double, double) { return x < 3.0 ? 1.0f : 0.0f; });
+  Medium m;
+  m.sigma_a = glm::dvec3(4.0);
+  Integrator in;
+  in.majorant_grid = glm::ivec3(3, 5, 7);
+  EXPECT_EQ(majorant_resolution(in, m, shell), glm::ivec3(3, 5, 7));
+  in.majorant = Majorant::Global;
+  EXPECT_EQ(majorant_resolution(in, m, shell), glm::ivec3(1));
 }
 
 }  // namespace

@@ -128,7 +128,8 @@ TEST_F(VulkanVdb, EstimatorsAgreeOnScatteringChromaticTemperatureScene) {
 
 // The majorant grid and one global majorant give the same image, and on a
 // sparse explosion shell (empty inside and in the corners) the grid saves
-// density lookups: at the default resolution and at 16³ cells.
+// density lookups: at 16³ cells, and more at the default resolution, which
+// the cost model (choose_majorant_resolution) makes finer for a thin shell.
 TEST_F(VulkanVdb, MajorantGridMatchesGlobalWithFewerLookups) {
   const test::Lattice shell_lat{0.05, {0.0, 0.0, 0.0}};
   Scene s = shell_view(32, 32, 512, {0.1, 0.15, 0.3}, 4, -4.0);
@@ -158,7 +159,7 @@ TEST_F(VulkanVdb, MajorantGridMatchesGlobalWithFewerLookups) {
               "seconds %.2f / %.2f / %.2f\n",
               lg, ld, lg / ld, l16, lg / l16, global.seconds, grid_default.seconds, grid16.seconds);
   EXPECT_LT(ld, lg);
-  EXPECT_LT(l16, ld);
+  EXPECT_LT(ld, l16);
   // The shell's own lookups are unavoidable; what a grid can save is the
   // empty interior (r < 20 voxels of 30): a bit under 2x here at 16^3.
   EXPECT_LT(l16, 0.75 * lg) << "a 16^3 majorant grid should skip the shell's empty interior";

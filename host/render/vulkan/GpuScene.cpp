@@ -197,7 +197,7 @@ void add_majorant_cells(const Scene& scene, GpuScene& g) {
     // Majorant cells over the stored (rounded) density.
     const GpuGridSource& src = g.grid_sources[slot];
     const DenseGrid& density = src.density->grid;
-    const MajorantGrid mg = build_majorant_grid(density, majorant_resolution(scene.integrator, density.dims));
+    const MajorantGrid mg = build_majorant_grid(density, majorant_resolution(scene.integrator, scene.media[src.medium], density));
     gpu::GpuGrid& grid = g.grids[slot];
     grid.majorant_res = gpu::uvec3(uint32_t(mg.res.x), uint32_t(mg.res.y), uint32_t(mg.res.z));
     grid.majorant_offset = uint32_t(g.majorants.size());
