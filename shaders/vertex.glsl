@@ -1,7 +1,8 @@
 // A scattering vertex (surface or medium): its light rays (next-event
 // estimation, drawn one at a time by next_light_ray) and its continuation.
-// Once scatterings that next-event estimation keeps from being absorbed have
-// lowered a path's weight below this fraction, Russian roulette (path_step).
+// Once the scatterings that implicit capture keeps from being absorbed have
+// lowered a path's weight below this fraction, Russian roulette
+// (scatter_vertex; docs/mis.md "No absorption events").
 const float SCATTER_ROULETTE_BELOW = 0.1;
 
 // The next of a vertex's light rays (docs/mis.md "Several light samples"),

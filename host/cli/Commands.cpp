@@ -115,6 +115,7 @@ void write_stats(const std::filesystem::path& file, const RenderArgs& args, cons
   j["scene"] = args.scene;
   j["light_strategy"] = result.light_strategy;
   j["emission_estimator"] = result.emission_estimator;
+  if (!result.majorant_grids.empty()) j["majorant_grids"] = result.majorant_grids;
   j["output"] = output.string();
   if (frame) j["frame"] = *frame;
   j["width"] = result.width;

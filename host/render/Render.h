@@ -1,6 +1,7 @@
 #pragma once
 // What every backend returns: per-pixel sums and sums of squares of the sample
 // radiance (so each render carries its own per-pixel variance), plus counters.
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -100,6 +101,9 @@ struct RenderResult {
   // (host/light/LightSelection.h): "bsdf" | "mis" | "light_only" and
   // "absorption" | "collision". Both backends fill them the same way.
   std::string light_strategy, emission_estimator;
+  // Each grid medium's majorant grid, cells per axis (the GPU's: chosen per
+  // grid, host/volume/MajorantGrid.h; empty on the CPU, which uses global majorants).
+  std::vector<std::array<int, 3>> majorant_grids;
   double seconds = 0.0;       // first dispatch to finished readback
   double load_seconds = 0.0;  // device/pipeline creation, uploads, bakes
   // Counters summed over all camera samples.

@@ -88,6 +88,7 @@ double tracking_cost(const DenseGrid& g, const MajorantGrid& m, double sigma_t_p
   const glm::dvec3 to_index = glm::dvec3(g.origin) - 0.5;  // texel coords -> index coords
   double cost = 0.0;
   for (int ray = 0; ray < kCostRays; ++ray) {
+    const double ray_start = cost;
     glm::dvec3 p(rng.next() * dims.x, rng.next() * dims.y, rng.next() * dims.z);
     glm::dvec3 v = to_texel * rng.direction();
     double t0, t1;
@@ -114,18 +115,19 @@ double tracking_cost(const DenseGrid& g, const MajorantGrid& m, double sigma_t_p
           t -= std::log(1.0 - rng.next()) / sigma_bar;
           if (t >= t_exit) break;
           cost += 1.0;  // a density lookup
+          if (cost - ray_start >= kCostCapPerRay) break;
           const double sigma = g.sample_index(p + t * v + to_index) * sigma_t_per_density;
           if (rng.next() * sigma_bar < sigma) {
             collided = true;
             break;
           }
         }
-        if (collided || axis < 0) break;
+        if (collided || axis < 0 || cost - ray_start >= kCostCapPerRay) break;
         t = t_exit;
         cell[axis] += v[axis] > 0.0 ? 1 : -1;
         if (cell[axis] < 0 || cell[axis] >= m.res[axis]) break;
       }
-      if (!collided || rng.next() >= albedo) break;
+      if (!collided || cost - ray_start >= kCostCapPerRay || rng.next() >= albedo) break;
       p += t * v;
       v = to_texel * rng.direction();
     }
@@ -163,4 +165,3 @@ glm::ivec3 choose_majorant_resolution(const DenseGrid& g, double sigma_t_per_den
 }
 
 }  // namespace pyrolume
-

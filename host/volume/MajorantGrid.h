@@ -29,10 +29,6 @@ glm::ivec3 default_majorant_resolution(glm::ivec3 dims);
 // precision the hardware uses for its weights.
 MajorantGrid build_majorant_grid(const DenseGrid& density, glm::ivec3 res);
 
-}  // namespace pyrolume
-
-namespace pyrolume {
-
 // The majorant grid is a trade: finer cells bound the density more tightly
 // (fewer tentative collisions, each a density lookup) but a ray crosses more
 // of them (each crossing one more step of the free-flight loop). What a ray
@@ -41,9 +37,13 @@ namespace pyrolume {
 // enters; isotropic in world space), each continuing after a real collision
 // with probability `albedo` (up to kCostBounces times) in a new isotropic
 // direction. Empty cells cost kEmptyCellCost (the GPU walks runs of them in
-// one step), other cells kCellCost. Deterministic: a fixed random sequence.
+// one step), other cells kCellCost. A ray stops counting at kCostCapPerRay:
+// in a nearly opaque medium every candidate pays thousands of lookups per ray
+// to cross the one texel where the density ramps up, and simulating them all
+// would cost seconds to learn nothing (the cells then decide, and the
+// coarsest wins). Deterministic: a fixed random sequence.
 inline constexpr int kCostRays = 2048, kCostBounces = 8;
-inline constexpr double kCellCost = 0.5, kEmptyCellCost = 0.05;
+inline constexpr double kCellCost = 0.5, kEmptyCellCost = 0.05, kCostCapPerRay = 128.0;
 double tracking_cost(const DenseGrid& density, const MajorantGrid& m, double sigma_t_per_density, double albedo);
 
 // The cheapest of the resolutions ceil(dims/16)·2^j, j = 0..3 (16, 8, 4 and 2

@@ -96,6 +96,30 @@ INSTANTIATE_TEST_SUITE_P(Backends, CliRender, ::testing::Values("vulkan", "cpu")
 // signal that arrives before the first pass ends leaves nothing to save (tested
 // in CliCheckpoint): on a loaded machine start-up can outlast the first wait,
 // and the render is then repeated with a longer one (the last must succeed).
+// --stats says which majorant grid each grid got on the GPU: the one the
+// file writes, else the cost model's (host/volume/MajorantGrid.h). The
+// shipped fire keeps the coarsest, one cell per 16³ texels; the CPU, which
+// uses global majorants, writes no key.
+TEST(CliStats, ReportsEachGridsMajorantCells) {
+  auto dir = temp_dir("majorant_stats");
+  const std::string fire = (std::filesystem::path(PYROLUME_SOURCE_DIR) / "assets/volumes/fire.vdb").string();
+  auto render = [&](const std::string& integrator, const std::string& backend) {
+    write_file(dir / "s.json", R"({"integrator": {)" + integrator + R"(}, "media": [{"type": "vdb", "file": ")" + fire +
+                                   R"("}]})");
+    CliResult r = run_cli("render " + (dir / "s.json").string() + " -o " + (dir / "o.exr").string() + " --backend " +
+                          backend + " --spp 1 --width 16 --height 16 --stats " + (dir / "st.json").string());
+    EXPECT_EQ(r.status, 0) << r.err;
+    return nlohmann::json::parse(read_file(dir / "st.json"));
+  };
+  auto automatic = render("", "vulkan");
+  ASSERT_TRUE(automatic.contains("majorant_grids")) << automatic.dump();
+  EXPECT_EQ(automatic["majorant_grids"], nlohmann::json::parse("[[6, 9, 6]]")) << automatic.dump();
+  auto written = render(R"("majorant_grid": [3, 4, 5])", "vulkan");
+  EXPECT_EQ(written["majorant_grids"], nlohmann::json::parse("[[3, 4, 5]]")) << written.dump();
+  EXPECT_FALSE(render("", "cpu").contains("majorant_grids"));
+  std::filesystem::remove_all(dir);
+}
+
 TEST(CliInterrupt, SigintSavesImageAndExits130) {
   auto dir = temp_dir("sigint");
   write_file(dir / "s.json", kScene);

@@ -65,6 +65,7 @@ class RenderSession {
   // Next-event estimation is on: every vertex sends a light ray too.
   bool next_event_estimation() const { return light_selection_.strategy != LightStrategy::Bsdf; }
   const LightSelection& light_selection() const { return light_selection_; }
+  const GpuScene& gpu_scene() const { return gpu_scene_; }
   // Rays a vertex may send: its continuation, and with next-event estimation
   // up to surface_light_samples light rays and the ratio-tracked
   // continuation's ray (VulkanRenderer::spp_per_pass).

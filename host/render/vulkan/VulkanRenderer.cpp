@@ -69,6 +69,8 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
   result.device = device_name();
   result.light_strategy = strategy_name(session.light_selection().strategy);
   result.emission_estimator = to_string(session.light_selection().estimator);
+  for (const gpu::GpuGrid& g : session.gpu_scene().grids)
+    result.majorant_grids.push_back({int(g.majorant_res.x), int(g.majorant_res.y), int(g.majorant_res.z)});
   result.warnings = session.warnings();
   result.load_seconds = since(load_start) + context_seconds_;
   context_seconds_ = 0.0;
