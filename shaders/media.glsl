@@ -3,9 +3,15 @@
 // the emission at a point.
 // Texture arrays are indexed with constants only (no dependence on
 // dynamically-uniform indexing, which lavapipe and older GPUs handle poorly).
-// With TEMPERATURE_IN_DENSITY, .y is the temperature grid's value (else 0).
-vec2 density_at(uint slot, vec3 tc) {
+// u: texel coordinates (density_texel). With TEMPERATURE_IN_DENSITY, .y is the
+// temperature grid's value (else 0). A sparse grid reads its tree instead.
+vec2 density_at(uint slot, vec3 u) {
   if (GRID_COUNT <= 1u) slot = 0u;
+  if (SPARSE_GRIDS && grids[slot].density_tree != 0u)
+    return vec2(sparse_trilinear(grids[slot].density_leaf_table, grids[slot].density_leaf_origin,
+                                 grids[slot].density_leaf_dims, u + grids[slot].density_index_origin),
+                0.0);
+  const vec3 tc = u / grids[slot].density_dims;
   vec2 v;
   switch (slot) {
     case 0u: v = textureLod(density_tex[0], tc, 0.0).rg; break;
@@ -15,8 +21,12 @@ vec2 density_at(uint slot, vec3 tc) {
   }
   return TEMPERATURE_IN_DENSITY ? v : vec2(v.x, 0.0);
 }
-float temperature_at(uint slot, vec3 tc) {
+float temperature_at(uint slot, vec3 u) {
   if (GRID_COUNT <= 1u) slot = 0u;
+  if (SPARSE_GRIDS && grids[slot].temperature_tree != 0u)
+    return sparse_trilinear(grids[slot].temperature_leaf_table, grids[slot].temperature_leaf_origin,
+                            grids[slot].temperature_leaf_dims, u + grids[slot].temperature_index_origin);
+  const vec3 tc = u / grids[slot].temperature_dims;
   switch (slot) {
     case 0u: return textureLod(temperature_tex[0], tc, 0.0).r;
     case 1u: return textureLod(temperature_tex[1], tc, 0.0).r;
@@ -72,7 +82,7 @@ vec3 grid_le(GpuMedium m, uint slot, vec3 x, float value_read) {
     vec4 p1 = vec4(x, 1.0);
     vec3 u = vec3(dot(grids[slot].temperature_row0, p1), dot(grids[slot].temperature_row1, p1),
                   dot(grids[slot].temperature_row2, p1));
-    value = temperature_at(slot, u / grids[slot].temperature_dims);
+    value = temperature_at(slot, u);
   }
   float T = (value - grids[slot].temperature_offset) * grids[slot].temperature_scale;
   if (!(T > grids[slot].cutoff_k) || !(T >= grids[slot].t_min_k)) return vec3(0.0);
@@ -174,7 +184,7 @@ void coefficients_at(vec3 x, float t, vec2 span[MEDIA_N], out vec3 sigma_a, out 
     float r = 1.0;
     if (is_grid(m)) {
       uint slot = m.grid_slot;
-      const vec2 v = density_at(slot, density_texel(slot, x) / grids[slot].density_dims);
+      const vec2 v = density_at(slot, density_texel(slot, x));
       r = grids[slot].density_scale * v.x;
       temperature_value[i] = v.y;
       stats.lookups += 1.0;

@@ -49,6 +49,10 @@ layout(std430, set = 0, binding = BINDING_MAJORANTS) readonly buffer MajorantBlo
 layout(set = 0, binding = BINDING_DENSITY) uniform sampler3D density_tex[MAX_GRIDS];
 layout(set = 0, binding = BINDING_TEMPERATURE) uniform sampler3D temperature_tex[MAX_GRIDS];
 layout(set = 0, binding = BINDING_BLACKBODY) uniform sampler1D blackbody_tex[MAX_GRIDS];
+// Some grid is a NanoVDB tree in sparse_tex (shaders/sparse.glsl); false: none of that code.
+layout(constant_id = SPEC_SPARSE_GRIDS) const bool SPARSE_GRIDS = false;
+layout(set = 0, binding = BINDING_SPARSE) uniform usamplerBuffer sparse_tex;
+#include "sparse.glsl"
 layout(push_constant) uniform PassBlock { PassConstants pass_constants; };
 layout(std430, set = 0, binding = BINDING_PASS_STATUS) buffer PassStatusBlock { PassStatus pass_status; };
 // Surfaces (shaders/bvh.glsl's contract).

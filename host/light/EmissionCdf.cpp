@@ -13,6 +13,7 @@
 #include "color/EmissionModel.h"
 #include "light/PiecewiseConstant.h"
 #include "scene/MediumVolume.h"
+#include "volume/SparseGrid.h"
 
 namespace pyrolume {
 
@@ -83,8 +84,12 @@ EmissionCdf EmissionCdf::build(const DenseGrid& density, const DenseGrid* temper
   if (!p.emits_rgb) {
     std::unordered_map<uint32_t, double> memo;
     E_t.resize(temperature->texel_count());
+    const glm::ivec3 TD = temperature->dims;
     for (size_t k = 0; k < E_t.size(); ++k) {
-      const float v = temperature->values[k];
+      const float v = temperature->is_sparse()
+                          ? temperature->texel(int(k % size_t(TD.x)), int((k / size_t(TD.x)) % size_t(TD.y)),
+                                               int(k / (size_t(TD.x) * size_t(TD.y))))
+                          : temperature->values[k];
       uint32_t bits;
       std::memcpy(&bits, &v, 4);
       auto it = memo.find(bits);
@@ -139,7 +144,9 @@ EmissionCdf EmissionCdf::build(const DenseGrid& density, const DenseGrid* temper
   std::vector<double> w;
   std::vector<uint32_t> entries;
   const glm::ivec3 D = density.dims;
-  auto rho = [&](int x, int y, int z) { return density.values[(size_t(z) * D.y + y) * D.x + x]; };
+  auto rho = [&](int x, int y, int z) {
+    return density.is_sparse() ? density.texel(x, y, z) : density.values[(size_t(z) * D.y + y) * D.x + x];
+  };
   for (int k = 0; k < C.z; ++k)
     for (int j = 0; j < C.y; ++j)
       for (int i = 0; i < C.x; ++i) {
@@ -210,7 +217,124 @@ EmissionCdf EmissionCdf::blocks(int b) const {
   return e;
 }
 
+EmissionCdf EmissionCdf::build_sparse_blocks(const DenseGrid& density, const DenseGrid* temperature,
+                                             const EmissionParams& p, int b) {
+  const auto t0 = std::chrono::steady_clock::now();
+  EmissionCdf e;
+  if (!density.is_sparse() || density.dims.x < 2 || density.dims.y < 2 || density.dims.z < 2) return e;
+  b = std::max(b, 1);
+  const glm::ivec3 C = density.dims - 1;  // cells, as build()'s
+  e.cells_ = (C + (b - 1)) / b;
+  const glm::dmat4 cell_to_world = density.index_to_world * translation(glm::dvec3(density.origin));
+  glm::dmat4 scale(1.0);
+  scale[0][0] = scale[1][1] = scale[2][2] = double(b);
+  e.cell_to_world_ = cell_to_world * scale;
+  e.world_to_cell_ = glm::inverse(e.cell_to_world_);
+  const double cell_volume = std::abs(glm::determinant(glm::dmat3(cell_to_world)));
+  e.cell_volume_ = cell_volume * double(b) * b * b;
+  const size_t nblock = e.cell_count();
+
+  auto E_of_value = [&](float value) -> double {
+    const double T = (double(value) - p.temperature.offset) * p.temperature.scale;
+    if (!temperature_emits(T, p.temperature.cutoff_k)) return 0.0;
+    const glm::dvec3 Le = temperature_Le(T, p.temperature.cutoff_k, p.emission.scale, p.emission.blackbody,
+                                         p.emission.observer, p.emission.adapt_to_k);
+    return color::srgb_luminance(p.sigma_a * Le);
+  };
+  const bool grid_emits = p.emits_temperature && temperature && !temperature->empty();
+  if (!(p.emits_rgb || grid_emits)) return e;
+  // E_max per block.
+  std::vector<float> E(nblock, 0.0f);
+  if (p.emits_rgb) {
+    std::fill(E.begin(), E.end(), float(color::srgb_luminance(p.sigma_a * p.Le_rgb)));
+  } else {
+    std::fill(E.begin(), E.end(), float(E_of_value(0.0f)));  // where no leaf is, the value is 0
+    // Temperature index -> density cell coordinates (affine).
+    const glm::dmat4 t2c = glm::inverse(cell_to_world) * temperature->index_to_world;
+    // The range of the temperature values whose trilinear footprint reaches
+    // into each block (a voxel is read within one of its own voxels; a hair
+    // more for the float lookups), then E_max from the range's ends (E grows
+    // with T).
+    constexpr double kReach = 1.0 + 1e-3;
+    std::vector<float> vlo(nblock, std::numeric_limits<float>::infinity()), vhi(nblock, -vlo[0]);
+    const glm::dvec3 reach = glm::abs(glm::dvec3(t2c[0])) + glm::abs(glm::dvec3(t2c[1])) + glm::abs(glm::dvec3(t2c[2]));
+    auto add_value = [&](const glm::dvec3& index, float v) {
+      const glm::dvec3 c(t2c * glm::dvec4(index, 1.0));
+      const glm::dvec3 lo = c - kReach * reach, hi = c + kReach * reach;
+      glm::ivec3 a, z;
+      for (int ax = 0; ax < 3; ++ax) {
+        if (!(hi[ax] >= 0.0 && lo[ax] < double(C[ax]))) return;  // misses the cells
+        a[ax] = int(std::max(0.0, std::floor(lo[ax]))) / b;
+        z[ax] = int(std::min(double(C[ax] - 1), std::floor(hi[ax]))) / b;
+      }
+      for (int k = a.z; k <= z.z; ++k)
+        for (int j = a.y; j <= z.y; ++j)
+          for (int i = a.x; i <= z.x; ++i) {
+            const size_t at = size_t(e.linear_cell({i, j, k}));
+            vlo[at] = std::min(vlo[at], v);
+            vhi[at] = std::max(vhi[at], v);
+          }
+    };
+    if (temperature->is_sparse()) {
+      temperature->sparse->for_each_nonzero([&](const glm::ivec3& ijk, float v) { add_value(glm::dvec3(ijk), v); });
+    } else {
+      const glm::ivec3 TD = temperature->dims;
+      for (int k = 0; k < TD.z; ++k)
+        for (int j = 0; j < TD.y; ++j)
+          for (int i = 0; i < TD.x; ++i)
+            if (const float v = temperature->texel(i, j, k); v != 0.0f)
+              add_value(glm::dvec3(temperature->origin + glm::ivec3(i, j, k)), v);
+    }
+    for (size_t c = 0; c < nblock; ++c)
+      if (vlo[c] <= vhi[c]) E[c] = float(std::max({double(E[c]), E_of_value(vlo[c]), E_of_value(vhi[c])}));
+  }
+  // Σρ per block: a nonzero voxel at texel t is a corner of cells t − 1 and t per axis.
+  std::vector<double> rho(nblock, 0.0);
+  density.sparse->for_each_nonzero([&](const glm::ivec3& ijk, float v) {
+    if (!(v > 0.0f)) return;
+    const glm::ivec3 t = ijk - density.origin;
+    glm::ivec3 a, z;
+    for (int ax = 0; ax < 3; ++ax) {
+      a[ax] = std::max(t[ax] - 1, 0) / b;
+      z[ax] = std::min(t[ax], C[ax] - 1) / b;
+      if (t[ax] < 0 || t[ax] > C[ax]) return;
+    }
+    for (int k = a.z; k <= z.z; ++k)
+      for (int j = a.y; j <= z.y; ++j)
+        for (int i = a.x; i <= z.x; ++i) rho[size_t(e.linear_cell({i, j, k}))] += double(v);
+  });
+  std::vector<double> w;
+  e.weight_.assign(nblock, 0.0f);
+  double total = 0.0;
+  for (size_t c = 0; c < nblock; ++c) {
+    const double wc = rho[c] * double(E[c]);
+    if (!(wc > 0.0)) continue;
+    e.weight_[c] = float(wc / (double(b) * b * b));  // mean weight per unit volume, as blocks()
+    w.push_back(wc);
+    e.entries_.push_back(uint32_t(c));
+    total += wc;
+  }
+  if (w.empty()) {
+    e.weight_.clear();
+    e.entries_.clear();
+    return e;
+  }
+  e.power_ = total * cell_volume;
+  e.set_distribution(w);
+  e.build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return e;
+}
+
 EmissionCdf EmissionCdf::build_light(const Medium& m, const StoredVolume& vol) {
+  // A sparse grid whose box has room for per-cell arrays gets the dense
+  // grid's light exactly (its lookups read the tree); a larger one the blocks.
+  const glm::ivec3 C = vol.density.grid.dims - 1;
+  if (vol.density.grid.is_sparse() && uint64_t(C.x) * uint64_t(C.y) * uint64_t(C.z) > kMaxCellsForCellLight) {
+    const DenseGrid* temperature = vol.temperature && !vol.temperature->grid.empty() ? &vol.temperature->grid : nullptr;
+    const EmissionCdf blocks = build_sparse_blocks(vol.density.grid, temperature, EmissionParams::from_medium(m),
+                                                   light_block(vol.density.grid.dims - 1));
+    return blocks.clustered(light_cluster(blocks.cells()));
+  }
   const EmissionCdf cells = build(m, vol);
   const EmissionCdf blocks = cells.blocks(light_block(cells.cells()));
   return blocks.clustered(light_cluster(blocks.cells()));

@@ -82,6 +82,21 @@ class EmissionCdf {
   double power() const { return power_; }
   double seconds_to_build() const { return build_seconds_; }
 
+  // For a sparse density grid (volume/SparseGrid.h), a distribution over
+  // blocks of b³ cells made from the trees alone, with no per-cell arrays (a
+  // 1024³ box has 10⁹ cells). A block's weight is Σρ · E_max: the density of
+  // every nonzero voxel that is a corner of one of its cells, times the
+  // largest E(T) over the temperature voxels within one voxel of the block
+  // (from the lowest and highest value: E grows with T; and E(T(0)), the
+  // value where no voxel is).
+  // A point that emits has a corner with ρ > 0 and a footprint texel with
+  // T > cutoff, so its block's weight is > 0: unbiased, as build()'s.
+  static EmissionCdf build_sparse_blocks(const DenseGrid& density, const DenseGrid* temperature,
+                                         const EmissionParams& p, int b);
+  // Up to this many cells a sparse grid's light is build()'s, made through
+  // lookups in the tree (the per-cell arrays take 8 B a cell); past it,
+  // build_sparse_blocks'.
+  static constexpr uint64_t kMaxCellsForCellLight = uint64_t(1) << 23;
   // The same distribution over blocks of b³ cells (the grid of blocks covers
   // the cells, the last ones may reach past them): a block's probability is
   // the sum of its cells', and a point is uniform inside the block. Lights in

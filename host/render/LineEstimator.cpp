@@ -28,13 +28,20 @@ LineRates line_rates(const Medium& m, const DenseGrid& density, const DenseGrid*
   const size_t n = size_t(mg.res.x) * size_t(mg.res.y) * size_t(mg.res.z);
   out.rate.assign(n, 0.0f);
   if (!m.emission.emits()) return out;
-  const EmissionCdf cells = EmissionCdf::build(density, temperature, EmissionParams::from_medium(m));
+  // A large sparse grid's weights come in blocks of 8³ cells (EmissionCdf::build_sparse_blocks).
+  const glm::ivec3 D = density.dims - 1;
+  const bool blocks = density.is_sparse() &&
+                      uint64_t(D.x) * uint64_t(D.y) * uint64_t(D.z) > EmissionCdf::kMaxCellsForCellLight;
+  const int bs = blocks ? 8 : 1;
+  const EmissionCdf cells = blocks
+                                ? EmissionCdf::build_sparse_blocks(density, temperature, EmissionParams::from_medium(m), bs)
+                                : EmissionCdf::build(density, temperature, EmissionParams::from_medium(m));
   if (cells.empty()) return out;
   out.power = cells.power();
 
   // E_c: emission cell (i, j, k) spans texel coordinates [i + 0.5, i + 1.5)
-  // per axis (EmissionCdf.h); it overlaps majorant cells floor(a / size) …
-  // ceil(b / size) − 1, clamped to the grid.
+  // per axis (EmissionCdf.h; a block of bs cells, [bs·i + 0.5, bs·(i + 1) + 0.5)); it overlaps majorant
+  // cells floor(a / size) … ceil(b / size) − 1, clamped to the grid.
   std::vector<double> E(n, 0.0);
   const glm::ivec3 C = cells.cells();
   for (int k = 0; k < C.z; ++k)
@@ -42,7 +49,7 @@ LineRates line_rates(const Medium& m, const DenseGrid& density, const DenseGrid*
       for (int i = 0; i < C.x; ++i) {
         const double w = cells.cell_weight({i, j, k});
         if (!(w > 0.0)) continue;
-        const glm::dvec3 a = glm::dvec3(i, j, k) + 0.5, b = a + 1.0;
+        const glm::dvec3 a = double(bs) * glm::dvec3(i, j, k) + 0.5, b = a + double(bs);
         const glm::ivec3 lo = glm::clamp(glm::ivec3(glm::floor(a / mg.cell_size)), glm::ivec3(0), mg.res - 1);
         const glm::ivec3 hi = glm::clamp(glm::ivec3(glm::ceil(b / mg.cell_size)) - 1, glm::ivec3(0), mg.res - 1);
         for (int z = lo.z; z <= hi.z; ++z)

@@ -84,8 +84,7 @@ void check_loaded_medium(const Scene& scene, size_t medium, const StoredVolume& 
 void check_majorant_depth(const Scene& scene, size_t medium, const DenseGrid& density) {
   if (density.empty()) return;
   const Medium& m = scene.media[medium];
-  double max_rho = 0.0;
-  for (float v : density.values) max_rho = std::max(max_rho, double(v));
+  const double max_rho = density.max_texel();
   const double sigma_bar = max3(m.sigma_a + m.sigma_s) * m.density_scale * max_rho;
   glm::dvec3 lo, hi;
   density.world_bounds(lo, hi);

@@ -198,7 +198,7 @@ struct Medium {
   TemperatureMapping temperature;
   Transform transform;
   int downsample = 1;
-  TextureFormat texture_format = TextureFormat::R16F;  // R32F is also used when values exceed R16F
+  TextureFormat texture_format = TextureFormat::Auto;  // R32F is also used when values exceed R16F
 };
 
 // A surface: a triangle mesh (OBJ), an analytic sphere, or a plane (a

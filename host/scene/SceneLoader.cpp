@@ -284,7 +284,10 @@ Medium read_medium(Reader r, const std::filesystem::path& base, int index) {
     m.density_scale = r.number("density_scale", 1.0);
     if (m.density_scale < 0) r.fail("density_scale", "must be >= 0");
     m.downsample = r.integer("downsample", 1, 1, 64);
-    m.texture_format = r.enum_choice("texture_format", TextureFormat::R16F, {TextureFormat::R16F, TextureFormat::R32F});
+    m.texture_format = r.enum_choice("texture_format", TextureFormat::Auto,
+                                      {TextureFormat::Auto, TextureFormat::R16F, TextureFormat::R32F, TextureFormat::Sparse});
+    if (m.texture_format == TextureFormat::Sparse && m.downsample > 1)
+      r.fail("downsample", "a sparse grid keeps every voxel; downsampling needs a dense texture_format (r16f or r32f)");
     if (r.has("temperature")) {
       Reader t = r.child("temperature");
       m.given.temperature_scale = t.has("scale");

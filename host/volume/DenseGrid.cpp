@@ -3,9 +3,14 @@
 #include <cmath>
 #include <limits>
 
+#include "volume/SparseGrid.h"
+
 namespace pyrolume {
 
+float DenseGrid::sparse_texel(int i, int j, int k) const { return sparse->value(origin + glm::ivec3(i, j, k)); }
+
 double DenseGrid::sample_index(const glm::dvec3& index_pos) const {
+  if (sparse) return sparse->sample_index(index_pos);
   if (values.empty()) return 0.0;
   // A sampler3D puts texel t's centre at normalised (t + 0.5) / dims; with
   // u = (index_pos - origin + 0.5) / dims the lookup reduces to this: the
@@ -32,6 +37,14 @@ double DenseGrid::sample_index(const glm::dvec3& index_pos) const {
   return v;
 }
 
+double DenseGrid::max_texel() const {
+  double m = 0.0;
+  if (sparse) return max_value > 0.0f ? double(max_value) : 0.0;  // exact: the tree holds floats
+  for (float v : values)
+    if (v > m) m = v;
+  return m;
+}
+
 double DenseGrid::sample_world(const glm::dvec3& p) const {
   return sample_index(glm::dvec3(world_to_index * glm::dvec4(p, 1.0)));
 }
@@ -39,7 +52,7 @@ double DenseGrid::sample_world(const glm::dvec3& p) const {
 void DenseGrid::world_bounds(glm::dvec3& lo, glm::dvec3& hi) const {
   lo = glm::dvec3(std::numeric_limits<double>::infinity());
   hi = -lo;
-  if (values.empty()) return;
+  if (empty()) return;
   // Trilinear support is the open box between the outermost (zero) padding
   // texel centres: index origin .. origin + dims - 1. Map its 8 corners, since
   // the affine map may rotate or shear.

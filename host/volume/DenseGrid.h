@@ -5,6 +5,7 @@
 // openvdb::tools::BoxSampler), so a texel centre is an integer index coordinate.
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +13,8 @@
 #include <glm/glm.hpp>
 
 namespace pyrolume {
+
+struct SparseGrid;
 
 struct DenseGrid {
   std::string name;              // grid name in the file
@@ -21,13 +24,22 @@ struct DenseGrid {
   glm::dmat4 world_to_index{1};
   std::vector<float> values;     // dims.x*dims.y*dims.z, x fastest, then y, then z; background 0
   float min_value = 0, max_value = 0;  // over active voxels (after NaN/neg handling)
-  bool empty() const { return values.empty(); }
+  // Set for a grid kept sparse (texture_format "sparse", volume/SparseGrid.h):
+  // `values` stays empty and texel() reads the tree; dims and origin describe
+  // the same padded box as a dense grid's, so texel space is the same.
+  std::shared_ptr<const SparseGrid> sparse;
+  bool empty() const { return values.empty() && !sparse; }
+  bool is_sparse() const { return bool(sparse); }
 
   size_t texel_count() const { return size_t(dims.x) * size_t(dims.y) * size_t(dims.z); }
   // Texel (i,j,k) of the array, 0 <= i < dims.x etc.
   float texel(int i, int j, int k) const {
+    if (sparse) return sparse_texel(i, j, k);
     return values[(size_t(k) * size_t(dims.y) + size_t(j)) * size_t(dims.x) + size_t(i)];
   }
+  float sparse_texel(int i, int j, int k) const;
+  // The largest value stored (≥ 0; NaN skipped): a bound on every lookup.
+  double max_texel() const;
 
   // Trilinear lookup at a world point exactly as the GPU does it with a sampler3D
   // (texel centres at integer index coords; OpenVDB BoxSampler convention: value at

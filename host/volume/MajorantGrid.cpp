@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <vector>
+
+#include "volume/SparseGrid.h"
 
 namespace pyrolume {
 
@@ -29,6 +32,34 @@ MajorantGrid build_majorant_grid(const DenseGrid& g, glm::ivec3 res) {
     lo = std::max(0, int(std::floor(a - 0.5)));
     hi = std::min(g.dims[axis] - 1, int(std::floor(b - 0.5)) + 1);
   };
+  if (g.is_sparse()) {
+    // The same maxima, scattered from the tree's nonzero voxels instead of
+    // gathered over the box: the cells whose texel range holds texel t, per axis.
+    std::vector<glm::ivec2> cells_of[3];
+    for (int a = 0; a < 3; ++a) {
+      cells_of[a].assign(size_t(g.dims[a]), glm::ivec2(std::numeric_limits<int>::max(), -1));
+      for (int c = 0; c < m.res[a]; ++c) {
+        int lo, hi;
+        range(a, c, lo, hi);
+        for (int t = lo; t <= hi; ++t) {
+          cells_of[a][size_t(t)].x = std::min(cells_of[a][size_t(t)].x, c);
+          cells_of[a][size_t(t)].y = std::max(cells_of[a][size_t(t)].y, c);
+        }
+      }
+    }
+    g.sparse->for_each_nonzero([&](const glm::ivec3& ijk, float v) {
+      const glm::ivec3 t = ijk - g.origin;
+      if (!(v > 0.0f) || glm::any(glm::lessThan(t, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(t, g.dims))) return;
+      const glm::ivec2 X = cells_of[0][size_t(t.x)], Y = cells_of[1][size_t(t.y)], Z = cells_of[2][size_t(t.z)];
+      for (int cz = Z.x; cz <= Z.y; ++cz)
+        for (int cy = Y.x; cy <= Y.y; ++cy)
+          for (int cx = X.x; cx <= X.y; ++cx) {
+            float& mx = m.max_density[(size_t(cz) * m.res.y + cy) * m.res.x + cx];
+            mx = std::max(mx, v);
+          }
+    });
+    return m;
+  }
   for (int cz = 0; cz < m.res.z; ++cz)
     for (int cy = 0; cy < m.res.y; ++cy)
       for (int cx = 0; cx < m.res.x; ++cx) {

@@ -25,9 +25,14 @@ void round_to_format(StoredGrid& g) {
 namespace {
 StoredGrid store(DenseGrid grid, TextureFormat wanted) {
   StoredGrid g;
+  if (grid.is_sparse()) {  // floats in the tree, as the GPU reads them
+    g.format = TextureFormat::Sparse;
+    g.grid = std::move(grid);
+    return g;
+  }
   // R16F's largest finite value is 65504; keep a margin for rounding.
   bool fits_half = std::max(std::abs(grid.min_value), std::abs(grid.max_value)) <= 6.0e4f;
-  g.format = (wanted == TextureFormat::R16F && fits_half) ? TextureFormat::R16F : TextureFormat::R32F;
+  g.format = (wanted != TextureFormat::R32F && fits_half) ? TextureFormat::R16F : TextureFormat::R32F;
   g.grid = std::move(grid);
   round_to_format(g);
   return g;
@@ -42,7 +47,7 @@ StoredVolume load_stored_volume(const VolumeOptions& m, const DenseLimits& limit
   if (grids.temperature) v.temperature = store(std::move(*grids.temperature), wanted);
   v.warnings = std::move(grids.warnings);
   // A mapping under which nothing glows is almost always a missing scale.
-  if (v.temperature && !v.temperature->grid.values.empty())
+  if (v.temperature && !v.temperature->grid.empty())
     if (const std::string w = cold_temperature_warning(v.temperature->grid, m.temperature); !w.empty())
       v.warnings.push_back(m.file.string() + ": " + w);
   return v;

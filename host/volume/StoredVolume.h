@@ -15,7 +15,7 @@ namespace pyrolume {
 
 struct StoredGrid {
   DenseGrid grid;                // values as stored (already rounded when R16F)
-  TextureFormat format = TextureFormat::R16F;
+  TextureFormat format = TextureFormat::R16F;  // Sparse: grid.sparse holds the values
   std::vector<uint16_t> half_bits;  // the R16F texels to upload (empty for R32F)
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -14,6 +15,7 @@
 
 #include "util/Error.h"
 #include "volume/SourceConventions.h"
+#include "volume/SparseGrid.h"
 #include "volume/VdbFile.h"
 
 namespace pyrolume {
@@ -44,6 +46,27 @@ std::string transform_text(const glm::dmat4& M) {
   return s.str();
 }
 
+// What the grid would take as a dense R16F texture (its active box with one
+// voxel of padding, 2 B a texel) and as a sparse NanoVDB float tree
+// (docs/volumes.md "Sparse grids"; texture_format "auto" chooses between them).
+void print_footprints(const GridReport& g, std::ostream& out) {
+  if (!g.bbox_min || !g.bbox_max || (g.active_voxels && *g.active_voxels == 0)) return;
+  auto mib = [](double bytes) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.1f MiB", bytes / double(1 << 20));
+    return std::string(b);
+  };
+  const glm::dvec3 d = glm::dvec3(*g.bbox_max - *g.bbox_min) + 3.0;
+  out << "  memory: dense " << mib(2.0 * d.x * d.y * d.z) << " (R16F over the active box); sparse ";
+  if (g.nodes)
+    out << mib(double(nanovdb_float_bytes(g.nodes->x, g.nodes->y, g.nodes->z))) << " (NanoVDB, " << g.nodes->x
+        << " leaves)\n";
+  else if (g.active_voxels)
+    out << "at least " << mib(4.0 * double(*g.active_voxels)) << " (4 B an active voxel; --values counts the leaves)\n";
+  else
+    out << "unknown (use --values)\n";
+}
+
 void print_report(const GridReport& g, std::ostream& out) {
   out << "grid \"" << g.name << "\"\n";
   out << "  type: " << g.type << (g.saved_as_half ? " (saved as half)" : "") << ", class: " << g.grid_class << "\n";
@@ -69,6 +92,7 @@ void print_report(const GridReport& g, std::ostream& out) {
   else out << "unknown (" << (g.note.empty() ? "not in metadata; use --values" : g.note) << ")";
   if (g.nonfinite) out << ", " << g.nonfinite << " NaN/Inf voxels";
   out << "\n";
+  print_footprints(g, out);
 }
 
 // ---- OpenVDB ----
@@ -113,6 +137,8 @@ void fill_from_values(const openvdb::GridBase& g, GridReport& r) {
                                         openvdb::Vec3SGrid, openvdb::Vec3DGrid, openvdb::Vec3IGrid>>(
       [&](const auto& typed) { scan_values(typed, r); });
   if (!done) r.note = "no value range for " + r.type + " grids";
+  const std::vector<openvdb::Index32> n = g.baseTree().nodeCount();
+  if (n.size() >= 3) r.nodes = glm::u64vec3(n[0], n[1], n[2]);
 }
 
 void fill_from_metadata(const openvdb::GridBase& g, GridReport& r) {
@@ -187,6 +213,7 @@ VolumeFileInfo read_openvdb_info(const std::string& file, bool values, const std
 template <class BuildT>
 void nano_grid(const nanovdb::NanoGrid<BuildT>& grid, bool values, GridReport& r) {
   r.index_to_world = nanovdb_index_to_world(grid);
+  r.nodes = glm::u64vec3(grid.tree().nodeCount(0), grid.tree().nodeCount(1), grid.tree().nodeCount(2));
   if (!values) {
     // NanoVDB keeps min/max of the active values in the root node (when the
     // grid was built with stats).

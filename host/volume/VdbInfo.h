@@ -27,6 +27,9 @@ struct GridInfo {
   std::optional<double> min_value, max_value;
   std::string range_label = "values";  // "|values|" for vector grids (magnitudes)
   uint64_t nonfinite = 0;
+  // The tree's leaves, lower and upper internal nodes (from the tree: NanoVDB
+  // always, OpenVDB with `values`): what a sparse grid takes.
+  std::optional<glm::u64vec3> nodes;
   std::string note;        // why a field is missing
   std::string unreadable;  // non-empty: the grid could not be read (why)
 

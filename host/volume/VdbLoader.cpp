@@ -26,11 +26,14 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <nanovdb/NanoVDB.h>
 #include <nanovdb/util/IO.h>
+#include <nanovdb/util/NanoToOpenVDB.h>
+#include <nanovdb/util/OpenToNanoVDB.h>
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
 #include "util/Error.h"
 #include "util/Memory.h"
+#include "volume/SparseGrid.h"
 #include "volume/VdbFile.h"
 
 namespace pyrolume {
@@ -263,13 +266,13 @@ void check_index_maps(const DenseGrid& g, const std::string& file, Role role) {
   throw input_error(file, role_key(role, g.name), s.str());
 }
 
-void report_counts(const DenseBuilder& b, const std::string& file, Role role, const std::string& grid,
+void report_counts(uint64_t nonfinite, uint64_t negative, const std::string& file, Role role, const std::string& grid,
                    std::vector<std::string>& warnings) {
-  if (b.nonfinite)
-    warnings.push_back(file + ": " + role_key(role, grid) + ": " + std::to_string(b.nonfinite) +
+  if (nonfinite)
+    warnings.push_back(file + ": " + role_key(role, grid) + ": " + std::to_string(nonfinite) +
                        " NaN/Inf voxels treated as 0");
-  if (b.negative)
-    warnings.push_back(file + ": " + role_key(role, grid) + ": " + std::to_string(b.negative) +
+  if (negative)
+    warnings.push_back(file + ": " + role_key(role, grid) + ": " + std::to_string(negative) +
                        " negative density voxels clamped to 0");
 }
 
@@ -277,7 +280,7 @@ void report_counts(const DenseBuilder& b, const std::string& file, Role role, co
 DenseGrid finish_grid(DenseBuilder& b, DenseGrid& out, const glm::dmat4& grid_to_world, const VolumeOptions& m,
                       Role role, const std::string& file, std::vector<std::string>& warnings) {
   b.finish();
-  report_counts(b, file, role, out.name, warnings);
+  report_counts(b.nonfinite, b.negative, file, role, out.name, warnings);
   out.index_to_world = m.transform * grid_to_world * b.index_map();
   out.world_to_index = glm::inverse(out.index_to_world);
   check_index_maps(out, file, role);
@@ -325,6 +328,87 @@ DenseGrid dense_from_openvdb(const GridT& grid, const VolumeOptions& m, Role rol
   return finish_grid(b, out, grid_to_world, m, role, file, warnings);
 }
 
+// texture_format "auto" (docs/volumes.md "Sparse grids"): a dense R16F
+// texture where it fits this device and host, unless it is large and mostly
+// empty; a sparse tree otherwise. Dense lookups are the faster ones on every
+// device measured (docs/benchmarks.md), so sparse is for what dense cannot hold
+// or would waste: past kSparseFromBytes, when the tree is under a quarter of
+// the texture.
+constexpr uint64_t kSparseFromBytes = uint64_t(256) << 20;
+
+bool keep_sparse(const VolumeOptions& m, const glm::i64vec3& bbox_dims, uint64_t sparse_bytes, const DenseLimits& limits) {
+  if (m.texture_format == TextureFormat::Sparse) return true;
+  if (m.texture_format != TextureFormat::Auto || m.downsample > 1) return false;
+  const glm::i64vec3 d = bbox_dims + int64_t(2);  // the zero padding
+  const uint64_t texels = uint64_t(d.x) * uint64_t(d.y) * uint64_t(d.z);
+  const uint64_t dense = 2 * texels;
+  const uint64_t room = memory_available_bytes();
+  const bool fits = (limits.max_dim == 0 || std::max({d.x, d.y, d.z}) <= int64_t(limits.max_dim)) &&
+                    (limits.max_bytes == 0 || dense <= limits.max_bytes) && texels <= max_dense_texels &&
+                    (room == 0 || texels * kHostBytesPerTexel <= room);
+  return !fits || (dense > kSparseFromBytes && dense > 4 * sparse_bytes);
+}
+
+// The same values as DenseBuilder stores (NaN/Inf -> 0, negative density -> 0,
+// inactive -> 0), kept in a NanoVDB float tree instead of a dense array: only
+// the nonzero active voxels are written, into a tree with background 0, and
+// active tiles become voxels (the GPU and CPU walk leaves).
+template <class GridT>
+DenseGrid sparse_from_openvdb(const GridT& grid, const VolumeOptions& m, Role role, const std::string& file,
+                              std::vector<std::string>& warnings) {
+  DenseGrid out;
+  out.name = grid.getName();
+  const glm::dmat4 grid_to_world = openvdb_index_to_world(grid.transform(), file, out.name);
+  const openvdb::CoordBBox bbox = grid.evalActiveVoxelBoundingBox();
+  if (grid.activeVoxelCount() == 0 || bbox.empty()) return empty_grid(out.name, grid_to_world, m, role, file, warnings);
+  const glm::i64vec3 lo(bbox.min().x(), bbox.min().y(), bbox.min().z()), hi(bbox.max().x(), bbox.max().y(), bbox.max().z());
+  const glm::i64vec3 dims = hi - lo + int64_t(3);
+  if (dims.x > (1 << 30) || dims.y > (1 << 30) || dims.z > (1 << 30) || lo.x <= INT32_MIN + 1 || lo.y <= INT32_MIN + 1 ||
+      lo.z <= INT32_MIN + 1 || hi.x >= INT32_MAX - 1 || hi.y >= INT32_MAX - 1 || hi.z >= INT32_MAX - 1)
+    throw input_error(file, role_key(role, out.name), "active bounding box reaches the end of the index range");
+  openvdb::FloatGrid::Ptr tree_grid = openvdb::FloatGrid::create(0.0f);
+  auto acc = tree_grid->getAccessor();
+  uint64_t nonfinite = 0, negative = 0;
+  float vmin = std::numeric_limits<float>::infinity(), vmax = -vmin;
+  auto process = [&](double v) {
+    float f = float(v);
+    if (!std::isfinite(f)) {
+      ++nonfinite;
+      f = 0.0f;
+    } else if (f < 0.0f && role == Role::Density) {
+      ++negative;
+      f = 0.0f;
+    }
+    vmin = std::min(vmin, f);
+    vmax = std::max(vmax, f);
+    return f;
+  };
+  for (auto it = grid.tree().cbeginValueOn(); it; ++it) {
+    const float f = process(double(*it));
+    if (it.isVoxelValue()) {
+      if (f != 0.0f) acc.setValue(it.getCoord(), f);
+    } else {
+      openvdb::CoordBBox box;
+      it.getBoundingBox(box);
+      if (f != 0.0f) tree_grid->tree().fill(box, f, true);
+    }
+  }
+  tree_grid->tree().voxelizeActiveTiles();
+  auto sparse = std::make_shared<SparseGrid>();
+  sparse->handle = nanovdb::openToNanoVDB(*tree_grid);
+  tree_grid.reset();
+  report_counts(nonfinite, negative, file, role, out.name, warnings);
+  out.sparse = std::move(sparse);
+  out.origin = glm::ivec3(lo - int64_t(1));
+  out.dims = glm::ivec3(dims);
+  out.min_value = vmin;
+  out.max_value = vmax;
+  out.index_to_world = m.transform * grid_to_world;
+  out.world_to_index = glm::inverse(out.index_to_world);
+  check_index_maps(out, file, role);
+  return out;
+}
+
 std::vector<GridEntry> openvdb_grid_entries(openvdb::io::File& f) {
   std::vector<GridEntry> entries;
   try {
@@ -368,10 +452,19 @@ VolumeGrids load_openvdb(const VolumeOptions& m, bool need_temperature, const De
     auto load = [&](const GridEntry& e, Role role) {
       openvdb::GridBase::Ptr g = f.readGrid(e.name);  // only this grid's tree is read
       out.tree_mem_bytes += g->baseTree().memUsage();
+      const openvdb::CoordBBox box = g->evalActiveVoxelBoundingBox();
+      std::vector<openvdb::Index32> nodes;  // per level, leaves first
+      if (auto fg = openvdb::gridConstPtrCast<openvdb::FloatGrid>(g)) nodes = fg->tree().nodeCount();
+      else if (auto dg = openvdb::gridConstPtrCast<openvdb::DoubleGrid>(g)) nodes = dg->tree().nodeCount();
+      nodes.resize(4, 0);
+      const bool sparse = !box.empty() && keep_sparse(m, glm::i64vec3(box.dim().x(), box.dim().y(), box.dim().z()),
+                                                      nanovdb_float_bytes(nodes[0], nodes[1], nodes[2]), limits);
       if (auto fg = openvdb::gridConstPtrCast<openvdb::FloatGrid>(g))
-        return dense_from_openvdb(*fg, m, role, file, out.warnings, limits);
+        return sparse ? sparse_from_openvdb(*fg, m, role, file, out.warnings)
+                      : dense_from_openvdb(*fg, m, role, file, out.warnings, limits);
       if (auto dg = openvdb::gridConstPtrCast<openvdb::DoubleGrid>(g))
-        return dense_from_openvdb(*dg, m, role, file, out.warnings, limits);
+        return sparse ? sparse_from_openvdb(*dg, m, role, file, out.warnings)
+                      : dense_from_openvdb(*dg, m, role, file, out.warnings, limits);
       throw input_error(file, role_key(role, e.name), "is a " + g->valueType() + " grid; expected float or double");
     };  // the sparse tree is freed here, before the next grid is read
     out.density = load(c.density, Role::Density);
@@ -406,6 +499,81 @@ DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Volume
   return finish_grid(b, out, grid_to_world, m, role, file, warnings);
 }
 
+// A NanoVDB float grid kept sparse as it was read: its values turned into
+// what DenseBuilder stores (NaN/Inf -> 0, negative density -> 0, inactive
+// voxels and tiles -> 0, background 0) in place, so a large tree is never
+// copied. Empty when a tile is active with a value (a box of voxels the leaf
+// walks would miss): sparse_from_openvdb voxelises those.
+std::optional<DenseGrid> sparse_in_place(nanovdb::GridHandle<nanovdb::HostBuffer>& h, const VolumeOptions& m, Role role,
+                                         const std::string& file, std::vector<std::string>& warnings) {
+  nanovdb::NanoGrid<float>* grid = h.grid<float>();
+  if (!grid) return std::nullopt;
+  auto& tree = grid->tree();
+  auto zero_tiles = [&](auto* node, uint64_t count) {
+    for (uint64_t i = 0; i < count; ++i, ++node)
+      for (uint32_t n = 0; n < node->SIZE; ++n) {
+        if (node->data()->isChild(n)) continue;
+        if (node->valueMask().isOn(n) && node->data()->getValue(n) != 0.0f) return false;
+        node->data()->setValue(n, 0.0f);
+      }
+    return true;
+  };
+  if (tree.nodeCount(1) && !zero_tiles(tree.getFirstNode<1>(), tree.nodeCount(1))) return std::nullopt;
+  if (tree.nodeCount(2) && !zero_tiles(tree.getFirstNode<2>(), tree.nodeCount(2))) return std::nullopt;
+  auto* root = tree.root().data();
+  for (uint32_t t = 0; t < root->mTableSize; ++t) {
+    auto* tile = root->tile(t);
+    if (tile->isChild()) continue;
+    if (tile->state && tile->value != 0.0f) return std::nullopt;
+    tile->value = 0.0f;
+  }
+  root->mBackground = 0.0f;
+  DenseGrid out;
+  out.name = grid->gridName();
+  const glm::dmat4 grid_to_world = nanovdb_index_to_world(*grid);
+  uint64_t nonfinite = 0, negative = 0, active = 0;
+  float vmin = std::numeric_limits<float>::infinity(), vmax = -vmin;
+  glm::ivec3 lo(INT32_MAX), hi(INT32_MIN);
+  auto* leaf = tree.getFirstNode<0>();
+  for (uint64_t l = 0; l < tree.nodeCount(0); ++l, ++leaf) {
+    const nanovdb::Coord o = leaf->origin();
+    for (uint32_t n = 0; n < 512; ++n) {
+      if (!leaf->valueMask().isOn(n)) {
+        leaf->setValueOnly(n, 0.0f);
+        continue;
+      }
+      float f = leaf->getValue(n);
+      if (!std::isfinite(f)) {
+        ++nonfinite;
+        f = 0.0f;
+      } else if (f < 0.0f && role == Role::Density) {
+        ++negative;
+        f = 0.0f;
+      }
+      leaf->setValueOnly(n, f);
+      ++active;
+      vmin = std::min(vmin, f);
+      vmax = std::max(vmax, f);
+      const glm::ivec3 ijk(o[0] + int(n >> 6), o[1] + int((n >> 3) & 7), o[2] + int(n & 7));
+      lo = glm::min(lo, ijk);
+      hi = glm::max(hi, ijk);
+    }
+  }
+  if (active == 0) return empty_grid(out.name, grid_to_world, m, role, file, warnings);
+  report_counts(nonfinite, negative, file, role, out.name, warnings);
+  auto sparse = std::make_shared<SparseGrid>();
+  sparse->handle = std::move(h);
+  out.sparse = std::move(sparse);
+  out.origin = lo - 1;
+  out.dims = hi - lo + 3;
+  out.min_value = vmin;
+  out.max_value = vmax;
+  out.index_to_world = m.transform * grid_to_world;
+  out.world_to_index = glm::inverse(out.index_to_world);
+  check_index_maps(out, file, role);
+  return out;
+}
+
 VolumeGrids load_nanovdb(const VolumeOptions& m, bool need_temperature, const DenseLimits& limits) {
   const std::string file = m.file.string();
   VolumeGrids out;
@@ -431,6 +599,24 @@ VolumeGrids load_nanovdb(const VolumeOptions& m, bool need_temperature, const De
     if (!h) throw input_error(file, role_key(role, e.name), "cannot read NanoVDB grid");
     validate_nanovdb_grid(h, file, e.name);  // before any accessor follows its offsets
     out.tree_mem_bytes += h.size();
+    const auto& nb = h.gridMetaData()->indexBBox();
+    const auto* tree_data = h.gridMetaData();
+    bool sparse = false;
+    if (!nb.empty()) {
+      const glm::i64vec3 dims(int64_t(nb.max()[0]) - nb.min()[0] + 1, int64_t(nb.max()[1]) - nb.min()[1] + 1,
+                              int64_t(nb.max()[2]) - nb.min()[2] + 1);
+      sparse = keep_sparse(m, dims, nanovdb_float_bytes(tree_data->nodeCount(0), tree_data->nodeCount(1),
+                                                        tree_data->nodeCount(2)), limits);
+    }
+    if (sparse) {
+      if (std::optional<DenseGrid> kept = sparse_in_place(h, m, role, file, out.warnings)) return std::move(*kept);
+      // Other value types, and active tiles: through an OpenVDB tree.
+      ensure_openvdb_initialized();
+      const openvdb::GridBase::Ptr g = nanovdb::nanoToOpenVDB(h);
+      if (auto fg = openvdb::gridConstPtrCast<openvdb::FloatGrid>(g)) return sparse_from_openvdb(*fg, m, role, file, out.warnings);
+      if (auto dg = openvdb::gridConstPtrCast<openvdb::DoubleGrid>(g)) return sparse_from_openvdb(*dg, m, role, file, out.warnings);
+      throw input_error(file, role_key(role, e.name), "NanoVDB grid type " + e.type + " cannot be kept sparse");
+    }
     if (auto* g = h.grid<float>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
     if (auto* g = h.grid<double>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
     if (auto* g = h.grid<nanovdb::Fp16>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);

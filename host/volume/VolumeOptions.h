@@ -22,10 +22,19 @@ enum class VolumeSource { Auto, Blender, Houdini, EmberGen, Kelvin };
 // Which world axis is up (a file's convention, or the scene's).
 enum class UpAxis { Y, Z };
 
-// The texture format grids are stored in (volume/StoredVolume.h).
-enum class TextureFormat { R16F, R32F };
+// The texture format grids are stored in (volume/StoredVolume.h): a dense 3D
+// texture of halfs or floats, or a sparse NanoVDB tree of floats
+// (volume/SparseGrid.h); Auto picks R16F or Sparse per grid (VdbLoader.h).
+enum class TextureFormat { Auto, R16F, R32F, Sparse };
 // Its name in the scene file (media[].texture_format).
-inline const char* to_string(TextureFormat f) { return f == TextureFormat::R32F ? "r32f" : "r16f"; }
+inline const char* to_string(TextureFormat f) {
+  switch (f) {
+    case TextureFormat::R16F: return "r16f";
+    case TextureFormat::R32F: return "r32f";
+    case TextureFormat::Sparse: return "sparse";
+    default: return "auto";
+  }
+}
 
 struct VolumeOptions {
   std::filesystem::path file;
@@ -34,7 +43,7 @@ struct VolumeOptions {
   bool need_temperature = false; // read the temperature grid too
   glm::dmat4 transform{1.0};     // composed on top of each grid's index->world map
   int downsample = 1;
-  TextureFormat texture_format = TextureFormat::R16F;  // R32F is also used when values exceed R16F
+  TextureFormat texture_format = TextureFormat::Auto;  // R32F is also used when values exceed R16F
   TemperatureMapping temperature;  // for the warning when nothing glows
 };
 

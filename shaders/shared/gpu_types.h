@@ -56,6 +56,8 @@ PYRO_CONST uint BINDING_QUEUES = 24;   // buffer WavefrontQueues, then its queue
 PYRO_CONST uint BINDING_ALPHA = 26;    // buffer AlphaTexel[] (one per pixel)
 PYRO_CONST uint BINDING_AOV_LIGHTS = 27;    // buffer AovLightTexel[] (one per pixel; film.aovs)
 PYRO_CONST uint BINDING_AOV_FEATURES = 28;  // buffer AovFeatureTexel[] (one per pixel; film.aovs)
+PYRO_CONST uint BINDING_SPARSE = 29;  // usamplerBuffer (rgba32ui): every sparse grid's NanoVDB tree and leaf table (shaders/sparse.glsl)
+PYRO_CONST uint SPARSE_ZERO_LEAF = 32;  // byte offset of 512 zero floats in that buffer: the values of every absent leaf
 
 // Specialisation constants of render.comp: a scene pays only for what it uses.
 PYRO_CONST uint SPEC_HAS_GRIDS = 0;
@@ -89,6 +91,7 @@ PYRO_CONST uint SPEC_WAVEFRONT_SPLIT = 17;  // the event stage leaves the next r
 PYRO_CONST uint SPEC_TEMPERATURE_IN_DENSITY = 18;
 PYRO_CONST uint SPEC_AOVS = 20;  // film.aovs: the light layers and first-hit features (docs/compositing.md "AOVs")
 PYRO_CONST uint SPEC_LIGHT_COUNT = 19;  // analytic lights (the scene's `lights`); 0 compiles their code out
+PYRO_CONST uint SPEC_SPARSE_GRIDS = 21;  // some grid is a NanoVDB tree (texture_format "sparse"); false compiles that code out
 PYRO_CONST uint WAVEFRONT_GROUP = 64;      // lanes per workgroup of the queue stages
 // 16-byte words of one path's state: a fixed part and a part per medium.
 PYRO_CONST uint WAVEFRONT_PATH_WORDS = 22;
@@ -156,6 +159,24 @@ struct GpuGrid {
   uint majorant_offset;   // cell (0,0,0)'s index in the majorant buffer
   vec3 majorant_cell;     // cell size in texels
   float majorant_scale;   // max channel of (sigma_a + sigma_s)·density_scale: a cell's value times this is its majorant
+  // A sparse grid (texture_format "sparse", shaders/sparse.glsl), in the
+  // sparse buffer (BINDING_SPARSE): the byte offset of its NanoVDB grid (0:
+  // the grid is a dense texture); the index coordinate of texel coordinate 0
+  // (index = u + index_origin); and its flat leaf table, which maps a leaf
+  // coordinate (index >> 3) − leaf_origin, inside leaf_dims, to the byte
+  // offset of that leaf's 512 values.
+  vec3 density_index_origin;
+  uint density_tree;
+  ivec3 density_leaf_origin;
+  uint density_leaf_table;
+  uvec3 density_leaf_dims;
+  uint unused2;
+  vec3 temperature_index_origin;
+  uint temperature_tree;
+  ivec3 temperature_leaf_origin;
+  uint temperature_leaf_table;
+  uvec3 temperature_leaf_dims;
+  uint unused3;
 };
 
 // Per-render constants (uniform buffer).
@@ -281,7 +302,7 @@ PYRO_OFFSET(GpuMedium, shape, 12); PYRO_OFFSET(GpuMedium, sigma_s, 16); PYRO_OFF
 PYRO_OFFSET(GpuMedium, emission, 32); PYRO_OFFSET(GpuMedium, emission_mode, 44); PYRO_OFFSET(GpuMedium, center, 48);
 PYRO_OFFSET(GpuMedium, radius, 60); PYRO_OFFSET(GpuMedium, box_min, 64); PYRO_OFFSET(GpuMedium, grid_slot, 76);
 PYRO_OFFSET(GpuMedium, box_max, 80); PYRO_OFFSET(GpuMedium, line_points, 92);
-static_assert(sizeof(GpuGrid) == 192);
+static_assert(sizeof(GpuGrid) == 288);
 PYRO_OFFSET(GpuGrid, density_row1, 16); PYRO_OFFSET(GpuGrid, density_row2, 32);
 PYRO_OFFSET(GpuGrid, density_dims, 48); PYRO_OFFSET(GpuGrid, density_scale, 60);
 PYRO_OFFSET(GpuGrid, temperature_row0, 64); PYRO_OFFSET(GpuGrid, temperature_row1, 80);
@@ -291,7 +312,12 @@ PYRO_OFFSET(GpuGrid, temperature_scale, 132); PYRO_OFFSET(GpuGrid, cutoff_k, 136
 PYRO_OFFSET(GpuGrid, lut_scale, 144); PYRO_OFFSET(GpuGrid, lut_offset, 148); PYRO_OFFSET(GpuGrid, t_min_k, 152);
 PYRO_OFFSET(GpuGrid, line_rate_offset, 156); PYRO_OFFSET(GpuGrid, majorant_res, 160);
 PYRO_OFFSET(GpuGrid, majorant_offset, 172); PYRO_OFFSET(GpuGrid, majorant_cell, 176);
-PYRO_OFFSET(GpuGrid, majorant_scale, 188);
+PYRO_OFFSET(GpuGrid, majorant_scale, 188); PYRO_OFFSET(GpuGrid, density_index_origin, 192);
+PYRO_OFFSET(GpuGrid, density_tree, 204); PYRO_OFFSET(GpuGrid, density_leaf_origin, 208);
+PYRO_OFFSET(GpuGrid, density_leaf_table, 220); PYRO_OFFSET(GpuGrid, density_leaf_dims, 224);
+PYRO_OFFSET(GpuGrid, temperature_index_origin, 240); PYRO_OFFSET(GpuGrid, temperature_tree, 252);
+PYRO_OFFSET(GpuGrid, temperature_leaf_origin, 256); PYRO_OFFSET(GpuGrid, temperature_leaf_table, 268);
+PYRO_OFFSET(GpuGrid, temperature_leaf_dims, 272);
 static_assert(sizeof(FrameConstants) == 128);
 PYRO_OFFSET(FrameConstants, tan_half_fov, 12); PYRO_OFFSET(FrameConstants, camera_forward, 16);
 PYRO_OFFSET(FrameConstants, aspect, 28); PYRO_OFFSET(FrameConstants, camera_right, 32);

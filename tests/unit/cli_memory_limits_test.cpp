@@ -53,7 +53,7 @@ TEST_F(CliMemoryLimits, ASparseGridWhoseDenseArrayCannotFitIsRefused) {
   // array (1.0e9 texels: 4 GB as float, 2 GB as R16F).
   const fs::path vdb = write_two_voxels_vdb(dir / "cube.vdb", {999, 999, 999});
   write_file(dir / "s.json", R"({"film": {"width": 8, "height": 8, "spp": 1},
-    "media": [{"type": "vdb", "file": "cube.vdb"}]})");
+    "media": [{"type": "vdb", "file": "cube.vdb", "texture_format": "r16f"}]})");
   for (const char* backend : {"cpu", "vulkan"}) {
     CliResult r = run_cli_with_memory_limit(
         kGiB * 3 / 2, "render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --backend " + backend);
@@ -61,6 +61,24 @@ TEST_F(CliMemoryLimits, ASparseGridWhoseDenseArrayCannotFitIsRefused) {
                    {vdb.string() + ": ", "density", "1002x1002x1002 texels (with downsample 1) need", "host memory",
                     "this process can still allocate", "add \"downsample\": "},
                    dir / "o.exr");
+  }
+  fs::remove_all(dir);
+}
+
+// The same grid as a user writes it (texture_format left out, "auto") is
+// kept sparse: it renders on both backends under the limit that refuses its
+// dense array (issue 26).
+TEST_F(CliMemoryLimits, ASparseGridRendersUnderTheLimitThatRefusesItsDenseArray) {
+  auto dir = temp_dir("mem-sparse");
+  write_two_voxels_vdb(dir / "cube.vdb", {999, 999, 999});
+  write_file(dir / "s.json", R"({"film": {"width": 8, "height": 8, "spp": 1},
+    "media": [{"type": "vdb", "file": "cube.vdb"}]})");
+  for (const char* backend : {"cpu", "vulkan"}) {
+    const fs::path out = dir / (std::string(backend) + ".exr");
+    CliResult r = run_cli_with_memory_limit(kGiB * 3 / 2, "render " + q(dir / "s.json") + " -o " + q(out) +
+                                                              " --backend " + backend);
+    EXPECT_EQ(r.status, 0) << backend << ": " << r.err;
+    EXPECT_TRUE(fs::exists(out)) << backend;
   }
   fs::remove_all(dir);
 }

@@ -1,11 +1,13 @@
 // The grid loader checks a grid against the device's 3D texture limits before
 // it allocates the dense array (issue 10 "limits"), naming the file and grid
-// and the downsample that would fit.
+// and the downsample that would fit; by default ("auto") such a grid is kept
+// sparse instead.
 #include <gtest/gtest.h>
 
 #include "scene/MediumVolume.h"
 #include "support/VdbScenes.h"
 #include "util/Error.h"
+#include "volume/SparseGrid.h"
 #include "volume/VdbLoader.h"
 
 namespace pyrolume {
@@ -25,6 +27,14 @@ TEST(VolumeLimits, GridPastTheDeviceDimensionIsRefusedBeforeAllocating) {
   // 4503 × 5 × 5 texels: past 4096 along x.
   const auto file = test::write_two_voxels_vdb(dir / "wide.vdb", {4500, 2, 2});
   Medium m = test::vdb_medium("wide", file, {1, 1, 1}, {0, 0, 0});
+  // By default ("auto") a grid past the device's limits is kept sparse: the
+  // same box, two voxels in a tree.
+  const VolumeGrids kept = load_volume(m, false, DenseLimits{4096, 0});
+  EXPECT_TRUE(kept.density.is_sparse());
+  EXPECT_EQ(kept.density.dims, glm::ivec3(4503, 5, 5));
+  EXPECT_EQ(kept.density.sparse->active_voxels(), 2u);
+  // A dense texture_format asked for is refused, with the downsample that fits.
+  m.texture_format = TextureFormat::R16F;
   const std::string err = load_error(m, DenseLimits{4096, 0});
   EXPECT_NE(err.find(file.string() + ": "), std::string::npos) << err;
   EXPECT_NE(err.find("density"), std::string::npos) << err;
@@ -43,14 +53,20 @@ TEST(VolumeLimits, GridPastTheAllocationLimitIsRefused) {
   auto dir = test::temp_dir("vol-bytes");
   const auto file = test::write_two_voxels_vdb(dir / "cube.vdb", {199, 199, 199});  // 202³ texels
   Medium m = test::vdb_medium("cube", file, {1, 1, 1}, {0, 0, 0});
+  EXPECT_TRUE(load_volume(m, false, DenseLimits{0, uint64_t(1) << 20}).density.is_sparse());  // "auto"
+  m.texture_format = TextureFormat::R16F;
   const std::string err = load_error(m, DenseLimits{0, uint64_t(1) << 20});  // 1 MiB
   EXPECT_NE(err.find("202x202x202 texels (with downsample 1) exceed what this device allows in one allocation (1 MiB"),
             std::string::npos)
       << err;
   // (199/3 + 3)³ · 2 B = 69³ · 2 B fits in 1 MiB; (199/2 + 3)³ · 2 B = 102³ · 2 B does not.
   EXPECT_NE(err.find("add \"downsample\": 3"), std::string::npos) << err;
-  // No limits: it loads.
-  EXPECT_EQ(load_volume(m, false).density.dims, glm::ivec3(202, 202, 202));
+  // No limits: it loads, dense (8 MiB as R16F is under what "auto" keeps sparse).
+  const VolumeGrids dense = load_volume(m, false);
+  EXPECT_EQ(dense.density.dims, glm::ivec3(202, 202, 202));
+  EXPECT_FALSE(dense.density.is_sparse());
+  m.texture_format = TextureFormat::Auto;
+  EXPECT_FALSE(load_volume(m, false).density.is_sparse());
   std::filesystem::remove_all(dir);
 }
 

@@ -5,6 +5,7 @@
 // since lavapipe cannot lose a device) saves the accumulation so far, says
 // which failure it was and exits 1.
 #include <cstdlib>
+#include <regex>
 
 #include <gtest/gtest.h>
 
@@ -113,14 +114,20 @@ TEST(CliLimitsVulkan, AccumulationLargerThanTheDeviceAllowsIsBadInput) {
   std::filesystem::remove_all(dir);
 }
 
-// A grid wider than the device's maxImageDimension3D: refused by the loader
-// before its dense array exists, naming the grid and the downsample that fits.
+// A grid wider than the device's maxImageDimension3D, as a dense texture:
+// refused by the loader before its dense array exists, naming the grid and the
+// downsample that fits. Left to "auto", the same grid is kept sparse and renders.
 TEST(CliLimitsVulkan, GridPastTheDevicesTextureLimitIsBadInput) {
   auto dir = temp_dir("cli-wide");
   write_two_voxels_vdb(dir / "wide.vdb", {20000, 1, 1});  // past any GPU's 3D limit (16384 at most today)
-  write_file(dir / "s.json", R"({"film": {"width": 4, "height": 4, "spp": 1},
+  const std::string scene = R"({"film": {"width": 4, "height": 4, "spp": 1},
     "background": {"rgb": [0.1, 0.1, 0.1]},
-    "media": [{"name": "wide", "type": "vdb", "file": "wide.vdb", "source": "houdini", "sigma_a": [1, 1, 1], "sigma_s": [0, 0, 0]}]})");
+    "media": [{"name": "wide", "type": "vdb", "file": "wide.vdb", "source": "houdini", "sigma_a": [1, 1, 1], "sigma_s": [0, 0, 0]FORMAT}]})";
+  write_file(dir / "s.json", std::regex_replace(scene, std::regex("FORMAT"), ""));
+  CliResult kept = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "sparse.exr"));
+  EXPECT_EQ(kept.status, 0) << kept.err;
+  EXPECT_TRUE(std::filesystem::exists(dir / "sparse.exr"));
+  write_file(dir / "s.json", std::regex_replace(scene, std::regex("FORMAT"), R"(, "texture_format": "r16f")"));
   CliResult r = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "o.exr"));
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;

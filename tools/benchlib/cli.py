@@ -30,6 +30,7 @@ Typical use:
               --configs 'vulkan/*' --device 1 --out-dir docs/gpu   # on a real GPU
   tools/bench --list                        # scenes and configs, render nothing
   tools/bench --cycles                      # against Blender Cycles at equal error (needs `blender`)
+  tools/bench --sparse                      # sparse grids against dense textures, and a 1024³ shell's memory
 
 Only the Python standard library is used, plus matplotlib for the plot (the
 plot is skipped with a warning when matplotlib is missing).
@@ -46,7 +47,7 @@ import shutil
 import statistics
 import time
 
-from . import cycles, denoise
+from . import cycles, denoise, sparse
 from .common import REPO, log
 from .configs import configs_for
 from .plot import plot
@@ -92,6 +93,9 @@ def parse_args(argv):
                     help="pyrolume against Blender Cycles at equal error on the Blender 2.79 fire "
                          "(needs `blender` and --data-dir; benchlib/cycles.py)")
     ap.add_argument("--cycles-threads", type=int, default=2, help="with --cycles: Cycles' CPU threads (default 2)")
+    ap.add_argument("--sparse", action="store_true",
+                    help="sparse NanoVDB grids against dense textures (fire and the Houdini plume, both backends), "
+                         "and the peak RSS of a generated 1024³-box shell (benchlib/sparse.py)")
     ap.add_argument("--render-reps", type=int, default=1,
                     help="with --denoise: renders per scene (default 1; the denoise runs --reps times)")
     args = ap.parse_args(argv)
@@ -132,6 +136,8 @@ def main(argv):
         return denoise.run(args, argv)
     if args.cycles:
         return cycles.run(args)
+    if args.sparse:
+        return sparse.run(args, argv)
 
     scenes, skipped = collect_scenes(args, work)
     cfg_filter = [c.strip() for c in args.configs.split(",")] if args.configs else None

@@ -46,9 +46,7 @@ MediumData prepare_vdb(const Medium& m, std::vector<std::string>& warnings) {
   // The bound comes from the texels themselves (not the loader's max_value), so
   // it holds for exactly what is sampled. NaN texels would break it: the loader
   // turns them into 0; skip them here too so they cannot poison the bound.
-  double max_rho = 0.0;
-  for (float v : vol->density.grid.values)
-    if (v > max_rho) max_rho = v;
+  const double max_rho = vol->density.grid.max_texel();
   d.max_density = max_rho;
   d.sigma_maj = (d.sigma_a + d.sigma_s) * max_rho;
   d.temperature = m.temperature;

@@ -27,6 +27,47 @@ void texel_rows(const DenseGrid& g, gpu::vec4& r0, gpu::vec4& r1, gpu::vec4& r2)
   gpu::vec4* rows[3] = {&r0, &r1, &r2};
   for (int r = 0; r < 3; ++r) *rows[r] = gpu::vec4(float(m[0][r]), float(m[1][r]), float(m[2][r]), float(m[3][r]));
 }
+
+// A sparse grid's tree and leaf table, appended to the sparse buffer (the
+// tree 32-byte aligned, as NanoVDB wants; offset 0 stays free so that 0 means
+// "dense"), and where they sit into the GpuGrid's fields; a dense grid gets 0.
+// The flat leaf table replaces the walk from the root (shaders/sparse.glsl);
+// a box so large and empty that the table would outweigh the tree is refused.
+void place_sparse(const std::string& file, const DenseGrid& g, GpuScene& out, gpu::vec3& index_origin, uint32_t& tree,
+                  gpu::ivec3& leaf_origin, uint32_t& leaf_table, gpu::uvec3& leaf_dims) {
+  tree = 0;
+  leaf_table = 0;
+  index_origin = v3(glm::dvec3(g.origin) - 0.5);
+  if (!g.is_sparse()) return;
+  auto append = [&](uint64_t align, uint64_t bytes) {
+    const uint64_t at = std::max<uint64_t>(out.sparse_bytes, gpu::SPARSE_ZERO_LEAF + 512 * 4);
+    const uint64_t aligned = (at + align - 1) / align * align;
+    if (aligned + bytes > uint64_t(UINT32_MAX))
+      throw input_error(file, "grid \"" + g.name + "\"", "sparse grids of more than 4 GiB together are not supported");
+    out.sparse_bytes = aligned + bytes;
+    return uint32_t(aligned);
+  };
+  tree = append(32, g.sparse->bytes());
+  out.sparse_blocks.push_back({tree, g.sparse.get(), -1});
+  const glm::ivec3 lo = g.origin >> 3, hi = (g.origin + g.dims - 1) >> 3, n = hi - lo + 1;
+  const uint64_t entries = uint64_t(n.x) * uint64_t(n.y) * uint64_t(n.z);
+  if (entries * 4 > std::max<uint64_t>(2 * g.sparse->bytes(), uint64_t(64) << 20))
+    throw input_error(file, "grid \"" + g.name + "\"",
+                      "its leaves are spread over a box of " + std::to_string(n.x) + " x " + std::to_string(n.y) + " x " +
+                          std::to_string(n.z) + " leaf cells, whose table of leaf addresses would outweigh the tree; "
+                          "crop the grid, or use \"texture_format\": \"r16f\" with a \"downsample\"");
+  std::vector<uint32_t> table(entries, gpu::SPARSE_ZERO_LEAF);
+  g.sparse->for_each_leaf([&](const glm::ivec3& o, uint64_t values) {
+    const glm::ivec3 L = (o >> 3) - lo;
+    if (glm::any(glm::lessThan(L, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(L, n))) return;  // all zero there
+    table[(size_t(L.z) * size_t(n.y) + size_t(L.y)) * size_t(n.x) + size_t(L.x)] = uint32_t(tree + values);
+  });
+  leaf_table = append(16, entries * 4);
+  leaf_origin = lo;
+  leaf_dims = gpu::uvec3(n);
+  out.sparse_blocks.push_back({leaf_table, nullptr, int(out.sparse_tables.size())});
+  out.sparse_tables.push_back(std::move(table));
+}
 }  // namespace
 
 namespace {
@@ -40,6 +81,7 @@ uint64_t density_temperature_bytes(const StoredGrid& density, const StoredGrid& 
 }
 
 bool temperature_fits_density_texture(const StoredGrid& density, const StoredGrid& temperature, uint64_t max_bytes) {
+  if (density.grid.is_sparse() || temperature.grid.is_sparse()) return false;  // each tree is read on its own
   if (density.grid.world_to_index != temperature.grid.world_to_index) return false;
   const double apart = double(dense_bytes(density.grid, density.format == TextureFormat::R16F)) +
                        double(dense_bytes(temperature.grid, temperature.format == TextureFormat::R16F));
@@ -107,7 +149,7 @@ gpu::GpuMedium pack_analytic_medium(const Medium& m) {
 // How a grid medium emits: a constant Le, or the blackbody of its temperature
 // grid (that grid's texel map, temperature mapping and LUT coordinates), or not.
 void pack_grid_emission(const Medium& m, const StoredVolume& v, bool with_luts, gpu::GpuMedium& g,
-                        gpu::GpuGrid& grid, GpuGridSource& src) {
+                        gpu::GpuGrid& grid, GpuGridSource& src, GpuScene& out) {
   if (m.emission.rgb) {
     g.emission = v3(*m.emission.rgb * m.emission.scale);
     g.emission_mode = gpu::EMIT_CONSTANT;
@@ -116,6 +158,8 @@ void pack_grid_emission(const Medium& m, const StoredVolume& v, bool with_luts, 
     g.emission_mode = gpu::EMIT_TEMPERATURE;
     src.temperature = &*v.temperature;
     texel_rows(v.temperature->grid, grid.temperature_row0, grid.temperature_row1, grid.temperature_row2);
+    place_sparse(m.file.string(), v.temperature->grid, out, grid.temperature_index_origin, grid.temperature_tree,
+                 grid.temperature_leaf_origin, grid.temperature_leaf_table, grid.temperature_leaf_dims);
     grid.temperature_dims = v3(glm::dvec3(v.temperature->grid.dims));
     grid.temperature_offset = float(m.temperature.offset);
     grid.temperature_scale = float(m.temperature.scale);
@@ -139,10 +183,12 @@ void pack_grid_medium(const Medium& m, size_t i, const StoredVolume& v, bool wit
   src.density = &v.density;
   texel_rows(v.density.grid, grid.density_row0, grid.density_row1, grid.density_row2);
   grid.density_dims = v3(glm::dvec3(v.density.grid.dims));
+  place_sparse(m.file.string(), v.density.grid, out, grid.density_index_origin, grid.density_tree, grid.density_leaf_origin,
+               grid.density_leaf_table, grid.density_leaf_dims);
   grid.density_scale = float(m.density_scale);
   // Depends on the medium's coefficients, not on the cells: edits change it.
   grid.majorant_scale = float(max3(m.sigma_a + m.sigma_s) * m.density_scale);
-  pack_grid_emission(m, v, with_luts, g, grid, src);
+  pack_grid_emission(m, v, with_luts, g, grid, src, out);
   out.has_emission = out.has_emission || (g.emission_mode != gpu::EMIT_NONE && m.emission.scale > 0.0);
   out.media.push_back(g);
   out.grids.push_back(grid);

@@ -11,6 +11,7 @@
 #include "render/Render.h"
 #include "scene/Scene.h"
 #include "shared/gpu_types.h"
+#include "volume/SparseGrid.h"
 #include "volume/StoredVolume.h"
 
 namespace pyrolume {
@@ -34,6 +35,18 @@ struct GpuScene {
   // Every emitting grid's temperature goes into its density texture's second
   // channel (temperature_fits_density_texture), so one lookup reads both.
   bool temperature_in_density = false;
+  // What the sparse buffer holds (shaders/sparse.glsl): the zero leaf at
+  // SPARSE_ZERO_LEAF, then each sparse grid's NanoVDB tree and its leaf table
+  // (in sparse_tables), at these byte offsets; the buffer's size.
+  struct SparseBlock {
+    uint32_t offset = 0;
+    const SparseGrid* tree = nullptr;  // or
+    int table = -1;                    // an index into sparse_tables
+  };
+  std::vector<SparseBlock> sparse_blocks;
+  std::vector<std::vector<uint32_t>> sparse_tables;
+  uint64_t sparse_bytes = 0;
+  bool has_sparse() const { return !sparse_blocks.empty(); }
 };
 
 // Whether a grid's temperature can be the second channel of its density

@@ -3,6 +3,7 @@
 // Vulkan structs are written {.sType = ...}: the rest is zero by design.
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -203,18 +204,26 @@ void Buffer::upload(Context& ctx, const void* src, VkDeviceSize bytes, VkDeviceS
     flush(offset, bytes);
     return;
   }
-  Buffer staging(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryKind::HostVisible, "staging upload");
-  std::memcpy(staging.map(), src, bytes);
-  staging.flush();
-  ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    // Earlier work on this buffer finishes before the copy overwrites it.
-    memory_barrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                   VK_ACCESS_TRANSFER_WRITE_BIT);
-    VkBufferCopy copy{0, offset, bytes};
-    vkCmdCopyBuffer(cmd, staging.buffer(), buffer(), 1, &copy);
-    memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                   VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
-  });
+  // In pieces of at most kStagingBytes: a large buffer (a sparse grid's
+  // tree) never needs a second copy of itself in host memory (on lavapipe the
+  // device's memory is host memory too).
+  constexpr VkDeviceSize kStagingBytes = VkDeviceSize(64) << 20;
+  Buffer staging(ctx, std::min(bytes, kStagingBytes), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryKind::HostVisible,
+                 "staging upload");
+  for (VkDeviceSize done = 0; done < bytes; done += kStagingBytes) {
+    const VkDeviceSize piece = std::min(bytes - done, kStagingBytes);
+    std::memcpy(staging.map(), static_cast<const char*>(src) + done, piece);
+    staging.flush();
+    ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+      // Earlier work on this buffer finishes before the copy overwrites it.
+      memory_barrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                     VK_ACCESS_TRANSFER_WRITE_BIT);
+      VkBufferCopy copy{0, offset + done, piece};
+      vkCmdCopyBuffer(cmd, staging.buffer(), buffer(), 1, &copy);
+      memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                     VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
+    });
+  }
 }
 
 void Buffer::download(Context& ctx, void* dst, VkDeviceSize bytes, VkDeviceSize offset) {

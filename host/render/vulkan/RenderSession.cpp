@@ -135,6 +135,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                         {gpu::BINDING_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_PASS_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_PATHS, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER},
+                        {gpu::BINDING_SPARSE, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER},
                         {gpu::BINDING_QUEUES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
                     uint32_t(sizeof(gpu::PassConstants)), spec_, "render");
   set_.emplace(ctx, *pipeline_, "render set");
@@ -204,6 +205,7 @@ std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const S
           {gpu::SPEC_HAS_SCATTERING, flag(g.has_scattering && scene.integrator.max_depth > 0)},
           {gpu::SPEC_HAS_EMISSION, flag(g.has_emission)},
           {gpu::SPEC_TEMPERATURE_IN_DENSITY, flag(g.temperature_in_density)},
+          {gpu::SPEC_SPARSE_GRIDS, flag(g.has_sparse())},
           {gpu::SPEC_COLLISION_ESTIMATOR, flag(lights.estimator != EmissionEstimator::Absorption)},
           {gpu::SPEC_DEBUG_MODE, settings.debug_mode},
           {gpu::SPEC_MEDIUM_COUNT, uint32_t(g.media.size())},
@@ -245,6 +247,9 @@ void RenderSession::write_grid_descriptors() {
     set_->write_image(gpu::BINDING_DENSITY, textures_3d_[d], slot);
     set_->write_image(gpu::BINDING_TEMPERATURE, textures_3d_[t], slot);
     set_->write_image(gpu::BINDING_BLACKBODY, textures_1d_[b], slot);
+  }
+  if (sparse_view_) {
+    set_->write_texel_buffer(gpu::BINDING_SPARSE, sparse_view_.get());
   }
 }
 
@@ -317,6 +322,11 @@ void RenderSession::create_textures(const Scene& scene) {
       img.upload(ctx_, &zero_half, sizeof zero_half);
       return img;
     }
+    if (g->grid.is_sparse()) {  // read from the sparse buffer; the slot gets a placeholder
+      vk::Image3D img(ctx_, 1, 1, 1, VK_FORMAT_R16_SFLOAT, "sparse grid slot");
+      img.upload(ctx_, &zero_half, sizeof zero_half);
+      return img;
+    }
     const glm::ivec3 d = g->grid.dims;
     const uint32_t max_dim = limits.maxImageDimension3D;
     const uint32_t largest = uint32_t(std::max({d.x, d.y, d.z}));
@@ -360,6 +370,7 @@ void RenderSession::create_textures(const Scene& scene) {
     img.upload(ctx_, lut->rgba().data(), lut->rgba().size() * sizeof(float));
     return img;
   };
+  create_sparse_buffer(scene);
   // Slot layout: 3D [0] placeholder, then density 1 + 2·slot, temperature 2 + 2·slot;
   // 1D [0] placeholder, then the LUT of slot at 1 + slot.
   textures_3d_.push_back(make_3d(nullptr, ""));
@@ -372,6 +383,41 @@ void RenderSession::create_textures(const Scene& scene) {
                                    s.temperature ? "grid \"" + s.temperature->grid.name + "\"" : ""));
     textures_1d_.push_back(make_lut(s.blackbody ? &*s.blackbody : nullptr));
   }
+}
+
+// The sparse grids' trees, each at its offset (a 16-byte placeholder when
+// there are none: every binding needs a buffer).
+void RenderSession::create_sparse_buffer(const Scene& scene) {
+  sparse_view_ = {};  // before its buffer goes
+  const uint64_t bytes = std::max<uint64_t>(16, (gpu_scene_.sparse_bytes + 15) / 16 * 16);
+  const uint64_t texels = bytes / 16;
+  if (texels > ctx_.properties().limits.maxTexelBufferElements || bytes > uint64_t(ctx_.max_allocation_size()))
+    throw input_error(scene.file.string(), "media",
+                      "the sparse grids need " + mib(double(bytes)) + ", more than this device's texel buffer holds (" +
+                          mib(16.0 * double(ctx_.properties().limits.maxTexelBufferElements)) + ")");
+  sparse_buffer_ = vk::Buffer(ctx_, bytes, VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                              vk::MemoryKind::DeviceLocal, "sparse grids");
+  if (gpu_scene_.has_sparse()) {
+    const std::vector<float> zero_leaf(512, 0.0f);
+    sparse_buffer_.upload(ctx_, zero_leaf.data(), zero_leaf.size() * sizeof(float), gpu::SPARSE_ZERO_LEAF);
+  }
+  for (const GpuScene::SparseBlock& b : gpu_scene_.sparse_blocks) {
+    if (b.tree) sparse_buffer_.upload(ctx_, b.tree->handle.data(), b.tree->bytes(), b.offset);
+    else {
+      const std::vector<uint32_t>& t = gpu_scene_.sparse_tables[size_t(b.table)];
+      sparse_buffer_.upload(ctx_, t.data(), t.size() * sizeof(uint32_t), b.offset);
+    }
+  }
+  const VkBufferViewCreateInfo vi{.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO,
+                                  .pNext = nullptr,
+                                  .flags = 0,
+                                  .buffer = sparse_buffer_.buffer(),
+                                  .format = VK_FORMAT_R32G32B32A32_UINT,
+                                  .offset = 0,
+                                  .range = VK_WHOLE_SIZE};
+  VkBufferView view = VK_NULL_HANDLE;
+  VK_CHECK(vkCreateBufferView(ctx_.device(), &vi, nullptr, &view));
+  sparse_view_ = vk::UniqueBufferView(view, {ctx_.device()});
 }
 
 // The BVH over every mesh triangle, the analytic shapes, one material per

@@ -103,6 +103,7 @@ class RenderSession {
   uint64_t shared_texture_bytes(const RenderSettings& settings) const;
   void upload_constants(const Scene& scene);
   void create_textures(const Scene& scene);
+  void create_sparse_buffer(const Scene& scene);
   void create_surfaces(const Scene& scene);
   void create_environment(const Scene& scene);
   // The emission CDFs of the emissive grids and the light selection for
@@ -167,6 +168,10 @@ class RenderSession {
   std::vector<vk::ComputePipeline> wavefront_stages_;
   vk::Buffer wavefront_paths_, wavefront_queues_;
   vk::UniqueBufferView wavefront_paths_view_;
+  // Every sparse grid's NanoVDB tree and leaf table (GpuScene::sparse_blocks), read as a
+  // uniform texel buffer of rgba32ui (shaders/sparse.glsl).
+  vk::Buffer sparse_buffer_;
+  vk::UniqueBufferView sparse_view_;
   uint32_t wavefront_capacity_ = 0;
   bool wavefront_split_ = false;
   gpu::PassConstants wavefront_pass_{};
