@@ -2,8 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <type_traits>
 
 namespace pyrolume {
+
+void SparseGrid::move_to(void* memory) const {
+  const uint64_t n = handle.size();
+  std::memcpy(memory, handle.data(), n);
+  handle = nanovdb::GridHandle<nanovdb::HostBuffer>(nanovdb::HostBuffer::createFull(n, memory));
+}
 
 float SparseGrid::value(const glm::ivec3& ijk) const {
   return grid().tree().getValue(nanovdb::Coord(ijk.x, ijk.y, ijk.z));
@@ -39,6 +47,28 @@ void SparseGrid::for_each_nonzero(const std::function<void(const glm::ivec3&, fl
       f(glm::ivec3(o[0] + int(i >> 6), o[1] + int((i >> 3) & 7), o[2] + int(i & 7)), v);
     }
   }
+  for_each_tile([&](const glm::ivec3& o, int size, float v) {
+    for (int k = 0; k < size; ++k)
+      for (int j = 0; j < size; ++j)
+        for (int i = 0; i < size; ++i) f(o + glm::ivec3(i, j, k), v);
+  });
+}
+
+void SparseGrid::for_each_tile(const std::function<void(const glm::ivec3&, int, float)>& f) const {
+  const auto& tree = grid().tree();
+  auto visit = [&](const auto* node, uint64_t count) {
+    using Node = std::remove_cv_t<std::remove_pointer_t<decltype(node)>>;
+    for (uint64_t i = 0; i < count; ++i, ++node)
+      for (uint32_t n = 0; n < Node::SIZE; ++n) {
+        if (node->data()->isChild(n)) continue;
+        const float v = node->data()->getValue(n);
+        if (v == 0.0f) continue;
+        const nanovdb::Coord o = node->offsetToGlobalCoord(n);
+        f(glm::ivec3(o[0], o[1], o[2]), int(Node::ChildNodeType::DIM), v);
+      }
+  };
+  if (tree.nodeCount(1)) visit(tree.getFirstNode<1>(), tree.nodeCount(1));
+  if (tree.nodeCount(2)) visit(tree.getFirstNode<2>(), tree.nodeCount(2));
 }
 
 void SparseGrid::for_each_leaf(const std::function<void(const glm::ivec3&, uint64_t)>& f) const {

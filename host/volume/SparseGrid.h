@@ -16,9 +16,17 @@
 namespace pyrolume {
 
 struct SparseGrid {
-  nanovdb::GridHandle<nanovdb::HostBuffer> handle;  // exactly one float grid, no active tiles
+  // Exactly one float grid. Its active tiles (cubes of one value) are kept:
+  // the lookups read them, and the visits below include them.
+  // Mutable for move_to, which changes where the same bytes live.
+  mutable nanovdb::GridHandle<nanovdb::HostBuffer> handle;
 
   const nanovdb::FloatGrid& grid() const { return *handle.grid<float>(); }
+  // Copies the tree to `memory` (bytes() long, 32-byte aligned, outliving
+  // this grid) and reads it from there from now on, its own buffer freed. The
+  // Vulkan backend moves trees into mapped device memory where the device's
+  // memory is host memory (lavapipe), so that each is held once.
+  void move_to(void* memory) const;
   size_t bytes() const { return handle.size(); }      // what the GPU stores
   uint64_t leaf_count() const { return grid().tree().nodeCount(0); }
   uint64_t active_voxels() const { return grid().activeVoxelCount(); }
@@ -28,8 +36,12 @@ struct SparseGrid {
   // Trilinear at an index position, OpenVDB's BoxSampler convention (voxel
   // ijk's value sits at the integer point ijk), 0 outside the tree.
   double sample_index(const glm::dvec3& index_pos) const;
-  // f(ijk, value) for every voxel of every leaf whose value is not 0.
+  // f(ijk, value) for every voxel of every leaf, and of every tile, whose
+  // value is not 0.
   void for_each_nonzero(const std::function<void(const glm::ivec3&, float)>& f) const;
+  // f(origin, size, value) for every tile of the internal nodes whose value is
+  // not 0: a cube of size³ voxels (8 or 128) from origin.
+  void for_each_tile(const std::function<void(const glm::ivec3&, int, float)>& f) const;
   // f(origin, offset) for every leaf: its first voxel's index and the byte
   // offset of its 512 values (x-major: voxel (x, y, z) at 4·(64x + 8y + z))
   // in handle's buffer.

@@ -22,6 +22,7 @@
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <type_traits>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <nanovdb/NanoVDB.h>
@@ -332,9 +333,9 @@ DenseGrid dense_from_openvdb(const GridT& grid, const VolumeOptions& m, Role rol
 // texture where it fits this device and host, unless it is large and mostly
 // empty; a sparse tree otherwise. Dense lookups are the faster ones on every
 // device measured (docs/benchmarks.md), so sparse is for what dense cannot hold
-// or would waste: past kSparseFromBytes, when the tree is under a quarter of
-// the texture.
-constexpr uint64_t kSparseFromBytes = uint64_t(256) << 20;
+// or would waste: past kSparseFromBytes, when the tree is under half the
+// texture (the box is mostly inactive).
+constexpr uint64_t kSparseFromBytes = uint64_t(64) << 20;
 
 bool keep_sparse(const VolumeOptions& m, const glm::i64vec3& bbox_dims, uint64_t sparse_bytes, const DenseLimits& limits) {
   if (m.texture_format == TextureFormat::Sparse) return true;
@@ -346,7 +347,7 @@ bool keep_sparse(const VolumeOptions& m, const glm::i64vec3& bbox_dims, uint64_t
   const bool fits = (limits.max_dim == 0 || std::max({d.x, d.y, d.z}) <= int64_t(limits.max_dim)) &&
                     (limits.max_bytes == 0 || dense <= limits.max_bytes) && texels <= max_dense_texels &&
                     (room == 0 || texels * kHostBytesPerTexel <= room);
-  return !fits || (dense > kSparseFromBytes && dense > 4 * sparse_bytes);
+  return !fits || (dense > kSparseFromBytes && dense > 2 * sparse_bytes);
 }
 
 // The same values as DenseBuilder stores (NaN/Inf -> 0, negative density -> 0,
@@ -502,31 +503,19 @@ DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Volume
 // A NanoVDB float grid kept sparse as it was read: its values turned into
 // what DenseBuilder stores (NaN/Inf -> 0, negative density -> 0, inactive
 // voxels and tiles -> 0, background 0) in place, so a large tree is never
-// copied. Empty when a tile is active with a value (a box of voxels the leaf
-// walks would miss): sparse_from_openvdb voxelises those.
+// copied. Active tiles stay tiles (SparseGrid reads and visits them). Empty
+// for an active root tile with a value (a 4096³ box; rare): sparse_from_openvdb
+// takes that grid apart.
 std::optional<DenseGrid> sparse_in_place(nanovdb::GridHandle<nanovdb::HostBuffer>& h, const VolumeOptions& m, Role role,
                                          const std::string& file, std::vector<std::string>& warnings) {
   nanovdb::NanoGrid<float>* grid = h.grid<float>();
   if (!grid) return std::nullopt;
   auto& tree = grid->tree();
-  auto zero_tiles = [&](auto* node, uint64_t count) {
-    for (uint64_t i = 0; i < count; ++i, ++node)
-      for (uint32_t n = 0; n < node->SIZE; ++n) {
-        if (node->data()->isChild(n)) continue;
-        if (node->valueMask().isOn(n) && node->data()->getValue(n) != 0.0f) return false;
-        node->data()->setValue(n, 0.0f);
-      }
-    return true;
-  };
-  if (tree.nodeCount(1) && !zero_tiles(tree.getFirstNode<1>(), tree.nodeCount(1))) return std::nullopt;
-  if (tree.nodeCount(2) && !zero_tiles(tree.getFirstNode<2>(), tree.nodeCount(2))) return std::nullopt;
   auto* root = tree.root().data();
-  for (uint32_t t = 0; t < root->mTableSize; ++t) {
-    auto* tile = root->tile(t);
-    if (tile->isChild()) continue;
-    if (tile->state && tile->value != 0.0f) return std::nullopt;
-    tile->value = 0.0f;
-  }
+  for (uint32_t t = 0; t < root->mTableSize; ++t)
+    if (!root->tile(t)->isChild() && root->tile(t)->state && root->tile(t)->value != 0.0f) return std::nullopt;
+  for (uint32_t t = 0; t < root->mTableSize; ++t)
+    if (!root->tile(t)->isChild()) root->tile(t)->value = 0.0f;
   root->mBackground = 0.0f;
   DenseGrid out;
   out.name = grid->gridName();
@@ -534,29 +523,46 @@ std::optional<DenseGrid> sparse_in_place(nanovdb::GridHandle<nanovdb::HostBuffer
   uint64_t nonfinite = 0, negative = 0, active = 0;
   float vmin = std::numeric_limits<float>::infinity(), vmax = -vmin;
   glm::ivec3 lo(INT32_MAX), hi(INT32_MIN);
+  // An active value v covering a cube of `size` voxels from `o`: what is kept.
+  auto process = [&](float f, const glm::ivec3& o, int size) {
+    const uint64_t voxels = uint64_t(size) * uint64_t(size) * uint64_t(size);
+    if (!std::isfinite(f)) {
+      nonfinite += voxels;
+      f = 0.0f;
+    } else if (f < 0.0f && role == Role::Density) {
+      negative += voxels;
+      f = 0.0f;
+    }
+    active += voxels;
+    vmin = std::min(vmin, f);
+    vmax = std::max(vmax, f);
+    lo = glm::min(lo, o);
+    hi = glm::max(hi, o + (size - 1));
+    return f;
+  };
+  auto tiles = [&](auto* node, uint64_t count) {
+    using Node = std::remove_pointer_t<decltype(node)>;
+    for (uint64_t i = 0; i < count; ++i, ++node)
+      for (uint32_t n = 0; n < Node::SIZE; ++n) {
+        if (node->data()->isChild(n)) continue;
+        float f = 0.0f;
+        if (node->valueMask().isOn(n)) {
+          const nanovdb::Coord o = node->offsetToGlobalCoord(n);
+          f = process(node->data()->getValue(n), glm::ivec3(o[0], o[1], o[2]), int(Node::ChildNodeType::DIM));
+        }
+        node->data()->setValue(n, f);
+      }
+  };
+  if (tree.nodeCount(1)) tiles(tree.getFirstNode<1>(), tree.nodeCount(1));
+  if (tree.nodeCount(2)) tiles(tree.getFirstNode<2>(), tree.nodeCount(2));
   auto* leaf = tree.getFirstNode<0>();
   for (uint64_t l = 0; l < tree.nodeCount(0); ++l, ++leaf) {
     const nanovdb::Coord o = leaf->origin();
     for (uint32_t n = 0; n < 512; ++n) {
-      if (!leaf->valueMask().isOn(n)) {
-        leaf->setValueOnly(n, 0.0f);
-        continue;
-      }
-      float f = leaf->getValue(n);
-      if (!std::isfinite(f)) {
-        ++nonfinite;
-        f = 0.0f;
-      } else if (f < 0.0f && role == Role::Density) {
-        ++negative;
-        f = 0.0f;
-      }
+      float f = 0.0f;
+      if (leaf->valueMask().isOn(n))
+        f = process(leaf->getValue(n), glm::ivec3(o[0] + int(n >> 6), o[1] + int((n >> 3) & 7), o[2] + int(n & 7)), 1);
       leaf->setValueOnly(n, f);
-      ++active;
-      vmin = std::min(vmin, f);
-      vmax = std::max(vmax, f);
-      const glm::ivec3 ijk(o[0] + int(n >> 6), o[1] + int((n >> 3) & 7), o[2] + int(n & 7));
-      lo = glm::min(lo, ijk);
-      hi = glm::max(hi, ijk);
     }
   }
   if (active == 0) return empty_grid(out.name, grid_to_world, m, role, file, warnings);

@@ -5,7 +5,7 @@
    ("texture_format": "r16f") and as sparse NanoVDB trees ("sparse"), on both
    backends, --reps times at --resolution and 16 spp; the medians of the
    renders' own samples per second (--stats) and sparse / dense.
-2. Memory: a generated 1024³-box explosion shell (gen_fire_vdb --sparse
+2. Memory: a generated 1024³-box explosion shell (gen_fire_vdb --thin-shell
    --resolution 1024, written as .nvdb into the work folder once), in a scene
    that leaves texture_format out ("auto" keeps it sparse), rendered on both
    backends; peak RSS (--stats peak_rss_mb) against the target, twice the
@@ -75,7 +75,7 @@ def shell_rows(args, work):
             return []
         log("bench: --sparse: generating the 1024³ explosion shell (once)")
         t0 = time.monotonic()
-        subprocess.run([args.generator, nvdb + ".tmp.nvdb", "--sparse", "--resolution", "1024"], check=True,
+        subprocess.run([args.generator, nvdb + ".tmp.nvdb", "--thin-shell", "--resolution", "1024"], check=True,
                        stdout=subprocess.DEVNULL)
         os.replace(nvdb + ".tmp.nvdb", nvdb)
         log(f"bench: --sparse: generated in {time.monotonic() - t0:.0f} s")
@@ -111,7 +111,7 @@ def run(args, argv):
         lines.append(f"| {name} | {backend} | {d:.3f} [{', '.join(f'{x:.3f}' for x in ds)}] | "
                      f"{s:.3f} [{', '.join(f'{x:.3f}' for x in ss)}] | {ratio:.2f}× |")
     if shell:
-        lines += ["", "The generated 1024³-box explosion shell (`gen_fire_vdb --sparse --resolution 1024`, .nvdb), "
+        lines += ["", "The generated 1024³-box explosion shell (`gen_fire_vdb --thin-shell --resolution 1024`, .nvdb), "
                       "texture_format left out, 160×90, 4 spp: peak RSS (--stats peak_rss_mb, in MB of 10⁶ bytes) "
                       "against twice the file's size plus 300 MB.", "",
                   "| backend | file, MB | peak RSS, MB | target, MB | load, s | render, s |", "|---|---|---|---|---|---|"]

@@ -1,6 +1,8 @@
 #include "render/vulkan/GpuScene.h"
 
 #include <cmath>
+#include <cstring>
+#include <map>
 
 #include "color/Blackbody.h"
 #include "color/EmissionModel.h"
@@ -61,6 +63,24 @@ void place_sparse(const std::string& file, const DenseGrid& g, GpuScene& out, gp
     const glm::ivec3 L = (o >> 3) - lo;
     if (glm::any(glm::lessThan(L, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(L, n))) return;  // all zero there
     table[(size_t(L.z) * size_t(n.y) + size_t(L.y)) * size_t(n.x) + size_t(L.x)] = uint32_t(tree + values);
+  });
+  // An active tile (a cube of one value) covers whole leaf cells: they point
+  // at a leaf of 512 copies of its value, one per value.
+  std::map<uint32_t, uint32_t> constant_leaves;
+  g.sparse->for_each_tile([&](const glm::ivec3& o, int size, float v) {
+    uint32_t bits;
+    std::memcpy(&bits, &v, 4);
+    auto it = constant_leaves.find(bits);
+    if (it == constant_leaves.end()) {
+      const uint32_t at = append(16, 512 * 4);
+      out.sparse_blocks.push_back({at, nullptr, int(out.sparse_tables.size())});
+      out.sparse_tables.emplace_back(512, bits);
+      it = constant_leaves.emplace(bits, at).first;
+    }
+    const glm::ivec3 a = glm::max((o >> 3) - lo, glm::ivec3(0)), b = glm::min(((o + size - 1) >> 3) - lo, n - 1);
+    for (int z = a.z; z <= b.z; ++z)
+      for (int y = a.y; y <= b.y; ++y)
+        for (int x = a.x; x <= b.x; ++x) table[(size_t(z) * size_t(n.y) + size_t(y)) * size_t(n.x) + size_t(x)] = it->second;
   });
   leaf_table = append(16, entries * 4);
   leaf_origin = lo;

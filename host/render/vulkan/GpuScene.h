@@ -36,8 +36,9 @@ struct GpuScene {
   // channel (temperature_fits_density_texture), so one lookup reads both.
   bool temperature_in_density = false;
   // What the sparse buffer holds (shaders/sparse.glsl): the zero leaf at
-  // SPARSE_ZERO_LEAF, then each sparse grid's NanoVDB tree and its leaf table
-  // (in sparse_tables), at these byte offsets; the buffer's size.
+  // SPARSE_ZERO_LEAF, then each sparse grid's NanoVDB tree, a leaf of 512
+  // copies for each value of its active tiles, and its leaf table (these in
+  // sparse_tables), at these byte offsets; the buffer's size.
   struct SparseBlock {
     uint32_t offset = 0;
     const SparseGrid* tree = nullptr;  // or

@@ -45,6 +45,7 @@ class Buffer {
   template <typename T>
   T* data() const { return static_cast<T*>(map()); }
   bool host_coherent() const { return coherent_; }
+  bool host_visible() const { return mapped_ != nullptr; }
   // Make host writes visible to the device / device writes visible to the host
   // (no-ops on coherent memory). The device-side barrier is still the caller's.
   void flush(VkDeviceSize offset = 0, VkDeviceSize size = VK_WHOLE_SIZE) const;

@@ -401,9 +401,25 @@ void RenderSession::create_sparse_buffer(const Scene& scene) {
     const std::vector<float> zero_leaf(512, 0.0f);
     sparse_buffer_.upload(ctx_, zero_leaf.data(), zero_leaf.size() * sizeof(float), gpu::SPARSE_ZERO_LEAF);
   }
+  // Where the buffer is mapped (the device's memory is host memory, as on
+  // lavapipe) the trees move into it, smallest first, each freeing its host
+  // copy as it goes: at most the largest tree is held twice, for a moment
+  // (docs/volumes.md "Sparse grids"). Elsewhere they are copied up.
+  std::vector<const GpuScene::SparseBlock*> trees;
+  for (const GpuScene::SparseBlock& b : gpu_scene_.sparse_blocks)
+    if (b.tree) trees.push_back(&b);
+  std::sort(trees.begin(), trees.end(), [](auto* a, auto* b) { return a->tree->bytes() < b->tree->bytes(); });
+  for (const GpuScene::SparseBlock* b : trees) {
+    if (sparse_buffer_.host_visible()) {
+      b->tree->move_to(static_cast<char*>(sparse_buffer_.map()) + b->offset);
+      sparse_buffer_.flush(b->offset, b->tree->bytes());
+    } else {
+      sparse_buffer_.upload(ctx_, b->tree->handle.data(), b->tree->bytes(), b->offset);
+    }
+  }
   for (const GpuScene::SparseBlock& b : gpu_scene_.sparse_blocks) {
-    if (b.tree) sparse_buffer_.upload(ctx_, b.tree->handle.data(), b.tree->bytes(), b.offset);
-    else {
+    if (b.tree) continue;
+    {
       const std::vector<uint32_t>& t = gpu_scene_.sparse_tables[size_t(b.table)];
       sparse_buffer_.upload(ctx_, t.data(), t.size() * sizeof(uint32_t), b.offset);
     }
