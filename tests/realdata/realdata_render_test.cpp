@@ -137,6 +137,19 @@ TEST_F(RealRender, HoudiniSmokeLitByBackground) {
   compare(s, 1024, 96, "houdini smoke");
 }
 
+// The same plume kept sparse (texture_format "sparse", issue 26): the GPU
+// reads the NanoVDB tree through its leaf table, the CPU through NanoVDB's
+// accessor, and the two agree.
+TEST_F(RealRender, HoudiniSmokeKeptSparse) {
+  Medium m = vdb(dir / "openvdb_smoke1_houdini.vdb", {0.15, 0.2, 0.25}, {0.45, 0.45, 0.45}, 0.3);
+  m.emission.scale = 0.0;
+  m.texture_format = TextureFormat::Sparse;
+  Scene s = framed(m, {0, 0, 1}, {0, 1, 0}, 24, 32);
+  s.background = {1.0, 1.0, 1.0};
+  s.integrator.max_depth = 4;
+  compare(s, 1024, 96, "houdini smoke, sparse");
+}
+
 // The same plume lit by a low sun (issue 24): a disc of 0.53° and irradiance
 // 3, under a dim sky, at 32 spp on both backends. The sun reaches the smoke
 // only by next-event estimation through ratio-tracked light rays; rays that
