@@ -617,10 +617,15 @@ VolumeGrids load_nanovdb(const VolumeOptions& m, bool need_temperature, const De
     if (sparse) {
       if (std::optional<DenseGrid> kept = sparse_in_place(h, m, role, file, out.warnings)) return std::move(*kept);
       // Other value types, and active tiles: through an OpenVDB tree.
+      // Converted per value type, not through the handle: its overload
+      // instantiates every OpenVDB tree type NanoVDB knows (minutes of build).
       ensure_openvdb_initialized();
-      const openvdb::GridBase::Ptr g = nanovdb::nanoToOpenVDB(h);
-      if (auto fg = openvdb::gridConstPtrCast<openvdb::FloatGrid>(g)) return sparse_from_openvdb(*fg, m, role, file, out.warnings);
-      if (auto dg = openvdb::gridConstPtrCast<openvdb::DoubleGrid>(g)) return sparse_from_openvdb(*dg, m, role, file, out.warnings);
+      if (auto* g = h.grid<float>()) return sparse_from_openvdb(*nanovdb::nanoToOpenVDB(*g), m, role, file, out.warnings);
+      if (auto* g = h.grid<double>()) return sparse_from_openvdb(*nanovdb::nanoToOpenVDB(*g), m, role, file, out.warnings);
+      if (auto* g = h.grid<nanovdb::Fp16>()) return sparse_from_openvdb(*nanovdb::nanoToOpenVDB(*g), m, role, file, out.warnings);
+      if (auto* g = h.grid<nanovdb::Fp8>()) return sparse_from_openvdb(*nanovdb::nanoToOpenVDB(*g), m, role, file, out.warnings);
+      if (auto* g = h.grid<nanovdb::Fp4>()) return sparse_from_openvdb(*nanovdb::nanoToOpenVDB(*g), m, role, file, out.warnings);
+      if (auto* g = h.grid<nanovdb::FpN>()) return sparse_from_openvdb(*nanovdb::nanoToOpenVDB(*g), m, role, file, out.warnings);
       throw input_error(file, role_key(role, e.name), "NanoVDB grid type " + e.type + " cannot be kept sparse");
     }
     if (auto* g = h.grid<float>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
