@@ -124,6 +124,36 @@ constexpr uint64_t kHostBytesPerTexel = 12;  // 4 (float array) + 4 (texture cop
 
 int64_t floor_div(int64_t a, int64_t k) { return a >= 0 ? a / k : -((-a + k - 1) / k); }
 
+// What every loader keeps of a grid's values, dense or sparse (docs/volumes.md):
+// NaN/Inf -> 0 and negative density -> 0, each counted for the warnings, and
+// the range of what is kept.
+struct ValueRules {
+  bool clamp_negative;
+  uint64_t nonfinite = 0, negative = 0;
+  float lo = std::numeric_limits<float>::infinity(), hi = -std::numeric_limits<float>::infinity();
+
+  // One active value, standing for `voxels` voxels (a tile covers many).
+  float apply(double v, uint64_t voxels = 1) {
+    float f = float(v);
+    if (!std::isfinite(f)) {  // NaN, Inf, or a double beyond float range
+      nonfinite += voxels;
+      f = 0.0f;
+    } else if (f < 0.0f && clamp_negative) {
+      negative += voxels;
+      f = 0.0f;
+    }
+    lo = std::min(lo, f);
+    hi = std::max(hi, f);
+    return f;
+  }
+
+  void set_range(DenseGrid& out) const {
+    if (lo > hi) return;  // nothing was active
+    out.min_value = lo;
+    out.max_value = hi;
+  }
+};
+
 // Fills a DenseGrid from active voxels. With downsample k, coarse voxel J
 // averages the k^3 fine voxels k*J .. k*J + k-1 (inactive ones count as the
 // background 0); its centre, the mean of the fine centres, is fine index
@@ -132,7 +162,7 @@ class DenseBuilder {
  public:
   DenseBuilder(DenseGrid& out, const glm::i64vec3& bmin, const glm::i64vec3& bmax, int k, bool clamp_negative,
                const std::string& file, Role role, const DenseLimits& limits)
-      : out_(out), k_(k), clamp_negative_(clamp_negative) {
+      : rules{clamp_negative}, out_(out), k_(k) {
     auto dims_at = [&](int64_t kk, glm::i64vec3* lo) {
       glm::i64vec3 cmin, cmax;
       for (int a = 0; a < 3; ++a) {
@@ -198,16 +228,7 @@ class DenseBuilder {
   }
 
   void add(int64_t i, int64_t j, int64_t k, double v) {
-    float f = float(v);
-    if (!std::isfinite(f)) {  // NaN, Inf, or a double beyond float range
-      ++nonfinite;
-      f = 0.0f;
-    } else if (f < 0.0f && clamp_negative_) {
-      ++negative;
-      f = 0.0f;
-    }
-    lo_ = std::min(lo_, f);
-    hi_ = std::max(hi_, f);
+    const float f = rules.apply(v);
     if (f == 0.0f) return;
     const int64_t x = floor_div(i, k_) - out_.origin.x, y = floor_div(j, k_) - out_.origin.y,
                   z = floor_div(k, k_) - out_.origin.z;
@@ -225,10 +246,7 @@ class DenseBuilder {
       const float w = 1.0f / float(k_ * k_ * k_);
       for (float& v : out_.values) v *= w;
     }
-    if (lo_ <= hi_) {
-      out_.min_value = lo_;
-      out_.max_value = hi_;
-    }
+    rules.set_range(out_);
   }
 
   // Coarse index -> fine index (identity for k = 1).
@@ -237,13 +255,11 @@ class DenseBuilder {
     return glm::scale(D, glm::dvec3(double(k_)));
   }
 
-  uint64_t nonfinite = 0, negative = 0;
+  ValueRules rules;
 
  private:
   DenseGrid& out_;
   int k_;
-  bool clamp_negative_;
-  float lo_ = std::numeric_limits<float>::infinity(), hi_ = -std::numeric_limits<float>::infinity();
 };
 
 // The renderers map rays into the grid with these matrices (the GPU in
@@ -267,24 +283,42 @@ void check_index_maps(const DenseGrid& g, const std::string& file, Role role) {
   throw input_error(file, role_key(role, g.name), s.str());
 }
 
-void report_counts(uint64_t nonfinite, uint64_t negative, const std::string& file, Role role, const std::string& grid,
+void report_counts(const ValueRules& r, const std::string& file, Role role, const std::string& grid,
                    std::vector<std::string>& warnings) {
-  if (nonfinite)
-    warnings.push_back(file + ": " + role_key(role, grid) + ": " + std::to_string(nonfinite) +
+  if (r.nonfinite)
+    warnings.push_back(file + ": " + role_key(role, grid) + ": " + std::to_string(r.nonfinite) +
                        " NaN/Inf voxels treated as 0");
-  if (negative)
-    warnings.push_back(file + ": " + role_key(role, grid) + ": " + std::to_string(negative) +
+  if (r.negative)
+    warnings.push_back(file + ": " + role_key(role, grid) + ": " + std::to_string(r.negative) +
                        " negative density voxels clamped to 0");
 }
 
-// A filled grid: its counts reported, its index maps set and checked.
+void set_index_maps(DenseGrid& out, const glm::dmat4& index_to_world, const std::string& file, Role role) {
+  out.index_to_world = index_to_world;
+  out.world_to_index = glm::inverse(out.index_to_world);
+  check_index_maps(out, file, role);
+}
+
+// A filled dense grid: its counts reported, its index maps set and checked.
 DenseGrid finish_grid(DenseBuilder& b, DenseGrid& out, const glm::dmat4& grid_to_world, const VolumeOptions& m,
                       Role role, const std::string& file, std::vector<std::string>& warnings) {
   b.finish();
-  report_counts(b.nonfinite, b.negative, file, role, out.name, warnings);
-  out.index_to_world = m.transform * grid_to_world * b.index_map();
-  out.world_to_index = glm::inverse(out.index_to_world);
-  check_index_maps(out, file, role);
+  report_counts(b.rules, file, role, out.name, warnings);
+  set_index_maps(out, m.transform * grid_to_world * b.index_map(), file, role);
+  return std::move(out);
+}
+
+// The same for a sparse grid whose active voxels span lo..hi: the box the
+// dense texture would have (one texel of padding each side), the tree kept.
+DenseGrid finish_sparse(DenseGrid& out, std::shared_ptr<SparseGrid> sparse, const glm::i64vec3& lo,
+                        const glm::i64vec3& hi, const ValueRules& rules, const glm::dmat4& grid_to_world,
+                        const VolumeOptions& m, Role role, const std::string& file, std::vector<std::string>& warnings) {
+  report_counts(rules, file, role, out.name, warnings);
+  out.sparse = std::move(sparse);
+  out.origin = glm::ivec3(lo - int64_t(1));
+  out.dims = glm::ivec3(hi - lo + int64_t(3));
+  rules.set_range(out);
+  set_index_maps(out, m.transform * grid_to_world, file, role);
   return std::move(out);
 }
 
@@ -293,9 +327,7 @@ DenseGrid empty_grid(std::string name, const glm::dmat4& grid_to_world, const Vo
                      const std::string& file, std::vector<std::string>& warnings) {
   DenseGrid out;
   out.name = std::move(name);
-  out.index_to_world = m.transform * grid_to_world;
-  out.world_to_index = glm::inverse(out.index_to_world);
-  check_index_maps(out, file, role);
+  set_index_maps(out, m.transform * grid_to_world, file, role);
   warnings.push_back(file + ": " + role_key(role, out.name) + ": empty grid (no active voxels): " +
                      (role == Role::Density ? "renders as no medium" : "the medium does not emit"));
   return out;
@@ -369,28 +401,15 @@ DenseGrid sparse_from_openvdb(const GridT& grid, const VolumeOptions& m, Role ro
     throw input_error(file, role_key(role, out.name), "active bounding box reaches the end of the index range");
   openvdb::FloatGrid::Ptr tree_grid = openvdb::FloatGrid::create(0.0f);
   auto acc = tree_grid->getAccessor();
-  uint64_t nonfinite = 0, negative = 0;
-  float vmin = std::numeric_limits<float>::infinity(), vmax = -vmin;
-  auto process = [&](double v) {
-    float f = float(v);
-    if (!std::isfinite(f)) {
-      ++nonfinite;
-      f = 0.0f;
-    } else if (f < 0.0f && role == Role::Density) {
-      ++negative;
-      f = 0.0f;
-    }
-    vmin = std::min(vmin, f);
-    vmax = std::max(vmax, f);
-    return f;
-  };
+  ValueRules rules{role == Role::Density};
   for (auto it = grid.tree().cbeginValueOn(); it; ++it) {
-    const float f = process(double(*it));
     if (it.isVoxelValue()) {
+      const float f = rules.apply(double(*it));
       if (f != 0.0f) acc.setValue(it.getCoord(), f);
     } else {
       openvdb::CoordBBox box;
       it.getBoundingBox(box);
+      const float f = rules.apply(double(*it), box.volume());
       if (f != 0.0f) tree_grid->tree().fill(box, f, true);
     }
   }
@@ -398,16 +417,7 @@ DenseGrid sparse_from_openvdb(const GridT& grid, const VolumeOptions& m, Role ro
   auto sparse = std::make_shared<SparseGrid>();
   sparse->handle = nanovdb::openToNanoVDB(*tree_grid);
   tree_grid.reset();
-  report_counts(nonfinite, negative, file, role, out.name, warnings);
-  out.sparse = std::move(sparse);
-  out.origin = glm::ivec3(lo - int64_t(1));
-  out.dims = glm::ivec3(dims);
-  out.min_value = vmin;
-  out.max_value = vmax;
-  out.index_to_world = m.transform * grid_to_world;
-  out.world_to_index = glm::inverse(out.index_to_world);
-  check_index_maps(out, file, role);
-  return out;
+  return finish_sparse(out, std::move(sparse), lo, hi, rules, grid_to_world, m, role, file, warnings);
 }
 
 std::vector<GridEntry> openvdb_grid_entries(openvdb::io::File& f) {
@@ -520,25 +530,16 @@ std::optional<DenseGrid> sparse_in_place(nanovdb::GridHandle<nanovdb::HostBuffer
   DenseGrid out;
   out.name = grid->gridName();
   const glm::dmat4 grid_to_world = nanovdb_index_to_world(*grid);
-  uint64_t nonfinite = 0, negative = 0, active = 0;
-  float vmin = std::numeric_limits<float>::infinity(), vmax = -vmin;
+  ValueRules rules{role == Role::Density};
+  uint64_t active = 0;
   glm::ivec3 lo(INT32_MAX), hi(INT32_MIN);
   // An active value v covering a cube of `size` voxels from `o`: what is kept.
   auto process = [&](float f, const glm::ivec3& o, int size) {
     const uint64_t voxels = uint64_t(size) * uint64_t(size) * uint64_t(size);
-    if (!std::isfinite(f)) {
-      nonfinite += voxels;
-      f = 0.0f;
-    } else if (f < 0.0f && role == Role::Density) {
-      negative += voxels;
-      f = 0.0f;
-    }
     active += voxels;
-    vmin = std::min(vmin, f);
-    vmax = std::max(vmax, f);
     lo = glm::min(lo, o);
     hi = glm::max(hi, o + (size - 1));
-    return f;
+    return rules.apply(f, voxels);
   };
   auto tiles = [&](auto* node, uint64_t count) {
     using Node = std::remove_pointer_t<decltype(node)>;
@@ -566,18 +567,10 @@ std::optional<DenseGrid> sparse_in_place(nanovdb::GridHandle<nanovdb::HostBuffer
     }
   }
   if (active == 0) return empty_grid(out.name, grid_to_world, m, role, file, warnings);
-  report_counts(nonfinite, negative, file, role, out.name, warnings);
   auto sparse = std::make_shared<SparseGrid>();
   sparse->handle = std::move(h);
-  out.sparse = std::move(sparse);
-  out.origin = lo - 1;
-  out.dims = hi - lo + 3;
-  out.min_value = vmin;
-  out.max_value = vmax;
-  out.index_to_world = m.transform * grid_to_world;
-  out.world_to_index = glm::inverse(out.index_to_world);
-  check_index_maps(out, file, role);
-  return out;
+  return finish_sparse(out, std::move(sparse), glm::i64vec3(lo), glm::i64vec3(hi), rules, grid_to_world, m, role, file,
+                       warnings);
 }
 
 VolumeGrids load_nanovdb(const VolumeOptions& m, bool need_temperature, const DenseLimits& limits) {
