@@ -31,3 +31,19 @@ def write_json_if_changed(path, data):
 def file_stamp(path):
     st = os.stat(path)
     return f"{os.path.abspath(path)}:{st.st_mtime_ns}:{st.st_size}"
+
+
+def replace_block(md_path, begin, end, block, heading):
+    """Writes `block` (which starts with `begin` and ends with `end`) into
+    md_path in place of the part between those markers, or appends it under a
+    new `## heading` where the markers are not there yet. Text outside the
+    markers is hand-written and kept as it is."""
+    text = open(md_path).read() if os.path.exists(md_path) else ""
+    if begin in text and end in text:
+        text = text[:text.index(begin)] + block + text[text.index(end) + len(end):]
+    else:
+        text = text.rstrip("\n") + f"\n\n## {heading}\n\n" + block + "\n"
+    tmp = md_path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, md_path)

@@ -21,7 +21,7 @@ import statistics
 import subprocess
 import time
 
-from .common import REPO, log
+from .common import REPO, log, replace_block
 from .runner import machine_info, render
 from .scenes import asset_scene, real_vdb_scene
 
@@ -121,13 +121,6 @@ def run(args, argv):
     block = "\n".join(lines)
     print(block)
     md = os.path.join(os.path.abspath(args.out_dir), "benchmarks.md")
-    text = open(md).read() if os.path.exists(md) else ""
-    if BEGIN in text and END in text:
-        text = text[:text.index(BEGIN)] + block + text[text.index(END) + len(END):]
-    else:
-        text = text.rstrip("\n") + "\n\n## Sparse grids\n\n" + block + "\n"
-    with open(md + ".tmp", "w") as fh:
-        fh.write(text)
-    os.replace(md + ".tmp", md)
+    replace_block(md, BEGIN, END, block, "Sparse grids")
     log(f"bench: --sparse: {os.path.relpath(md)}")
     return 0
