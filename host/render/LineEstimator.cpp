@@ -96,6 +96,7 @@ LineMedia line_media(const Scene& scene, const std::vector<const StoredVolume*>&
   LineMedia out;
   out.line.assign(n, false);
   out.rates.resize(n);
+  out.majorant_res.assign(n, glm::ivec3(0));
   if (asked && *asked != EmissionEstimator::Line) return out;
   std::vector<double> power(n, 0.0);
   double total = 0.0;
@@ -111,8 +112,8 @@ LineMedia line_media(const Scene& scene, const std::vector<const StoredVolume*>&
       const DenseGrid& density = vol->density.grid;
       const DenseGrid* temperature =
           vol->temperature && !vol->temperature->grid.empty() ? &vol->temperature->grid : nullptr;
-      LineRates rates =
-          line_rates(m, density, temperature, build_majorant_grid(density, majorant_resolution(scene.integrator, m, density)));
+      out.majorant_res[i] = majorant_resolution(scene.integrator, m, density);
+      LineRates rates = line_rates(m, density, temperature, build_majorant_grid(density, out.majorant_res[i]));
       power[i] = rates.power;
       out.line[i] = asked || rates.thin();
       out.rates[i] = std::move(rates.rate);

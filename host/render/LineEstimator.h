@@ -69,6 +69,10 @@ struct LineMedia {
   // Per scene medium: a grid medium's LineRates::rate where `line` holds
   // (on the majorant grid the GPU builds: majorant_resolution), else empty.
   std::vector<std::vector<float>> rates;
+  // Per scene medium: the majorant grid resolution majorant_resolution chose
+  // for a grid medium whose rates were computed (0 where none was chosen), so
+  // that the renderer does not run the choice's simulation again.
+  std::vector<glm::ivec3> majorant_res;
   bool any() const { return std::find(line.begin(), line.end(), true) != line.end(); }
 };
 

@@ -8,11 +8,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <random>
 
 #include "light/EmissionCdf.h"
+#include "render/vulkan/GpuScene.h"
 #include "scene/MediumVolume.h"
 #include "scene/Scene.h"
 #include "support/TestSupport.h"
@@ -204,6 +206,43 @@ TEST_F(SparseGridTest, AutoKeepsSmallGridsDense) {
   Scene s = load_scene(fs::path(PYROLUME_SOURCE_DIR) / "assets/scenes/fire.json");
   EXPECT_EQ(s.media[0].texture_format, TextureFormat::Auto);
   EXPECT_FALSE(load_stored_volume(s.media[0]).density.grid.is_sparse());
+}
+
+// A live edit re-packs the media headers without the leaf tables (they visit
+// every leaf): the sparse buffer's layout, and so every offset the GpuGrids
+// hold, must be the one the session built its buffer with.
+TEST_F(SparseGridTest, HeadersForALiveEditKeepTheSparseLayoutWithoutItsTables) {
+  const fs::path file = write_noisy_grid(dir / "noisy.vdb");
+  Scene scene;
+  scene.media.push_back(noisy_medium(file, TextureFormat::Sparse));
+  std::vector<std::optional<StoredVolume>> volumes;
+  volumes.push_back(load_stored_volume(scene.media[0]));
+  const GpuScene full = build_gpu_scene(scene, volumes);
+  ASSERT_EQ(full.grids.size(), 1u);
+  ASSERT_FALSE(full.sparse_tables.empty());
+  EXPECT_NE(full.grids[0].density_tree, 0u);
+  EXPECT_NE(full.grids[0].temperature_tree, 0u);
+  // The majorant cells were chosen once, by the line estimator's pass, and kept.
+  ASSERT_EQ(full.line.majorant_res.size(), 1u);
+  EXPECT_EQ(full.line.majorant_res[0], majorant_resolution(scene.integrator, scene.media[0], volumes[0]->density.grid));
+  EXPECT_EQ(glm::ivec3(full.grids[0].majorant_res.x, full.grids[0].majorant_res.y, full.grids[0].majorant_res.z),
+            full.line.majorant_res[0]);
+
+  scene.media[0].density_scale *= 2.0;  // the edit
+  const GpuScene edit = pack_gpu_media(scene, volumes, /*with_luts=*/false, full.line.line, /*with_tables=*/false);
+  EXPECT_TRUE(edit.sparse_tables.empty());
+  EXPECT_TRUE(edit.sparse_blocks.empty());
+  EXPECT_EQ(edit.sparse_bytes, full.sparse_bytes);
+  ASSERT_EQ(edit.grids.size(), 1u);
+  const gpu::GpuGrid &a = edit.grids[0], &b = full.grids[0];
+  EXPECT_EQ(a.density_tree, b.density_tree);
+  EXPECT_EQ(a.density_leaf_table, b.density_leaf_table);
+  EXPECT_EQ(a.temperature_tree, b.temperature_tree);
+  EXPECT_EQ(a.temperature_leaf_table, b.temperature_leaf_table);
+  EXPECT_EQ(std::memcmp(&a.density_leaf_origin, &b.density_leaf_origin, sizeof a.density_leaf_origin), 0);
+  EXPECT_EQ(std::memcmp(&a.density_leaf_dims, &b.density_leaf_dims, sizeof a.density_leaf_dims), 0);
+  EXPECT_EQ(std::memcmp(&a.temperature_leaf_dims, &b.temperature_leaf_dims, sizeof a.temperature_leaf_dims), 0);
+  EXPECT_EQ(a.density_scale, 2.0f * b.density_scale);  // while the edit itself goes through
 }
 
 TEST_F(SparseGridTest, SparseWithDownsampleIsRefused) {

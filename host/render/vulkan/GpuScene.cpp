@@ -35,8 +35,10 @@ void texel_rows(const DenseGrid& g, gpu::vec4& r0, gpu::vec4& r1, gpu::vec4& r2)
 // "dense"), and where they sit into the GpuGrid's fields; a dense grid gets 0.
 // The flat leaf table replaces the walk from the root (shaders/sparse.glsl);
 // a box so large and empty that the table would outweigh the tree is refused.
-void place_sparse(const std::string& file, const DenseGrid& g, GpuScene& out, gpu::vec3& index_origin, uint32_t& tree,
-                  gpu::ivec3& leaf_origin, uint32_t& leaf_table, gpu::uvec3& leaf_dims) {
+// Without `with_tables` only the offsets are laid out (the same ones): a live
+// edit re-packs the headers, and the tables it would rebuild visit every leaf.
+void place_sparse(const std::string& file, const DenseGrid& g, bool with_tables, GpuScene& out, gpu::vec3& index_origin,
+                  uint32_t& tree, gpu::ivec3& leaf_origin, uint32_t& leaf_table, gpu::uvec3& leaf_dims) {
   tree = 0;
   leaf_table = 0;
   index_origin = v3(glm::dvec3(g.origin) - 0.5);
@@ -50,7 +52,7 @@ void place_sparse(const std::string& file, const DenseGrid& g, GpuScene& out, gp
     return uint32_t(aligned);
   };
   tree = append(32, g.sparse->bytes());
-  out.sparse_blocks.push_back({tree, g.sparse.get(), -1});
+  if (with_tables) out.sparse_blocks.push_back({tree, g.sparse.get(), -1});
   const glm::ivec3 lo = g.origin >> 3, hi = (g.origin + g.dims - 1) >> 3, n = hi - lo + 1;
   const uint64_t entries = uint64_t(n.x) * uint64_t(n.y) * uint64_t(n.z);
   if (entries * 4 > std::max<uint64_t>(2 * g.sparse->bytes(), uint64_t(64) << 20))
@@ -58,8 +60,8 @@ void place_sparse(const std::string& file, const DenseGrid& g, GpuScene& out, gp
                       "its leaves are spread over a box of " + std::to_string(n.x) + " x " + std::to_string(n.y) + " x " +
                           std::to_string(n.z) + " leaf cells, whose table of leaf addresses would outweigh the tree; "
                           "crop the grid, or use \"texture_format\": \"r16f\" with a \"downsample\"");
-  std::vector<uint32_t> table(entries, gpu::SPARSE_ZERO_LEAF);
-  g.sparse->for_each_leaf([&](const glm::ivec3& o, uint64_t values) {
+  std::vector<uint32_t> table(with_tables ? entries : 0, gpu::SPARSE_ZERO_LEAF);
+  if (with_tables) g.sparse->for_each_leaf([&](const glm::ivec3& o, uint64_t values) {
     const glm::ivec3 L = (o >> 3) - lo;
     if (glm::any(glm::lessThan(L, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(L, n))) return;  // all zero there
     table[(size_t(L.z) * size_t(n.y) + size_t(L.y)) * size_t(n.x) + size_t(L.x)] = uint32_t(tree + values);
@@ -73,10 +75,13 @@ void place_sparse(const std::string& file, const DenseGrid& g, GpuScene& out, gp
     auto it = constant_leaves.find(bits);
     if (it == constant_leaves.end()) {
       const uint32_t at = append(16, 512 * 4);
-      out.sparse_blocks.push_back({at, nullptr, int(out.sparse_tables.size())});
-      out.sparse_tables.emplace_back(512, bits);
+      if (with_tables) {
+        out.sparse_blocks.push_back({at, nullptr, int(out.sparse_tables.size())});
+        out.sparse_tables.emplace_back(512, bits);
+      }
       it = constant_leaves.emplace(bits, at).first;
     }
+    if (!with_tables) return;
     const glm::ivec3 a = glm::max((o >> 3) - lo, glm::ivec3(0)), b = glm::min(((o + size - 1) >> 3) - lo, n - 1);
     for (int z = a.z; z <= b.z; ++z)
       for (int y = a.y; y <= b.y; ++y)
@@ -85,6 +90,7 @@ void place_sparse(const std::string& file, const DenseGrid& g, GpuScene& out, gp
   leaf_table = append(16, entries * 4);
   leaf_origin = lo;
   leaf_dims = gpu::uvec3(n);
+  if (!with_tables) return;
   out.sparse_blocks.push_back({leaf_table, nullptr, int(out.sparse_tables.size())});
   out.sparse_tables.push_back(std::move(table));
 }
@@ -168,7 +174,7 @@ gpu::GpuMedium pack_analytic_medium(const Medium& m) {
 
 // How a grid medium emits: a constant Le, or the blackbody of its temperature
 // grid (that grid's texel map, temperature mapping and LUT coordinates), or not.
-void pack_grid_emission(const Medium& m, const StoredVolume& v, bool with_luts, gpu::GpuMedium& g,
+void pack_grid_emission(const Medium& m, const StoredVolume& v, bool with_luts, bool with_tables, gpu::GpuMedium& g,
                         gpu::GpuGrid& grid, GpuGridSource& src, GpuScene& out) {
   if (m.emission.rgb) {
     g.emission = v3(*m.emission.rgb * m.emission.scale);
@@ -178,7 +184,7 @@ void pack_grid_emission(const Medium& m, const StoredVolume& v, bool with_luts, 
     g.emission_mode = gpu::EMIT_TEMPERATURE;
     src.temperature = &*v.temperature;
     texel_rows(v.temperature->grid, grid.temperature_row0, grid.temperature_row1, grid.temperature_row2);
-    place_sparse(m.file.string(), v.temperature->grid, out, grid.temperature_index_origin, grid.temperature_tree,
+    place_sparse(m.file.string(), v.temperature->grid, with_tables, out, grid.temperature_index_origin, grid.temperature_tree,
                  grid.temperature_leaf_origin, grid.temperature_leaf_table, grid.temperature_leaf_dims);
     grid.temperature_dims = v3(glm::dvec3(v.temperature->grid.dims));
     grid.temperature_offset = float(m.temperature.offset);
@@ -193,7 +199,8 @@ void pack_grid_emission(const Medium& m, const StoredVolume& v, bool with_luts, 
 
 // Medium i, a grid, in the next grid slot: its GpuMedium, GpuGrid (all but the
 // majorant cells' geometry, add_majorant_cells') and source.
-void pack_grid_medium(const Medium& m, size_t i, const StoredVolume& v, bool with_luts, GpuScene& out) {
+void pack_grid_medium(const Medium& m, size_t i, const StoredVolume& v, bool with_luts, bool with_tables,
+                      GpuScene& out) {
   gpu::GpuMedium g = medium_coefficients(m);
   g.shape = gpu::SHAPE_GRID;
   g.grid_slot = uint32_t(out.grids.size());
@@ -203,12 +210,12 @@ void pack_grid_medium(const Medium& m, size_t i, const StoredVolume& v, bool wit
   src.density = &v.density;
   texel_rows(v.density.grid, grid.density_row0, grid.density_row1, grid.density_row2);
   grid.density_dims = v3(glm::dvec3(v.density.grid.dims));
-  place_sparse(m.file.string(), v.density.grid, out, grid.density_index_origin, grid.density_tree, grid.density_leaf_origin,
+  place_sparse(m.file.string(), v.density.grid, with_tables, out, grid.density_index_origin, grid.density_tree, grid.density_leaf_origin,
                grid.density_leaf_table, grid.density_leaf_dims);
   grid.density_scale = float(m.density_scale);
   // Depends on the medium's coefficients, not on the cells: edits change it.
   grid.majorant_scale = float(max3(m.sigma_a + m.sigma_s) * m.density_scale);
-  pack_grid_emission(m, v, with_luts, g, grid, src, out);
+  pack_grid_emission(m, v, with_luts, with_tables, g, grid, src, out);
   out.has_emission = out.has_emission || (g.emission_mode != gpu::EMIT_NONE && m.emission.scale > 0.0);
   out.media.push_back(g);
   out.grids.push_back(grid);
@@ -230,7 +237,7 @@ bool every_temperature_fits_density(const std::vector<GpuGridSource>& sources, u
 }  // namespace
 
 GpuScene pack_gpu_media(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes, bool with_luts,
-                        const std::vector<bool>& line) {
+                        const std::vector<bool>& line, bool with_tables) {
   GpuScene out;
   out.line.line = line;
   out.line.line.resize(scene.media.size(), false);
@@ -248,7 +255,7 @@ GpuScene pack_gpu_media(const Scene& scene, const std::vector<std::optional<Stor
       if (out.grids.size() >= gpu::MAX_GRIDS)
         throw input_error(scene.file.string(), "media[" + std::to_string(i) + "]",
                           "at most " + std::to_string(gpu::MAX_GRIDS) + " vdb media per scene");
-      pack_grid_medium(m, i, v, with_luts, out);
+      pack_grid_medium(m, i, v, with_luts, with_tables, out);
     }
     out.has_scattering = out.has_scattering || max3(m.sigma_s) > 0.0;
   }
@@ -263,7 +270,10 @@ void add_majorant_cells(const Scene& scene, GpuScene& g) {
     // Majorant cells over the stored (rounded) density.
     const GpuGridSource& src = g.grid_sources[slot];
     const DenseGrid& density = src.density->grid;
-    const MajorantGrid mg = build_majorant_grid(density, majorant_resolution(scene.integrator, scene.media[src.medium], density));
+    const bool chosen = src.medium < g.line.majorant_res.size() && g.line.majorant_res[src.medium].x > 0;
+    const glm::ivec3 res = chosen ? g.line.majorant_res[src.medium]
+                                  : majorant_resolution(scene.integrator, scene.media[src.medium], density);
+    const MajorantGrid mg = build_majorant_grid(density, res);
     gpu::GpuGrid& grid = g.grids[slot];
     grid.majorant_res = gpu::uvec3(uint32_t(mg.res.x), uint32_t(mg.res.y), uint32_t(mg.res.z));
     grid.majorant_offset = uint32_t(g.majorants.size());
@@ -287,6 +297,7 @@ GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<Sto
   LineMedia line = line_media(scene, by_medium);
   GpuScene out = pack_gpu_media(scene, volumes, with_luts, line.line);
   out.line.rates = std::move(line.rates);
+  out.line.majorant_res = std::move(line.majorant_res);
   add_majorant_cells(scene, out);
   out.temperature_in_density = every_temperature_fits_density(out.grid_sources, max_texture_bytes);
   return out;

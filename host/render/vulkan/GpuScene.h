@@ -47,7 +47,7 @@ struct GpuScene {
   std::vector<SparseBlock> sparse_blocks;
   std::vector<std::vector<uint32_t>> sparse_tables;
   uint64_t sparse_bytes = 0;
-  bool has_sparse() const { return !sparse_blocks.empty(); }
+  bool has_sparse() const { return sparse_bytes > 0; }
 };
 
 // Whether a grid's temperature can be the second channel of its density
@@ -81,8 +81,11 @@ GpuScene build_gpu_scene(const Scene& scene, const std::vector<std::optional<Sto
 // majorant_offset and majorant_cell stay 0; temperature_in_density false):
 // all that a live edit of a medium's parameters changes. `line`: per scene
 // medium, collected by the line estimator (line_media; missing: false).
+// `with_tables` = false lays out the sparse buffer (the same offsets in the
+// GpuGrids) without building its leaf tables (sparse_blocks and sparse_tables
+// stay empty): an edit keeps the buffer it has.
 GpuScene pack_gpu_media(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes,
-                        bool with_luts = true, const std::vector<bool>& line = {});
+                        bool with_luts = true, const std::vector<bool>& line = {}, bool with_tables = true);
 // Each grid's majorant cells (from its density as stored and the scene's
 // integrator.majorant settings) into g.majorants, and where they lie into its
 // GpuGrid; for the grid media with line rates (g.line.rates), the rates after them.

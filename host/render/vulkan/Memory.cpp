@@ -378,6 +378,19 @@ VkSamplerCreateInfo linear_sampler(VkSamplerAddressMode mode) {
 }
 }  // namespace
 
+UniqueBufferView texel_buffer_view(Context& ctx, const Buffer& buffer, VkFormat format) {
+  const VkBufferViewCreateInfo vi{.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO,
+                                  .pNext = nullptr,
+                                  .flags = 0,
+                                  .buffer = buffer.buffer(),
+                                  .format = format,
+                                  .offset = 0,
+                                  .range = VK_WHOLE_SIZE};
+  VkBufferView view = VK_NULL_HANDLE;
+  VK_CHECK(vkCreateBufferView(ctx.device(), &vi, nullptr, &view));
+  return UniqueBufferView(view, {ctx.device()});
+}
+
 Image3D::Image3D(Context& ctx, uint32_t width, uint32_t height, uint32_t depth, VkFormat format, const char* name)
     : SampledImage(ctx, VK_IMAGE_TYPE_3D, {width, height, depth}, format,
                    linear_sampler(VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER), name) {}

@@ -69,6 +69,9 @@ class Buffer {
   VkDeviceSize atom_ = 1;  // nonCoherentAtomSize
 };
 
+// A view of the whole buffer as texels of `format` (a texel-buffer binding).
+UniqueBufferView texel_buffer_view(Context& ctx, const Buffer& buffer, VkFormat format);
+
 // A sampled image with its view and sampler, filled from host data. Texels are
 // tightly packed, x fastest, then y, then z. After upload() it stays in
 // SHADER_READ_ONLY_OPTIMAL.

@@ -419,21 +419,10 @@ void RenderSession::create_sparse_buffer(const Scene& scene) {
   }
   for (const GpuScene::SparseBlock& b : gpu_scene_.sparse_blocks) {
     if (b.tree) continue;
-    {
-      const std::vector<uint32_t>& t = gpu_scene_.sparse_tables[size_t(b.table)];
-      sparse_buffer_.upload(ctx_, t.data(), t.size() * sizeof(uint32_t), b.offset);
-    }
+    const std::vector<uint32_t>& t = gpu_scene_.sparse_tables[size_t(b.table)];
+    sparse_buffer_.upload(ctx_, t.data(), t.size() * sizeof(uint32_t), b.offset);
   }
-  const VkBufferViewCreateInfo vi{.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO,
-                                  .pNext = nullptr,
-                                  .flags = 0,
-                                  .buffer = sparse_buffer_.buffer(),
-                                  .format = VK_FORMAT_R32G32B32A32_UINT,
-                                  .offset = 0,
-                                  .range = VK_WHOLE_SIZE};
-  VkBufferView view = VK_NULL_HANDLE;
-  VK_CHECK(vkCreateBufferView(ctx_.device(), &vi, nullptr, &view));
-  sparse_view_ = vk::UniqueBufferView(view, {ctx_.device()});
+  sparse_view_ = vk::texel_buffer_view(ctx_, sparse_buffer_, VK_FORMAT_R32G32B32A32_UINT);
 }
 
 // The BVH over every mesh triangle, the analytic shapes, one material per
@@ -549,7 +538,7 @@ void RenderSession::upload_constants(const Scene& scene) {
   // Only the headers: the blackbody LUTs and majorant cells stay as baked (an
   // edit changes neither the emission's mode nor the grids), so they are not
   // rebuilt; the majorant scale, which follows the coefficients, is.
-  GpuScene now = pack_gpu_media(scene, volumes_, /*with_luts=*/false, gpu_scene_.line.line);
+  GpuScene now = pack_gpu_media(scene, volumes_, /*with_luts=*/false, gpu_scene_.line.line, /*with_tables=*/false);
   for (size_t i = 0; i < now.grids.size() && i < gpu_scene_.grids.size(); ++i)
     keep_baked_grid_fields(gpu_scene_.grids[i], now.grids[i]);
   const gpu::FrameConstants frame = build_frame_constants(scene, settings_, uint32_t(now.media.size()), light_selection_);
@@ -625,16 +614,7 @@ void RenderSession::create_wavefront(const std::vector<uint32_t>& code) {
   wavefront_paths_ = vk::Buffer(ctx_, slots * words * 4 * sizeof(uint32_t),
                                 VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT, vk::MemoryKind::DeviceLocal,
                                 "wavefront paths");
-  const VkBufferViewCreateInfo vi{.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO,
-                                  .pNext = nullptr,
-                                  .flags = 0,
-                                  .buffer = wavefront_paths_.buffer(),
-                                  .format = VK_FORMAT_R32G32B32A32_UINT,
-                                  .offset = 0,
-                                  .range = VK_WHOLE_SIZE};
-  VkBufferView view = VK_NULL_HANDLE;
-  VK_CHECK(vkCreateBufferView(ctx_.device(), &vi, nullptr, &view));
-  wavefront_paths_view_ = vk::UniqueBufferView(view, {ctx_.device()});
+  wavefront_paths_view_ = vk::texel_buffer_view(ctx_, wavefront_paths_, VK_FORMAT_R32G32B32A32_UINT);
   wavefront_queues_ = vk::Buffer(ctx_, sizeof(gpu::WavefrontQueues) + 4 * slots * sizeof(uint32_t),
                                  kStorage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, vk::MemoryKind::HostVisible,
                                  "wavefront queues");
