@@ -184,7 +184,9 @@ std::vector<std::string> missing_inputs(const Scene& pattern_scene, const Scene&
 // pass is done (or the render returns), then printed once.
 struct SceneRemarks {
   std::vector<std::string> lines;
-  void say() {
+  // The bar's line is cleared first: the remarks go on lines of their own.
+  void say(ProgressBar* bar = nullptr) {
+    if (bar && !lines.empty()) bar->finish();
     for (const std::string& l : lines) std::cerr << l << "\n";
     lines.clear();
   }
@@ -275,14 +277,15 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
     RenderSettings settings = settings_from(args, frame_scene);
     settings.frame = uint32_t(frame);
     ProgressBar bar("frame " + std::to_string(frame));
+    bar.status("loading its volumes, lights and shaders ...");
     RenderControl control;
     control.progress = [&](int done, int target) {
-      remarks.say();
+      remarks.say(&bar);
       bar.update(done, target);
     };
     control.cancel = &cancel;
     RenderResult result = backend->render(frame_scene, settings, control);
-    remarks.say();
+    remarks.say(&bar);
     bar.finish();
     if (result.cancelled) {
       // A partly converged frame is not complete: write nothing, so that
@@ -429,9 +432,10 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   };
 
   ProgressBar bar("rendering");
+  bar.status("loading the scene's volumes, lights and shaders ...");
   RenderControl control;
   control.progress = [&](int done, int target) {
-    remarks.say();
+    remarks.say(&bar);
     bar.update(done, target);
   };
   control.cancel = &cancel;
@@ -484,7 +488,7 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   RenderResult result;
   try {
     result = backend->render(scene, settings, control);
-    remarks.say();
+    remarks.say(&bar);
   } catch (const RenderFailed& e) {
     bar.finish();
     const RenderResult& partial = e.partial;
