@@ -37,13 +37,16 @@ MajorantGrid build_majorant_grid(const DenseGrid& density, glm::ivec3 res);
 // enters; isotropic in world space), each continuing after a real collision
 // with probability `albedo` (up to kCostBounces times) in a new isotropic
 // direction. Empty cells cost kEmptyCellCost (the GPU walks runs of them in
-// one step), other cells kCellCost. A ray stops counting at kCostCapPerRay:
+// one step), other cells kCellCost: on lavapipe a cell crossing costs about
+// what a lookup does (0.5 chose 2³-texel cells for the dense Blender fire,
+// 8 % slower at equal error than the 4³ that 1.0 chooses; docs/benchmarks.md
+// "Choosing the majorant grid's cells"). A ray stops counting at kCostCapPerRay:
 // in a nearly opaque medium every candidate pays thousands of lookups per ray
 // to cross the one texel where the density ramps up, and simulating them all
 // would cost seconds to learn nothing (the cells then decide, and the
 // coarsest wins). Deterministic: a fixed random sequence.
 inline constexpr int kCostRays = 2048, kCostBounces = 8;
-inline constexpr double kCellCost = 0.5, kEmptyCellCost = 0.05, kCostCapPerRay = 128.0;
+inline constexpr double kCellCost = 1.0, kEmptyCellCost = 0.05, kCostCapPerRay = 128.0;
 double tracking_cost(const DenseGrid& density, const MajorantGrid& m, double sigma_t_per_density, double albedo);
 
 // The cheapest of the resolutions ceil(dims/16)·2^j, j = 0..3 (16, 8, 4 and 2
