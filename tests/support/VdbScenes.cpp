@@ -71,7 +71,7 @@ std::filesystem::path write_two_voxels_vdb(const std::filesystem::path& file, co
   return write_grids(file, {g});
 }
 
-void write_nanovdb_copy(const std::filesystem::path& vdb, const std::filesystem::path& nvdb) {
+void write_nanovdb_copy(const std::filesystem::path& vdb, const std::filesystem::path& nvdb, bool fp16) {
   ensure_openvdb();
   openvdb::io::File f(vdb.string());
   f.open(false);
@@ -79,7 +79,8 @@ void write_nanovdb_copy(const std::filesystem::path& vdb, const std::filesystem:
   for (auto it = f.beginName(); it != f.endName(); ++it) {
     const auto g = openvdb::gridPtrCast<openvdb::FloatGrid>(f.readGrid(*it));
     if (!g) throw std::runtime_error("write_nanovdb_copy: grid '" + *it + "' of " + vdb.string() + " is not float");
-    handles.push_back(nanovdb::openToNanoVDB(*g));
+    handles.push_back(fp16 ? nanovdb::openToNanoVDB<nanovdb::HostBuffer, openvdb::FloatTree, nanovdb::Fp16>(*g)
+                           : nanovdb::openToNanoVDB(*g));
   }
   f.close();
   nanovdb::io::writeGrids<nanovdb::HostBuffer, std::vector>(nvdb.string(), handles);

@@ -108,8 +108,9 @@ std::filesystem::path write_vdb(const std::filesystem::path& file, const std::ve
 std::filesystem::path write_two_voxels_vdb(const std::filesystem::path& file, const glm::ivec3& far);
 
 // Converts every grid of a .vdb file to one .nvdb file (NanoVDB, uncompressed).
-// Float grids only (the test scenes write nothing else); others throw.
-void write_nanovdb_copy(const std::filesystem::path& vdb, const std::filesystem::path& nvdb);
+// Float grids only (the test scenes write nothing else); others throw. With
+// fp16, as NanoVDB's 16-bit quantised grids (Float16) instead of float.
+void write_nanovdb_copy(const std::filesystem::path& vdb, const std::filesystem::path& nvdb, bool fp16 = false);
 
 // A second grid for emission, on its own lattice (voxel size and offset may
 // differ from the density's).

@@ -208,6 +208,45 @@ TEST_F(SparseGridTest, AutoKeepsSmallGridsDense) {
   EXPECT_FALSE(load_stored_volume(s.media[0]).density.grid.is_sparse());
 }
 
+// A quantised NanoVDB grid (Float16) kept sparse goes through OpenVDB
+// (VdbLoader converts it by its value type): it must hold the values the
+// dense load decodes from the same file, texel for texel, and those must be
+// the float source's to within 16-bit quantisation.
+TEST_F(SparseGridTest, QuantisedNanoVdbKeptSparseHoldsWhatTheDenseLoadDecodes) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.0f, 2.0f);
+  std::vector<float> values(size_t(23 * 17 * 29));
+  for (float& v : values) v = u(rng);
+  const test::VoxelBox box{{-5, 3, -13}, {17, 19, 15}};
+  auto at = [&, box](int i, int j, int k) {
+    return values[(size_t(k - box.lo.z) * 17 + size_t(j - box.lo.y)) * 23 + size_t(i - box.lo.x)];
+  };
+  const fs::path vdb = test::write_vdb(dir / "q.vdb", {test::make_float_grid("density", {0.07, {0.3, -0.2, 0.1}}, box, at)});
+  const fs::path nvdb = dir / "q.nvdb";
+  test::write_nanovdb_copy(vdb, nvdb, /*fp16=*/true);
+  Medium m = test::vdb_medium("q", nvdb, {1.0, 1.0, 1.0}, {0.5, 0.5, 0.5}, 0.0, std::nullopt, 1.0, false);
+  m.texture_format = TextureFormat::Sparse;
+  const DenseGrid sparse = load_stored_volume(m).density.grid;
+  m.texture_format = TextureFormat::R32F;
+  const DenseGrid dense = load_stored_volume(m).density.grid;
+  m.file = vdb;
+  const DenseGrid source = load_stored_volume(m).density.grid;
+  ASSERT_TRUE(sparse.is_sparse());
+  ASSERT_FALSE(dense.is_sparse());
+  ASSERT_EQ(sparse.dims, dense.dims);
+  ASSERT_EQ(sparse.origin, dense.origin);
+  ASSERT_EQ(dense.dims, source.dims);
+  int differ = 0;
+  for (int k = 0; k < dense.dims.z; ++k)
+    for (int j = 0; j < dense.dims.y; ++j)
+      for (int i = 0; i < dense.dims.x; ++i) {
+        ASSERT_EQ(sparse.texel(i, j, k), dense.texel(i, j, k)) << i << ' ' << j << ' ' << k;
+        ASSERT_NEAR(dense.texel(i, j, k), source.texel(i, j, k), 2.0 / 65535.0 + 1e-6) << i << ' ' << j << ' ' << k;
+        differ += dense.texel(i, j, k) != source.texel(i, j, k);
+      }
+  EXPECT_GT(differ, 100) << "the file must really be quantised";
+}
+
 // A live edit re-packs the media headers without the leaf tables (they visit
 // every leaf): the sparse buffer's layout, and so every offset the GpuGrids
 // hold, must be the one the session built its buffer with.
