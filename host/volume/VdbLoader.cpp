@@ -489,6 +489,20 @@ VolumeGrids load_openvdb(const VolumeOptions& m, bool need_temperature, const De
 
 // ---- NanoVDB ----
 
+// f(grid) for h's grid as the NanoGrid of its value type, for the scalar
+// float types pyrolume reads (float, double and NanoVDB's quantised floats);
+// nothing for the others.
+template <class F>
+std::optional<DenseGrid> with_scalar_grid(nanovdb::GridHandle<nanovdb::HostBuffer>& h, F&& f) {
+  if (auto* g = h.grid<float>()) return f(*g);
+  if (auto* g = h.grid<double>()) return f(*g);
+  if (auto* g = h.grid<nanovdb::Fp16>()) return f(*g);
+  if (auto* g = h.grid<nanovdb::Fp8>()) return f(*g);
+  if (auto* g = h.grid<nanovdb::Fp4>()) return f(*g);
+  if (auto* g = h.grid<nanovdb::FpN>()) return f(*g);
+  return std::nullopt;
+}
+
 template <class BuildT>
 DenseGrid dense_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const VolumeOptions& m, Role role,
                              const std::string& file, std::vector<std::string>& warnings, const DenseLimits& limits) {
@@ -607,26 +621,19 @@ VolumeGrids load_nanovdb(const VolumeOptions& m, bool need_temperature, const De
       sparse = keep_sparse(m, dims, nanovdb_float_bytes(tree_data->nodeCount(0), tree_data->nodeCount(1),
                                                         tree_data->nodeCount(2)), limits);
     }
-    if (sparse) {
+    if (sparse)
       if (std::optional<DenseGrid> kept = sparse_in_place(h, m, role, file, out.warnings)) return std::move(*kept);
-      // Other value types, and active tiles: through an OpenVDB tree.
-      // Converted per value type, not through the handle: its overload
-      // instantiates every OpenVDB tree type NanoVDB knows (minutes of build).
+    // Dense, or kept sparse through an OpenVDB tree (other value types than
+    // float, and active root tiles). Both take the grid by its value type:
+    // nanoToOpenVDB's handle overload would instantiate every OpenVDB tree
+    // type NanoVDB knows (minutes of build).
+    auto read = [&](const auto& g) {
+      if (!sparse) return dense_from_nanovdb(g, m, role, file, out.warnings, limits);
       ensure_openvdb_initialized();
-      if (auto* g = h.grid<float>()) return sparse_from_openvdb(*nanovdb::nanoToOpenVDB(*g), m, role, file, out.warnings);
-      if (auto* g = h.grid<double>()) return sparse_from_openvdb(*nanovdb::nanoToOpenVDB(*g), m, role, file, out.warnings);
-      if (auto* g = h.grid<nanovdb::Fp16>()) return sparse_from_openvdb(*nanovdb::nanoToOpenVDB(*g), m, role, file, out.warnings);
-      if (auto* g = h.grid<nanovdb::Fp8>()) return sparse_from_openvdb(*nanovdb::nanoToOpenVDB(*g), m, role, file, out.warnings);
-      if (auto* g = h.grid<nanovdb::Fp4>()) return sparse_from_openvdb(*nanovdb::nanoToOpenVDB(*g), m, role, file, out.warnings);
-      if (auto* g = h.grid<nanovdb::FpN>()) return sparse_from_openvdb(*nanovdb::nanoToOpenVDB(*g), m, role, file, out.warnings);
-      throw input_error(file, role_key(role, e.name), "NanoVDB grid type " + e.type + " cannot be kept sparse");
-    }
-    if (auto* g = h.grid<float>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
-    if (auto* g = h.grid<double>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
-    if (auto* g = h.grid<nanovdb::Fp16>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
-    if (auto* g = h.grid<nanovdb::Fp8>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
-    if (auto* g = h.grid<nanovdb::Fp4>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
-    if (auto* g = h.grid<nanovdb::FpN>()) return dense_from_nanovdb(*g, m, role, file, out.warnings, limits);
+      return sparse_from_openvdb(*nanovdb::nanoToOpenVDB(g), m, role, file, out.warnings);
+    };
+    if (std::optional<DenseGrid> g = with_scalar_grid(h, read)) return std::move(*g);
+    if (sparse) throw input_error(file, role_key(role, e.name), "NanoVDB grid type " + e.type + " cannot be kept sparse");
     throw input_error(file, role_key(role, e.name), "NanoVDB grid type " + e.type + " is not supported");
   };
   out.density = load(c.density, Role::Density);
