@@ -92,21 +92,20 @@ bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, 
   if (!surface) {
     stats.events += 1.0;
     set_features(p, collision_albedo(c.sigma_a, sigma_s), vec3(0.0), x);
-    if (event == EVENT_ABSORB) {
-      // Absorbed: the absorption estimator collects sigma_a·Le / (sigma_bar·P_a).
-      if (HAS_EMISSION && !COLLISION_ESTIMATOR)
-        p.L += p.w * emission_at(x, p.t, span, rho, temperature_value) / (sigma_bar * p_a);
-      return ray_ends(p);
-    }
+    // The absorption estimator collects sigma_a·Le / (sigma_bar·P_a) where the
+    // path is absorbed. A medium's real collision scatters whenever it can
+    // (implicit capture, path_track): there it collects what an absorption
+    // would have, as its expected value sigma_a·Le / (sigma_bar·(P_a + P_s)),
+    // p_s being P_a + P_s. Every real collision of the path adds its share,
+    // each weighted by the scattering that led to it, instead of one
+    // all-or-nothing sample where the path happens to be absorbed. One copy
+    // of the emission lookup serves both events (docs/rendering.md "llvmpipe
+    // workarounds": every branch runs).
+    if (HAS_EMISSION && !COLLISION_ESTIMATOR)
+      p.L += p.w * emission_at(x, p.t, span, rho, temperature_value) /
+             (sigma_bar * (event == EVENT_ABSORB ? p_a : p_s));
+    if (event == EVENT_ABSORB) return ray_ends(p);
   }
-  // A medium's real collision scatters whenever it can (implicit capture,
-  // path_track): the absorption estimator collects here what an absorption
-  // would have, as its expected value sigma_a·Le / (sigma_bar·(P_a + P_s)),
-  // p_s being P_a + P_s. Every real collision of the path adds its share,
-  // each weighted by the scattering that led to it, instead of one
-  // all-or-nothing sample where the path happens to be absorbed.
-  if (!surface && HAS_EMISSION && !COLLISION_ESTIMATOR)
-    p.L += p.w * emission_at(x, p.t, span, rho, temperature_value) / (sigma_bar * p_s);
   return scatter_vertex(p, surface, x, sigma_s, sigma_bar, p_s, rho, rng, stats);
 }
 

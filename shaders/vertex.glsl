@@ -179,7 +179,15 @@ bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float
     lights_after = NEE && max3(p.w * albedo) > 0.0 ? frame.surface_light_samples : 0u;
     n_light = max(lights_after, 1u);
   } else {
-    phase_mixture(p.d, d, share, q, f, pdf_own);
+    if (!NEE && MEDIUM_COUNT == 1u) {
+      // One lobe, sampled exactly (q[0] = 1): its HG value cancels in the
+      // weight f/pdf, and no MIS weight needs the pdf (docs/rendering.md
+      // "llvmpipe workarounds": every branch runs, so skip the evaluation).
+      f = share[0];
+      pdf_own = 1.0;
+    } else {
+      phase_mixture(p.d, d, share, q, f, pdf_own);
+    }
     if (none) f = vec3(0.0);
     if (NEE) {  // its one light ray, drawn by next_light_ray with this phase mixture
       p.vertex_medium = true;
