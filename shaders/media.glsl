@@ -140,12 +140,12 @@ float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, float t_span_end, bool
   vec3 t_axis = t + mix(tx, vec3(INF), isnan(tx));  // where the ray crosses each axis' next face
   const uint local = uint((cell.z * res.y + cell.y) * res.x + cell.x);
   uint index = offset + local;
-  float majorant = majorants[index];
+  float majorant = majorant_value(index);
   if (majorant > 0.0) {
     t_next = min(t_next, max(min3(t_axis), t + min_step));
     const float sigma_bar = majorant * grids[slot].majorant_scale;
     const uint rates = grids[slot].line_rate_offset;
-    return line && rates != 0u ? max(sigma_bar, majorants[rates + local]) : sigma_bar;
+    return line && rates != 0u ? max(sigma_bar, majorant_value(rates + local)) : sigma_bar;
   }
   // An empty cell: walk the DDA on to the first non-empty cell (or out of the
   // grid) right here, so a run of empty cells costs one tracking step.
@@ -161,7 +161,7 @@ float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, float t_span_end, bool
     }
     t_axis[a] += t_delta[a];
     index = offset + uint((cell.z * res.y + cell.y) * res.x + cell.x);
-    if (majorants[index] > 0.0) break;
+    if (majorant_value(index) > 0.0) break;
     t_enter = min3(t_axis);
   }
   t_next = min(t_next, max(t_enter, t + min_step));

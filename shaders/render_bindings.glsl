@@ -45,7 +45,11 @@ layout(std430, set = 0, binding = BINDING_ALPHA) buffer AlphaBlock { AlphaTexel 
 layout(std430, set = 0, binding = BINDING_AOV_LIGHTS) buffer AovLightBlock { AovLightTexel aov_lights[]; };
 layout(std430, set = 0, binding = BINDING_AOV_FEATURES) buffer AovFeatureBlock { AovFeatureTexel aov_features[]; };
 layout(std140, set = 0, binding = BINDING_GRIDS) uniform GridBlock { GpuGrid grids[MAX_GRIDS]; };
-layout(std430, set = 0, binding = BINDING_MAJORANTS) readonly buffer MajorantBlock { float majorants[]; };
+// A uniform texel buffer, not a storage buffer: on lavapipe a texel fetch
+// costs about a third of a storage-buffer gather, and the free-flight loop
+// reads a cell every step (docs/rendering.md "llvmpipe workarounds").
+layout(set = 0, binding = BINDING_MAJORANTS) uniform samplerBuffer majorant_tex;
+float majorant_value(uint index) { return texelFetch(majorant_tex, int(index)).r; }
 layout(set = 0, binding = BINDING_DENSITY) uniform sampler3D density_tex[MAX_GRIDS];
 layout(set = 0, binding = BINDING_TEMPERATURE) uniform sampler3D temperature_tex[MAX_GRIDS];
 layout(set = 0, binding = BINDING_BLACKBODY) uniform sampler1D blackbody_tex[MAX_GRIDS];

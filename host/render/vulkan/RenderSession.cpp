@@ -77,7 +77,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                              vk::MemoryKind::HostVisible, "frame constants");
   media_buffer_ = vk::Buffer(ctx, gpu::MAX_MEDIA * sizeof(gpu::GpuMedium), kUniform, vk::MemoryKind::HostVisible, "media");
   grid_buffer_ = vk::Buffer(ctx, gpu::MAX_GRIDS * sizeof(gpu::GpuGrid), kUniform, vk::MemoryKind::HostVisible, "grids");
-  majorant_buffer_ = storage_buffer(ctx, gpu_scene_.majorants, "majorant cells");
+  create_majorant_buffer(scene);
   const VkDeviceSize pixels = VkDeviceSize(settings.width) * VkDeviceSize(settings.height);
   const VkDeviceSize align = std::max<VkDeviceSize>(ctx.properties().limits.minStorageBufferOffsetAlignment, 1);
   auto aligned = [&](VkDeviceSize bytes) { return (bytes + align - 1) / align * align; };
@@ -114,7 +114,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                         {gpu::BINDING_AOV_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_AOV_FEATURES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_GRIDS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
-                        {gpu::BINDING_MAJORANTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_MAJORANTS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER},
                         {gpu::BINDING_DENSITY, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS},
                         {gpu::BINDING_TEMPERATURE, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS},
                         {gpu::BINDING_BLACKBODY, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS},
@@ -233,7 +233,7 @@ std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const S
 
 // The bindings that change with the media's grids.
 void RenderSession::write_grid_descriptors() {
-  set_->write_buffer(gpu::BINDING_MAJORANTS, majorant_buffer_);
+  set_->write_texel_buffer(gpu::BINDING_MAJORANTS, majorant_view_.get());
   set_->write_buffer(gpu::BINDING_EMISSION_CDF, emission_cdf_);
   set_->write_buffer(gpu::BINDING_EMISSION_CELLS, emission_cells_);
   set_->write_buffer(gpu::BINDING_EMISSION_PMF, emission_pmf_);
@@ -299,7 +299,7 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
   for (const auto& v : volumes_)
     if (v)
       for (const auto& w : v->warnings) warnings_.push_back(w);
-  majorant_buffer_ = storage_buffer(ctx_, gpu_scene_.majorants, "majorant cells");
+  create_majorant_buffer(scene);
   upload_emission_lights(lights);
   create_textures(scene);
   write_grid_descriptors();
@@ -383,6 +383,25 @@ void RenderSession::create_textures(const Scene& scene) {
                                    s.temperature ? "grid \"" + s.temperature->grid.name + "\"" : ""));
     textures_1d_.push_back(make_lut(s.blackbody ? &*s.blackbody : nullptr));
   }
+}
+
+// The majorant cells (a one-cell placeholder when there are none: every
+// binding needs a buffer).
+void RenderSession::create_majorant_buffer(const Scene& scene) {
+  majorant_view_ = {};  // before its buffer goes
+  const std::vector<float> none(1, 0.0f);
+  const std::vector<float>& cells = gpu_scene_.majorants.empty() ? none : gpu_scene_.majorants;
+  if (cells.size() > ctx_.properties().limits.maxTexelBufferElements)
+    throw input_error(scene.file.string(), "media",
+                      "the majorant grids need " + std::to_string(cells.size()) +
+                          " cells, more than this device's texel buffer holds (" +
+                          std::to_string(ctx_.properties().limits.maxTexelBufferElements) +
+                          "); set integrator.majorant to \"global\"");
+  majorant_buffer_ = vk::Buffer(ctx_, cells.size() * sizeof(float),
+                                VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                vk::MemoryKind::DeviceLocal, "majorant cells");
+  majorant_buffer_.upload(ctx_, cells.data(), cells.size() * sizeof(float));
+  majorant_view_ = vk::texel_buffer_view(ctx_, majorant_buffer_, VK_FORMAT_R32_SFLOAT);
 }
 
 // The sparse grids' trees, each at its offset (a 16-byte placeholder when

@@ -104,6 +104,7 @@ class RenderSession {
   void upload_constants(const Scene& scene);
   void create_textures(const Scene& scene);
   void create_sparse_buffer(const Scene& scene);
+  void create_majorant_buffer(const Scene& scene);
   void create_surfaces(const Scene& scene);
   void create_environment(const Scene& scene);
   // The emission CDFs of the emissive grids and the light selection for
@@ -126,7 +127,11 @@ class RenderSession {
   std::vector<std::optional<StoredVolume>> volumes_;
   std::vector<std::string> warnings_;
   GpuScene gpu_scene_;
-  vk::Buffer frame_buffer_, media_buffer_, grid_buffer_, majorant_buffer_, accum_;
+  vk::Buffer frame_buffer_, media_buffer_, grid_buffer_, accum_;
+  // Every grid's majorant cells and line rates (GpuScene::majorants), read as
+  // a uniform texel buffer of r32f (shaders/render_bindings.glsl).
+  vk::Buffer majorant_buffer_;
+  vk::UniqueBufferView majorant_view_;
   std::vector<vk::Image3D> textures_3d_;
   std::vector<vk::Image1D> textures_1d_;
   // Surfaces: BVH nodes, triangles, triangle attributes, shapes, materials.
