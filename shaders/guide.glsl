@@ -45,7 +45,8 @@ void guide_media(vec3 o, vec3 d, float t_end, vec2 span[MEDIA_N], inout vec3 L, 
     const vec3 x = o + tm * d;
     vec3 sigma_a, sigma_s;
     float rho[MEDIA_N], temperature_value[MEDIA_N];
-    coefficients_at(x, tm, span, sigma_a, sigma_s, rho, temperature_value, stats);
+    uint no_rng = 0u;  // the guide's march reads the trilinear density
+    coefficients_at(x, tm, span, false, sigma_a, sigma_s, rho, temperature_value, stats, no_rng);
     const vec3 E = emission_at(x, tm, span, rho, temperature_value);
     const vec3 sigma_t = sigma_a + sigma_s;
     const vec3 tr = exp(-sigma_t * dt);

@@ -21,6 +21,27 @@ vec2 density_at(uint slot, vec3 u) {
   }
   return TEMPERATURE_IN_DENSITY ? v : vec2(v.x, 0.0);
 }
+// The density at one texel of u's trilinear footprint, texel c + o chosen with
+// probability w_o = Π_a (o_a ? f_a : 1 − f_a), the trilinear weight (c =
+// floor(u − 0.5), f = u − 0.5 − c): its expectation is the trilinear value.
+// Delta tracking needs no more (docs/rendering.md "Stochastic density
+// lookups"): a null collision's probability is linear in the density, and
+// every texel of the footprint lies under the cell's majorant. One texel fetch
+// costs lavapipe far less than a filtered lookup.
+float stochastic_density(uint slot, vec3 u, inout uint rng) {
+  if (GRID_COUNT <= 1u) slot = 0u;
+  const vec3 f0 = u - 0.5, c = floor(f0), f = f0 - c;
+  const vec3 xi = vec3(rng_next(rng), rng_next(rng), rng_next(rng));
+  const ivec3 dims = ivec3(grids[slot].density_dims);
+  const ivec3 texel = clamp(ivec3(c) + ivec3(lessThan(xi, f)), ivec3(0), dims - 1);
+  const int index = (texel.z * dims.y + texel.y) * dims.x + texel.x;
+  switch (slot) {
+    case 0u: return texelFetch(density_texels[0], index).r;
+    case 1u: return texelFetch(density_texels[1], index).r;
+    case 2u: return texelFetch(density_texels[2], index).r;
+    default: return texelFetch(density_texels[3], index).r;
+  }
+}
 float temperature_at(uint slot, vec3 u) {
   if (GRID_COUNT <= 1u) slot = 0u;
   if (SPARSE_GRIDS && grids[slot].temperature_tree != 0u)
@@ -171,9 +192,13 @@ float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, float t_span_end, bool
 // Media coefficients at a tentative collision; rho[i] keeps each grid's
 // density_scale · density for the scattering-lobe choice, and
 // temperature_value[i] its temperature grid's value where the density lookup
-// reads it (TEMPERATURE_IN_DENSITY; else 0).
-void coefficients_at(vec3 x, float t, vec2 span[MEDIA_N], out vec3 sigma_a, out vec3 sigma_s, out float rho[MEDIA_N],
-                     out float temperature_value[MEDIA_N], inout PathStats stats) {
+// reads it (TEMPERATURE_IN_DENSITY; else 0). With `stochastic` and
+// STOCHASTIC_DENSITY the grids' densities are stochastic_density's unbiased
+// one-texel estimates, and temperature_value is 0 (event_temperatures reads it
+// where the path has its event).
+void coefficients_at(vec3 x, float t, vec2 span[MEDIA_N], bool stochastic, out vec3 sigma_a, out vec3 sigma_s,
+                     out float rho[MEDIA_N], out float temperature_value[MEDIA_N], inout PathStats stats,
+                     inout uint rng) {
   sigma_a = vec3(0.0);
   sigma_s = vec3(0.0);
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
@@ -184,7 +209,8 @@ void coefficients_at(vec3 x, float t, vec2 span[MEDIA_N], out vec3 sigma_a, out 
     float r = 1.0;
     if (is_grid(m)) {
       uint slot = m.grid_slot;
-      const vec2 v = density_at(slot, density_texel(slot, x));
+      const vec2 v = STOCHASTIC_DENSITY && stochastic ? vec2(stochastic_density(slot, density_texel(slot, x), rng), 0.0)
+                                                      : density_at(slot, density_texel(slot, x));
       r = grids[slot].density_scale * v.x;
       temperature_value[i] = v.y;
       stats.lookups += 1.0;
@@ -192,6 +218,19 @@ void coefficients_at(vec3 x, float t, vec2 span[MEDIA_N], out vec3 sigma_a, out 
     rho[i] = r;
     sigma_a += r * m.sigma_a;
     sigma_s += r * m.sigma_s;
+  }
+}
+
+// The temperature values at x that a stochastic coefficients_at left out
+// (TEMPERATURE_IN_DENSITY reads them with the density; otherwise grid_le reads
+// its own texture): the emission needs the trilinear value, since Le is not
+// linear in T.
+void event_temperatures(vec3 x, float t, vec2 span[MEDIA_N], inout float temperature_value[MEDIA_N]) {
+  if (!STOCHASTIC_DENSITY || !TEMPERATURE_IN_DENSITY) return;
+  for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
+    if (!(span[i].x <= t && t < span[i].y) || !is_grid(media[i])) continue;
+    const uint slot = media[i].grid_slot;
+    temperature_value[i] = density_at(slot, density_texel(slot, x)).y;
   }
 }
 

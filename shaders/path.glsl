@@ -101,9 +101,14 @@ bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, 
     // all-or-nothing sample where the path happens to be absorbed. One copy
     // of the emission lookup serves both events (docs/rendering.md "llvmpipe
     // workarounds": every branch runs).
-    if (HAS_EMISSION && !COLLISION_ESTIMATOR)
+    if (HAS_EMISSION && !COLLISION_ESTIMATOR) {
+      // rho is the free flight's (stochastic) estimate, as in P_a and P_s:
+      // sigma_a(rho)/(sigma_bar·P) keeps its expectation; the temperature is
+      // the trilinear value (media.glsl event_temperatures).
+      event_temperatures(x, p.t, span, temperature_value);
       p.L += p.w * emission_at(x, p.t, span, rho, temperature_value) /
              (sigma_bar * (event == EVENT_ABSORB ? p_a : p_s));
+    }
     if (event == EVENT_ABSORB) return ray_ends(p);
   }
   return scatter_vertex(p, surface, x, sigma_s, sigma_bar, p_s, rho, rng, stats);

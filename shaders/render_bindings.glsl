@@ -45,14 +45,18 @@ layout(std430, set = 0, binding = BINDING_ALPHA) buffer AlphaBlock { AlphaTexel 
 layout(std430, set = 0, binding = BINDING_AOV_LIGHTS) buffer AovLightBlock { AovLightTexel aov_lights[]; };
 layout(std430, set = 0, binding = BINDING_AOV_FEATURES) buffer AovFeatureBlock { AovFeatureTexel aov_features[]; };
 layout(std140, set = 0, binding = BINDING_GRIDS) uniform GridBlock { GpuGrid grids[MAX_GRIDS]; };
-// A uniform texel buffer, not a storage buffer: on lavapipe a texel fetch
-// costs about a third of a storage-buffer gather, and the free-flight loop
-// reads a cell every step (docs/rendering.md "llvmpipe workarounds").
+// A uniform texel buffer, not a storage buffer: on lavapipe a texel fetch is
+// the cheaper gather, and the free-flight loop reads a cell every step
+// (docs/rendering.md "llvmpipe workarounds": texel buffers for gathers).
 layout(set = 0, binding = BINDING_MAJORANTS) uniform samplerBuffer majorant_tex;
 float majorant_value(uint index) { return texelFetch(majorant_tex, int(index)).r; }
 layout(set = 0, binding = BINDING_DENSITY) uniform sampler3D density_tex[MAX_GRIDS];
 layout(set = 0, binding = BINDING_TEMPERATURE) uniform sampler3D temperature_tex[MAX_GRIDS];
 layout(set = 0, binding = BINDING_BLACKBODY) uniform sampler1D blackbody_tex[MAX_GRIDS];
+// Free flights read the density at one texel of its trilinear footprint, from
+// these texel buffers (media.glsl stochastic_density); false: by the sampler.
+layout(constant_id = SPEC_STOCHASTIC_DENSITY) const bool STOCHASTIC_DENSITY = false;
+layout(set = 0, binding = BINDING_DENSITY_TEXELS) uniform samplerBuffer density_texels[MAX_GRIDS];
 // Some grid is a NanoVDB tree in sparse_tex (shaders/sparse.glsl); false: none of that code.
 layout(constant_id = SPEC_SPARSE_GRIDS) const bool SPARSE_GRIDS = false;
 layout(set = 0, binding = BINDING_SPARSE) uniform usamplerBuffer sparse_tex;

@@ -25,7 +25,7 @@ vec3 transmittance(vec3 o, vec3 d, bool ratio, inout uint rng, inout PathStats s
     t += dt;
     vec3 sigma_a, sigma_s;
     float rho[MEDIA_N], temperature_value[MEDIA_N];
-    coefficients_at(o + t * d, t, span, sigma_a, sigma_s, rho, temperature_value, stats);
+    coefficients_at(o + t * d, t, span, true, sigma_a, sigma_s, rho, temperature_value, stats, rng);
     vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
     if (ratio) {
       T *= sigma_n / sigma_bar;
@@ -105,7 +105,9 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
       }
       p.t += dt;
       x = p.o + p.t * p.d;
-      coefficients_at(x, p.t, span, sigma_a, sigma_s, rho, temperature_value, stats);
+      // The collision estimator collects emission at every tentative collision: it
+      // reads the trilinear density and temperature there.
+      coefficients_at(x, p.t, span, !COLLISION_ESTIMATOR, sigma_a, sigma_s, rho, temperature_value, stats, rng);
       if (HAS_EMISSION && COLLISION_ESTIMATOR && !p.skip_segment) {
         // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision;
         // the line estimator is this one with sigma_bar raised to the line rates (grid_majorant).

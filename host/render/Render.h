@@ -49,6 +49,10 @@ struct RenderSettings {
   // free-flight loop until the group's last event, as before the early exit
   // (Vulkan; the image is the same bit for bit either way).
   bool early_event_exit = true;
+  // Test and bench hook (no scene key): false reads the density by the
+  // sampler's trilinear filter in free flights too, instead of one texel of its
+  // footprint (Vulkan; docs/rendering.md "Stochastic density lookups").
+  bool stochastic_density = true;
   // Test hook (no scene key): false keeps the temperature in a texture of its
   // own even where it could be the density texture's second channel (Vulkan;
   // GpuScene::temperature_in_density).

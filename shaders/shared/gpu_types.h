@@ -30,7 +30,7 @@ PYRO_CONST uint BINDING_FRAME = 0;     // uniform FrameConstants
 PYRO_CONST uint BINDING_MEDIA = 1;     // uniform GpuMedium[MAX_MEDIA]
 PYRO_CONST uint BINDING_ACCUM = 2;     // buffer AccumTexel[] (one per pixel)
 PYRO_CONST uint BINDING_GRIDS = 3;     // uniform GpuGrid[MAX_GRIDS]
-PYRO_CONST uint BINDING_MAJORANTS = 4; // samplerBuffer (r32f): every grid's majorant cells (a texel fetch is the cheapest gather on lavapipe)
+PYRO_CONST uint BINDING_MAJORANTS = 4; // samplerBuffer (r32f): every grid's majorant cells
 PYRO_CONST uint BINDING_DENSITY = 5;   // sampler3D[MAX_GRIDS]
 PYRO_CONST uint BINDING_TEMPERATURE = 6;  // sampler3D[MAX_GRIDS]
 PYRO_CONST uint BINDING_BLACKBODY = 7; // sampler1D[MAX_GRIDS]: blackbody LUT per grid medium
@@ -57,6 +57,7 @@ PYRO_CONST uint BINDING_ALPHA = 26;    // buffer AlphaTexel[] (one per pixel)
 PYRO_CONST uint BINDING_AOV_LIGHTS = 27;    // buffer AovLightTexel[] (one per pixel; film.aovs)
 PYRO_CONST uint BINDING_AOV_FEATURES = 28;  // buffer AovFeatureTexel[] (one per pixel; film.aovs)
 PYRO_CONST uint BINDING_SPARSE = 29;  // usamplerBuffer (rgba32ui): every sparse grid's NanoVDB tree and leaf table (shaders/sparse.glsl)
+PYRO_CONST uint BINDING_DENSITY_TEXELS = 30;  // samplerBuffer[MAX_GRIDS] (r16f or r32f): each dense grid's density texels, for stochastic lookups
 PYRO_CONST uint SPARSE_ZERO_LEAF = 32;  // byte offset of 512 zero floats in that buffer: the values of every absent leaf
 
 // Specialisation constants of render.comp: a scene pays only for what it uses.
@@ -92,6 +93,7 @@ PYRO_CONST uint SPEC_TEMPERATURE_IN_DENSITY = 18;
 PYRO_CONST uint SPEC_AOVS = 20;  // film.aovs: the light layers and first-hit features (docs/compositing.md "AOVs")
 PYRO_CONST uint SPEC_LIGHT_COUNT = 19;  // analytic lights (the scene's `lights`); 0 compiles their code out
 PYRO_CONST uint SPEC_SPARSE_GRIDS = 21;  // some grid is a NanoVDB tree (texture_format "sparse"); false compiles that code out
+PYRO_CONST uint SPEC_STOCHASTIC_DENSITY = 22;  // free flights read one texel of the density's trilinear footprint (docs/rendering.md "Stochastic density lookups")
 PYRO_CONST uint WAVEFRONT_GROUP = 64;      // lanes per workgroup of the queue stages
 // 16-byte words of one path's state: a fixed part and a part per medium.
 PYRO_CONST uint WAVEFRONT_PATH_WORDS = 22;

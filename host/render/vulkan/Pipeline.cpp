@@ -131,8 +131,8 @@ void DescriptorSet::write_buffer(uint32_t binding, const Buffer& buffer, VkDevic
   write(binding, 0, &info, nullptr, nullptr);
 }
 
-void DescriptorSet::write_texel_buffer(uint32_t binding, VkBufferView view) {
-  write(binding, 0, nullptr, nullptr, &view);
+void DescriptorSet::write_texel_buffer(uint32_t binding, VkBufferView view, uint32_t array_element) {
+  write(binding, array_element, nullptr, nullptr, &view);
 }
 
 void DescriptorSet::write_image(uint32_t binding, VkImageView view, VkSampler sampler, VkImageLayout layout,

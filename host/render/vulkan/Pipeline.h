@@ -63,7 +63,7 @@ class DescriptorSet {
   void write_buffer(uint32_t binding, const Buffer& buffer, VkDeviceSize offset = 0,
                     VkDeviceSize range = VK_WHOLE_SIZE);
   // A storage texel buffer's view.
-  void write_texel_buffer(uint32_t binding, VkBufferView view);
+  void write_texel_buffer(uint32_t binding, VkBufferView view, uint32_t array_element = 0);
   void write_image(uint32_t binding, VkImageView view, VkSampler sampler,
                    VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, uint32_t array_element = 0);
   void write_image(uint32_t binding, const SampledImage& image, uint32_t array_element = 0) {

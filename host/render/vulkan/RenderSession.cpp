@@ -118,6 +118,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                         {gpu::BINDING_DENSITY, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS},
                         {gpu::BINDING_TEMPERATURE, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS},
                         {gpu::BINDING_BLACKBODY, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_GRIDS},
+                        {gpu::BINDING_DENSITY_TEXELS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, gpu::MAX_GRIDS},
                         {gpu::BINDING_BVH_NODES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_BVH_TRIANGLES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_BVH_ATTRIBUTES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
@@ -206,6 +207,7 @@ std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const S
           {gpu::SPEC_HAS_EMISSION, flag(g.has_emission)},
           {gpu::SPEC_TEMPERATURE_IN_DENSITY, flag(g.temperature_in_density)},
           {gpu::SPEC_SPARSE_GRIDS, flag(g.has_sparse())},
+          {gpu::SPEC_STOCHASTIC_DENSITY, flag(stochastic_density(g, settings))},
           {gpu::SPEC_COLLISION_ESTIMATOR, flag(lights.estimator != EmissionEstimator::Absorption)},
           {gpu::SPEC_DEBUG_MODE, settings.debug_mode},
           {gpu::SPEC_MEDIUM_COUNT, uint32_t(g.media.size())},
@@ -247,6 +249,7 @@ void RenderSession::write_grid_descriptors() {
     set_->write_image(gpu::BINDING_DENSITY, textures_3d_[d], slot);
     set_->write_image(gpu::BINDING_TEMPERATURE, textures_3d_[t], slot);
     set_->write_image(gpu::BINDING_BLACKBODY, textures_1d_[b], slot);
+    set_->write_texel_buffer(gpu::BINDING_DENSITY_TEXELS, density_texel_views_[used ? 1 + slot : 0].get(), slot);
   }
   if (sparse_view_) {
     set_->write_texel_buffer(gpu::BINDING_SPARSE, sparse_view_.get());
@@ -257,6 +260,7 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
   if (settings.width != settings_.width || settings.height != settings_.height ||
       settings.debug_mode != settings_.debug_mode ||
       settings.early_event_exit != settings_.early_event_exit ||
+      settings.stochastic_density != settings_.stochastic_density ||
       settings.temperature_in_density != settings_.temperature_in_density || scene.media.size() != volumes_.size())
     return false;
   // Load into locals first: a bad frame (or a different variant) leaves the
@@ -290,6 +294,8 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
   // ones (every pass was waited for, so none is in flight).
   auto old_3d = std::move(textures_3d_);
   auto old_1d = std::move(textures_1d_);
+  auto old_texel_views = std::move(density_texel_views_);
+  auto old_texels = std::move(density_texels_);
   textures_3d_.clear();
   textures_1d_.clear();
   volumes_ = std::move(volumes);
@@ -371,6 +377,7 @@ void RenderSession::create_textures(const Scene& scene) {
     return img;
   };
   create_sparse_buffer(scene);
+  create_density_texels();
   // Slot layout: 3D [0] placeholder, then density 1 + 2·slot, temperature 2 + 2·slot;
   // 1D [0] placeholder, then the LUT of slot at 1 + slot.
   textures_3d_.push_back(make_3d(nullptr, ""));
@@ -382,6 +389,44 @@ void RenderSession::create_textures(const Scene& scene) {
     textures_3d_.push_back(make_3d(together ? nullptr : s.temperature,
                                    s.temperature ? "grid \"" + s.temperature->grid.name + "\"" : ""));
     textures_1d_.push_back(make_lut(s.blackbody ? &*s.blackbody : nullptr));
+  }
+}
+
+bool RenderSession::stochastic_density(const GpuScene& g, const RenderSettings& settings) const {
+  if (!settings.stochastic_density || g.grid_sources.empty()) return false;
+  for (const GpuGridSource& s : g.grid_sources) {
+    if (s.density->grid.is_sparse() || s.density->grid.empty()) return false;
+    const uint64_t texels = s.density->grid.texel_count();
+    const bool half = s.density->format == TextureFormat::R16F;
+    if ((half ? s.density->half_bits.size() : s.density->grid.values.size()) != texels) return false;
+    const uint64_t bytes = texels * (half ? 2u : 4u);
+    if (texels > ctx_.properties().limits.maxTexelBufferElements || bytes > uint64_t(ctx_.max_allocation_size()))
+      return false;
+  }
+  return true;
+}
+
+// One texel buffer per grid slot at 1 + slot, [0] a placeholder: the density's
+// stored texels (r16f or r32f, as its texture) where stochastic_density.
+void RenderSession::create_density_texels() {
+  density_texel_views_.clear();
+  density_texels_.clear();
+  auto add = [&](const void* data, size_t count, bool half, const char* name) {
+    const size_t bytes = count * (half ? 2u : 4u);
+    density_texels_.emplace_back(ctx_, bytes, VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                 vk::MemoryKind::DeviceLocal, name);
+    density_texels_.back().upload(ctx_, data, bytes);
+    density_texel_views_.push_back(
+        vk::texel_buffer_view(ctx_, density_texels_.back(), half ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT));
+  };
+  const float zero = 0.0f;
+  add(&zero, 1, false, "unused density texels");
+  const bool stochastic = stochastic_density(gpu_scene_, settings_);
+  for (const GpuGridSource& s : gpu_scene_.grid_sources) {
+    const StoredGrid& g = *s.density;
+    if (!stochastic) add(&zero, 1, false, "unused density texels");
+    else if (g.format == TextureFormat::R16F) add(g.half_bits.data(), g.half_bits.size(), true, "density texels");
+    else add(g.grid.values.data(), g.grid.values.size(), false, "density texels");
   }
 }
 

@@ -105,6 +105,10 @@ class RenderSession {
   void create_textures(const Scene& scene);
   void create_sparse_buffer(const Scene& scene);
   void create_majorant_buffer(const Scene& scene);
+  // Whether free flights read the density stochastically: every grid is a
+  // dense texture whose texels also fit a texel buffer.
+  bool stochastic_density(const GpuScene& g, const RenderSettings& settings) const;
+  void create_density_texels();
   void create_surfaces(const Scene& scene);
   void create_environment(const Scene& scene);
   // The emission CDFs of the emissive grids and the light selection for
@@ -134,6 +138,10 @@ class RenderSession {
   vk::UniqueBufferView majorant_view_;
   std::vector<vk::Image3D> textures_3d_;
   std::vector<vk::Image1D> textures_1d_;
+  // Each grid slot's density texels for stochastic lookups (a one-texel
+  // placeholder where unused; shaders/media.glsl stochastic_density).
+  std::vector<vk::Buffer> density_texels_;
+  std::vector<vk::UniqueBufferView> density_texel_views_;
   // Surfaces: BVH nodes, triangles, triangle attributes, shapes, materials.
   geometry::GpuSurfaces gpu_surfaces_;
   vk::Buffer bvh_nodes_, bvh_triangles_, bvh_attributes_, surface_shapes_, materials_;
