@@ -12,13 +12,25 @@ frame_camera), black background, 8 bounces.
           box filter, linear interpolation, automatic step size.
   pyrolume: the shortest scene file for it, its defaults otherwise:
           density_scale 5, sigma_a = sigma_s = 0.5, temperature scale 1500.
-Each renderer is measured against its own 1024-spp reference (their emission
-models differ, docs/benchmarks.md "Against Cycles"; Cycles' has 1024 spp,
-pyrolume's 4096, see OUR_REF_SPP): Cycles at 64 spp, and
-pyrolume at rising spp until its relMSE is below Cycles'. The time pyrolume
-needs for Cycles' 64-spp relMSE is interpolated in log-log between its two
-bracketing points; both times are the renderers' own render times (Cycles'
-RENDER_TIME_S, pyrolume's --stats seconds), medians of --reps seeds.
+Each renderer is measured against its own reference (their emission models
+differ, docs/benchmarks.md "Against Cycles"): Cycles at 64 spp, and pyrolume
+at rising spp until its relMSE is below Cycles'. The time pyrolume needs for
+Cycles' 64-spp relMSE is interpolated in log-log between its two bracketing
+points; both times are the renderers' own render times (Cycles'
+RENDER_TIME_S, pyrolume's --stats seconds), medians of --reps seeds. Three
+ways to score, all printed:
+  as the issue asks: both references 1024 spp. A reference's own noise is in
+          the relMSE measured against it, about spp/1024 of the test image's
+          own: 6 % for Cycles at 64 spp, but a quarter for pyrolume at the
+          ~200 spp where it matches, which this score counts against it;
+  reference noise removed: each relMSE divided by 1 + spp/ref_spp (error
+          falling as 1/spp), Cycles' against its 1024-spp reference, pyrolume's
+          against a 4096-spp one. For Cycles, whose stratified samples make the
+          error fall faster, this removes at most what its reference adds,
+          so it never favours pyrolume;
+  pyrolume's reference 4096 spp, Cycles' 1024, as measured (the score this
+          bench printed before): pyrolume's reference adds 5 % at 200 spp,
+          Cycles' 6 %.
 """
 
 import json
@@ -91,6 +103,8 @@ def run(args):
     t_cycles_ref = cycles_render(args, vdb, camera, REF_SPP, 99, cycles_ref)
     ours_ref = os.path.join(work, "pyrolume_ref.exr")
     render(args, scene_path, ours_ref, ours_ref + ".json", "vulkan", OUR_REF_SPP, 99, size=(W, H))
+    ours_ref_issue = os.path.join(work, f"pyrolume_ref_{REF_SPP}.exr")
+    render(args, scene_path, ours_ref_issue, ours_ref_issue + ".json", "vulkan", REF_SPP, 98, size=(W, H))
 
     cycles = []
     for seed in seeds:
@@ -102,25 +116,33 @@ def run(args):
     t_c = statistics.median(t for t, _ in cycles)
     e_c = statistics.median(e for _, e in cycles)
 
-    ours = []  # (spp, median seconds, median relMSE, median seconds with loading)
+    ours = []  # (spp, median seconds, median relMSE, median seconds with loading, median relMSE vs REF_SPP)
     spp = 4
     while True:
         pts = []
         for seed in seeds:
             exr = os.path.join(work, f"pyrolume_{spp}_{seed}.exr")
             st = render(args, scene_path, exr, exr + ".json", "vulkan", spp, seed, size=(W, H))
-            pts.append((st["seconds"], compare(args, exr, ours_ref)["rel_mse"], st["seconds"] + st["load_seconds"]))
-        ours.append((spp, statistics.median(p[0] for p in pts), statistics.median(p[1] for p in pts),
-                     statistics.median(p[2] for p in pts)))
-        log(f"bench --cycles: pyrolume {spp} spp: {ours[-1][1]:.2f} s, relMSE {ours[-1][2]:.4g}")
-        if ours[-1][2] <= e_c or spp >= 4096:
+            pts.append((st["seconds"], compare(args, exr, ours_ref)["rel_mse"], st["seconds"] + st["load_seconds"],
+                        compare(args, exr, ours_ref_issue)["rel_mse"]))
+        ours.append((spp,) + tuple(statistics.median(p[i] for p in pts) for i in range(4)))
+        log(f"bench --cycles: pyrolume {spp} spp: {ours[-1][1]:.2f} s, relMSE {ours[-1][2]:.4g} "
+            f"({ours[-1][4]:.4g} against its {REF_SPP}-spp reference)")
+        if (ours[-1][2] <= e_c and ours[-1][4] <= e_c) or spp >= 4096:
             break
         spp *= 2
-    if len(ours) >= 2 and ours[-1][2] <= e_c:
-        (s0, t0, e0, _), (s1, t1, e1, _) = ours[-2], ours[-1]
-        t_match = log_interp(t0, e0, t1, e1, e_c) if e0 > e_c else t0
-    else:
-        t_match = ours[-1][1] if ours[-1][2] <= e_c else float("nan")
+
+    def time_to(points, target):
+        """pyrolume's time to `target` on (spp, seconds, relMSE) points, log-log between the bracketing two."""
+        for (s0, t0, e0), (s1, t1, e1) in zip(points, points[1:]):
+            if e1 <= target:
+                return log_interp(t0, e0, t1, e1, target) if e0 > target else t0
+        return points[0][1] if points and points[0][2] <= target else float("nan")
+
+    t_match = time_to([(o[0], o[1], o[2]) for o in ours], e_c)
+    t_issue = time_to([(o[0], o[1], o[4]) for o in ours], e_c)
+    e_c_clean = e_c / (1 + CYCLES_SPP / REF_SPP)
+    t_clean = time_to([(o[0], o[1], o[2] / (1 + o[0] / OUR_REF_SPP)) for o in ours], e_c_clean)
     # pyrolume at the spp closest to Cycles' time, for the side-by-side image.
     near = min(ours, key=lambda o: abs(math.log(o[1] / t_c)))
     png = os.path.join(work, f"pyrolume_{near[0]}.png")
@@ -128,15 +150,19 @@ def run(args):
 
     result = {"cycles_spp": CYCLES_SPP, "cycles_seconds": t_c, "cycles_rel_mse": e_c,
               "cycles_reference_seconds": t_cycles_ref, "pyrolume": ours, "pyrolume_seconds_to_match": t_match,
-              "ratio": t_match / t_c, "cycles_png": os.path.join(work, f"cycles_{CYCLES_SPP}.png"),
+              "ratio": t_match / t_c, "ratio_both_1024": t_issue / t_c, "ratio_reference_noise_removed": t_clean / t_c,
+              "cycles_png": os.path.join(work, f"cycles_{CYCLES_SPP}.png"),
               "pyrolume_png": png, "pyrolume_png_spp": near[0], "threads": args.cycles_threads}
     with open(os.path.join(work, "result.json"), "w") as f:
         json.dump(result, f, indent=1)
     print(f"Cycles {CYCLES_SPP} spp: {t_c:.2f} s, relMSE {e_c:.4g} (against its own {REF_SPP}-spp reference; "
           f"pyrolume's has {OUR_REF_SPP} spp)")
-    for s, t, e, tl in ours:
-        print(f"pyrolume {s} spp: {t:.2f} s ({tl:.2f} s with loading), relMSE {e:.4g}")
-    print(f"pyrolume reaches Cycles' {CYCLES_SPP}-spp relMSE in {t_match:.2f} s: "
-          f"{t_match / t_c:.2f}× Cycles' time (target ≤ 1)")
+    for s, t, e, tl, e_issue in ours:
+        print(f"pyrolume {s} spp: {t:.2f} s ({tl:.2f} s with loading), relMSE {e:.4g} "
+              f"({e_issue:.4g} against a {REF_SPP}-spp reference)")
+    print(f"pyrolume reaches Cycles' {CYCLES_SPP}-spp relMSE (target ≤ 1× Cycles' time):")
+    print(f"  both references {REF_SPP} spp, as the issue asks: {t_issue:.2f} s, {t_issue / t_c:.2f}×")
+    print(f"  each reference's noise removed: {t_clean:.2f} s, {t_clean / t_c:.2f}×")
+    print(f"  pyrolume's reference {OUR_REF_SPP} spp, Cycles' {REF_SPP}: {t_match:.2f} s, {t_match / t_c:.2f}×")
     print(f"images: {result['cycles_png']} and {png} ({near[0]} spp); numbers: {os.path.join(work, 'result.json')}")
     return 0
