@@ -400,7 +400,12 @@ bool RenderSession::stochastic_density(const GpuScene& g, const RenderSettings& 
     const bool half = s.density->format == TextureFormat::R16F;
     if ((half ? s.density->half_bits.size() : s.density->grid.values.size()) != texels) return false;
     const uint64_t bytes = texels * (half ? 2u : 4u);
-    if (texels > ctx_.properties().limits.maxTexelBufferElements || bytes > uint64_t(ctx_.max_allocation_size()))
+    // The copy is on top of the texture, which the dense-or-sparse choice
+    // sized against the memory left: only small grids get it, where it costs
+    // little (a 256 MiB copy is an R16F grid of 512³ texels).
+    constexpr uint64_t kMaxCopyBytes = uint64_t(256) << 20;
+    if (texels > ctx_.properties().limits.maxTexelBufferElements ||
+        bytes > std::min<uint64_t>(kMaxCopyBytes, uint64_t(ctx_.max_allocation_size())))
       return false;
   }
   return true;
