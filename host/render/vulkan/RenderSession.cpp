@@ -32,6 +32,17 @@ vk::Buffer storage_buffer(vk::Context& ctx, const std::vector<T>& values, const 
   return b;
 }
 
+// A device-local uniform texel buffer holding `count` texels of `format` from
+// `data`, and its view (majorant cells, density texels).
+void uniform_texel_buffer(vk::Context& ctx, const void* data, size_t count, VkFormat format, size_t texel_bytes,
+                          const char* name, vk::Buffer& buffer, vk::UniqueBufferView& view) {
+  view = {};  // before its buffer goes
+  buffer = vk::Buffer(ctx, count * texel_bytes, VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                      vk::MemoryKind::DeviceLocal, name);
+  buffer.upload(ctx, data, count * texel_bytes);
+  view = vk::texel_buffer_view(ctx, buffer, format);
+}
+
 // What every grid medium must satisfy once loaded (render/SceneChecks.h).
 void check_loaded_media(const Scene& scene, const std::vector<std::optional<StoredVolume>>& volumes) {
   for (size_t i = 0; i < volumes.size(); ++i)
@@ -249,7 +260,8 @@ void RenderSession::write_grid_descriptors() {
     set_->write_image(gpu::BINDING_DENSITY, textures_3d_[d], slot);
     set_->write_image(gpu::BINDING_TEMPERATURE, textures_3d_[t], slot);
     set_->write_image(gpu::BINDING_BLACKBODY, textures_1d_[b], slot);
-    set_->write_texel_buffer(gpu::BINDING_DENSITY_TEXELS, density_texel_views_[used ? 1 + slot : 0].get(), slot);
+    const size_t texels = 1 + slot < density_texel_views_.size() ? 1 + slot : 0;
+    set_->write_texel_buffer(gpu::BINDING_DENSITY_TEXELS, density_texel_views_[texels].get(), slot);
   }
   if (sparse_view_) {
     set_->write_texel_buffer(gpu::BINDING_SPARSE, sparse_view_.get());
@@ -411,26 +423,24 @@ bool RenderSession::stochastic_density(const GpuScene& g, const RenderSettings& 
   return true;
 }
 
-// One texel buffer per grid slot at 1 + slot, [0] a placeholder: the density's
-// stored texels (r16f or r32f, as its texture) where stochastic_density.
+// [0] a one-texel placeholder for the slots that read none; where
+// stochastic_density, the density's stored texels (r16f or r32f, as its
+// texture) of grid slot s at 1 + s.
 void RenderSession::create_density_texels() {
   density_texel_views_.clear();
   density_texels_.clear();
   auto add = [&](const void* data, size_t count, bool half, const char* name) {
-    const size_t bytes = count * (half ? 2u : 4u);
-    density_texels_.emplace_back(ctx_, bytes, VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                 vk::MemoryKind::DeviceLocal, name);
-    density_texels_.back().upload(ctx_, data, bytes);
-    density_texel_views_.push_back(
-        vk::texel_buffer_view(ctx_, density_texels_.back(), half ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT));
+    density_texels_.emplace_back();
+    density_texel_views_.emplace_back();
+    uniform_texel_buffer(ctx_, data, count, half ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT, half ? 2u : 4u, name,
+                         density_texels_.back(), density_texel_views_.back());
   };
   const float zero = 0.0f;
   add(&zero, 1, false, "unused density texels");
-  const bool stochastic = stochastic_density(gpu_scene_, settings_);
+  if (!stochastic_density(gpu_scene_, settings_)) return;
   for (const GpuGridSource& s : gpu_scene_.grid_sources) {
     const StoredGrid& g = *s.density;
-    if (!stochastic) add(&zero, 1, false, "unused density texels");
-    else if (g.format == TextureFormat::R16F) add(g.half_bits.data(), g.half_bits.size(), true, "density texels");
+    if (g.format == TextureFormat::R16F) add(g.half_bits.data(), g.half_bits.size(), true, "density texels");
     else add(g.grid.values.data(), g.grid.values.size(), false, "density texels");
   }
 }
@@ -438,7 +448,6 @@ void RenderSession::create_density_texels() {
 // The majorant cells (a one-cell placeholder when there are none: every
 // binding needs a buffer).
 void RenderSession::create_majorant_buffer(const Scene& scene) {
-  majorant_view_ = {};  // before its buffer goes
   const std::vector<float> none(1, 0.0f);
   const std::vector<float>& cells = gpu_scene_.majorants.empty() ? none : gpu_scene_.majorants;
   if (cells.size() > ctx_.properties().limits.maxTexelBufferElements)
@@ -447,11 +456,8 @@ void RenderSession::create_majorant_buffer(const Scene& scene) {
                           " cells, more than this device's texel buffer holds (" +
                           std::to_string(ctx_.properties().limits.maxTexelBufferElements) +
                           "); set integrator.majorant to \"global\"");
-  majorant_buffer_ = vk::Buffer(ctx_, cells.size() * sizeof(float),
-                                VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                vk::MemoryKind::DeviceLocal, "majorant cells");
-  majorant_buffer_.upload(ctx_, cells.data(), cells.size() * sizeof(float));
-  majorant_view_ = vk::texel_buffer_view(ctx_, majorant_buffer_, VK_FORMAT_R32_SFLOAT);
+  uniform_texel_buffer(ctx_, cells.data(), cells.size(), VK_FORMAT_R32_SFLOAT, sizeof(float), "majorant cells",
+                       majorant_buffer_, majorant_view_);
 }
 
 // The sparse grids' trees, each at its offset (a 16-byte placeholder when
