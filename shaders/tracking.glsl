@@ -54,12 +54,18 @@ struct Collision {
   vec3 sigma_a;  // read only for film.aovs' albedo (the wavefront does not carry it)
 };
 
+// Scenes whose only medium is one grid: path_track's free flights walk its
+// majorant cells in one pass (grid_free_flight).
+const bool ONE_GRID = HAS_GRIDS && !HAS_ANALYTIC_MEDIA && MEDIUM_COUNT == 1u;
+
 // Free flights along the current ray until its event (path_step's loop).
 //
 // Delta tracking against a piecewise-constant majorant: the ray is split at
 // media boundaries and majorant-cell faces, and free flights restart at each
-// (memoryless). RGB sigma is handled by spectral tracking (Kutz et al. 2017,
-// "Spectral and Decomposition Tracking", history-aware averaged probabilities):
+// (memoryless); with ONE_GRID a flight spends one sampled optical depth
+// across the cells instead (grid_free_flight), the same distribution. RGB
+// sigma is handled by spectral tracking (Kutz et al. 2017, "Spectral and
+// Decomposition Tracking", history-aware averaged probabilities):
 // distances are sampled with the grey majorant sigma_bar, and event x (absorb /
 // scatter / null) is chosen with P_x = avg(sigma_x ⊙ w) / (sigma_bar·avg(w)); the
 // path weight w then picks up sigma_x / (sigma_bar·P_x) per channel. For grey
@@ -83,27 +89,46 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
   vec3 x = vec3(0.0), sigma_a = vec3(0.0), sigma_s = vec3(0.0);
   for (;;) {
     if (event == EVENT_NONE) do {
-      float t_next;
-      bool any_ahead;
-      sigma_bar = majorant_at(p.o, p.d, p.t, span, COLLISION_ESTIMATOR, t_next, any_ahead);
-      if (!any_ahead) t_next = INF;
-      // Media beyond the closest surface do not matter: free flights end there.
       const float t_surface = p.has_hit ? p.hit.t : INF;
-      if (isinf(t_next) && !p.has_hit) {
-        event = EVENT_ESCAPE;
-        break;
-      }
-      const float t_end = min(t_next, t_surface);
-      float dt = sigma_bar > 0.0 ? sample_free_flight(sigma_bar, rng_next(rng)) : INF;
-      if (p.t + dt >= t_end) {
-        if (p.has_hit && t_surface <= t_next) {
-          event = EVENT_SURFACE;
+      if (ONE_GRID) {
+        // The flight walks the majorant cells itself (grid_free_flight).
+        // Media beyond the closest surface do not matter: free flights end there.
+        const vec2 s = span[0];
+        if (p.t < s.x && !(p.has_hit && t_surface <= s.x)) p.t = s.x;
+        if (p.t >= s.y || p.t < s.x) {  // past the grid, or a surface before it
+          event = p.has_hit ? EVENT_SURFACE : EVENT_ESCAPE;
           break;
         }
-        p.t = t_next;
-        continue;
+        const float t_end = min(s.y, t_surface);
+        sigma_bar = grid_free_flight(media[0], p.o, p.d, p.t, t_end, COLLISION_ESTIMATOR, -log(1.0 - rng_next(rng)));
+        if (sigma_bar <= 0.0) {
+          // Out of the grid (the surface, or nothing, beyond), or out of walk
+          // steps: a fresh flight from p.t.
+          if (p.t >= t_end) event = p.has_hit ? EVENT_SURFACE : EVENT_ESCAPE;
+          continue;
+        }
+      } else {
+        // Restarted at every majorant-cell face and media boundary.
+        float t_next;
+        bool any_ahead;
+        sigma_bar = majorant_at(p.o, p.d, p.t, span, COLLISION_ESTIMATOR, t_next, any_ahead);
+        if (!any_ahead) t_next = INF;
+        if (isinf(t_next) && !p.has_hit) {
+          event = EVENT_ESCAPE;
+          break;
+        }
+        const float t_end = min(t_next, t_surface);
+        float dt = sigma_bar > 0.0 ? sample_free_flight(sigma_bar, rng_next(rng)) : INF;
+        if (p.t + dt >= t_end) {
+          if (p.has_hit && t_surface <= t_next) {
+            event = EVENT_SURFACE;
+            break;
+          }
+          p.t = t_next;
+          continue;
+        }
+        p.t += dt;
       }
-      p.t += dt;
       x = p.o + p.t * p.d;
       // The collision estimator collects emission at every tentative collision: it
       // reads the trilinear density and temperature there.

@@ -155,7 +155,7 @@ TYPED_TEST(HardGeometry, CameraInsideAndOnTheBoundary) {
   };
   for (const Place& p : {Place{"camera inside", {0.1, 0.05, -0.3}}, Place{"camera on support face", {0.1, 0.05, sup.min.z}},
                          Place{"camera on constant-region face", {0.1, 0.05, cen.min.z}}}) {
-    Scene s = this->constant_box_scene(16, 16, 512, {0.8, 1.6, 3.2}, {0, 0, 0});
+    Scene s = this->constant_box_scene(16, 16, 1024, {0.8, 1.6, 3.2}, {0, 0, 0});
     s.camera.position = p.position;
     s.camera.look_at = p.position + glm::dvec3(0.2, 0.15, 1.0);
     s.camera.fov_deg = 70.0;

@@ -91,6 +91,33 @@ TEST_F(VulkanVdb, ZeroMajorantRegionsAreSkipped) {
   EXPECT_LT(grid.density_lookups, global.density_lookups);
 }
 
+// Free flights walk the majorant cells with one sampled optical depth
+// (grid_free_flight); a walk stops after 256 cells and the flight goes on
+// with a fresh one. 1000 cells along the view direction, in a thin medium,
+// make most flights stop and go on several times, across the zero gap too:
+// the closed form still holds.
+TEST_F(VulkanVdb, FreeFlightsWalkOnPastTheWalksStepBudget) {
+  const test::VoxelBox wide{{-5, -5, -16}, {5, 5, 16}};
+  auto value = [](int, int, int k) { return (k <= -7 || k >= 7) ? 0.75f : 0.0f; };
+  test::write_vdb(dir / "gap_z.vdb", {test::make_float_grid("density", lat, wide, value)});
+  Scene s = test::vdb_base_scene(16, 12, 1024);
+  s.camera.position = {0.05, 0.1, -4.0};
+  s.camera.look_at = {0.0, 0.0, 0.0};
+  s.camera.fov_deg = 20.0;
+  s.background = {0.05, 0.1, 0.2};
+  s.media.push_back(test::vdb_medium("gap", dir / "gap_z.vdb", {0.8, 1.6, 3.2}, {0, 0, 0}, 0.0,
+                                     glm::dvec3(1.0, 0.6, 0.3), 1.5));
+  s.media[0].density_scale = 0.2;
+  s.integrator.majorant_grid = glm::ivec3(1, 1, 1000);
+  const test::TrilinearVoxelField f(lat, wide, value);
+  auto exact = test::exact_image(s, [&](const glm::dvec3& o, const glm::dvec3& d, int* sig) {
+    if (sig) *sig = f.signature(o, d);
+    return test::uniform_albedo_radiance(s, f.optical_depth(o, d));
+  });
+  const RenderResult r = expect_closed_form(s, exact, "1000 cells along the view");
+  std::printf("1000 cells along the view: lookups/sample %.3f, %.2f s\n", per_sample(r.density_lookups, r), r.seconds);
+}
+
 // No closed form with multiple scattering: the two estimators must converge to
 // the same image (GPU vs GPU, independent seeds). A sparse explosion shell with
 // chromatic σa/σs, anisotropic scattering and blackbody emission from its
