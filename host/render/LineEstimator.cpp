@@ -9,14 +9,19 @@
 
 namespace pyrolume {
 
-glm::ivec3 majorant_resolution(const Integrator& in, const Medium& m, const DenseGrid& density) {
+glm::ivec3 majorant_resolution(const Scene& scene, const Medium& m, const DenseGrid& density) {
+  const Integrator& in = scene.integrator;
   if (in.majorant == Majorant::Global) return glm::ivec3(1);
   if (in.majorant_grid) return *in.majorant_grid;
   const glm::dvec3 sigma_t = m.sigma_a + m.sigma_s;
   const double albedo = sigma_t.x + sigma_t.y + sigma_t.z > 0.0
                             ? (m.sigma_s.x + m.sigma_s.y + m.sigma_s.z) / (sigma_t.x + sigma_t.y + sigma_t.z)
                             : 0.0;
-  return choose_majorant_resolution(density, std::max({sigma_t.x, sigma_t.y, sigma_t.z}) * m.density_scale, albedo);
+  // A grid that is the scene's only medium: its free flights walk the cells
+  // (shaders/tracking.glsl ONE_GRID), which makes crossing them cheaper.
+  const CellCosts costs = scene.media.size() == 1 ? kWalkedFlightCosts : kRestartedFlightCosts;
+  return choose_majorant_resolution(density, std::max({sigma_t.x, sigma_t.y, sigma_t.z}) * m.density_scale, albedo,
+                                    costs);
 }
 
 namespace {
@@ -112,7 +117,7 @@ LineMedia line_media(const Scene& scene, const std::vector<const StoredVolume*>&
       const DenseGrid& density = vol->density.grid;
       const DenseGrid* temperature =
           vol->temperature && !vol->temperature->grid.empty() ? &vol->temperature->grid : nullptr;
-      out.majorant_res[i] = majorant_resolution(scene.integrator, m, density);
+      out.majorant_res[i] = majorant_resolution(scene, m, density);
       LineRates rates = line_rates(m, density, temperature, build_majorant_grid(density, out.majorant_res[i]));
       power[i] = rates.power;
       out.line[i] = asked || rates.thin();

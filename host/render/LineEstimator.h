@@ -54,8 +54,9 @@ LineRates line_rates(const Medium& m, const DenseGrid& density, const DenseGrid*
 // The majorant grid's resolution for medium m's density texture: one cell
 // with integrator.majorant "global", else integrator.majorant_grid, else the
 // cheapest for tracking (choose_majorant_resolution, with m's σt per unit
-// density and its albedo).
-glm::ivec3 majorant_resolution(const Integrator& in, const Medium& m, const DenseGrid& density);
+// density and its albedo, and the cell costs of the way the scene's free
+// flights cross cells).
+glm::ivec3 majorant_resolution(const Scene& scene, const Medium& m, const DenseGrid& density);
 
 // A homogeneous medium (constant emission) is one cell: each ray gets
 // kLinePointsPerCell points along its chord through it (shaders/media.glsl

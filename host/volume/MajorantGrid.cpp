@@ -110,7 +110,8 @@ void box_span(glm::dvec3 p, glm::dvec3 v, glm::dvec3 dims, double& t0, double& t
 
 }  // namespace
 
-double tracking_cost(const DenseGrid& g, const MajorantGrid& m, double sigma_t_per_density, double albedo) {
+double tracking_cost(const DenseGrid& g, const MajorantGrid& m, double sigma_t_per_density, double albedo,
+                     CellCosts costs) {
   if (g.empty() || !(sigma_t_per_density > 0.0)) return 0.0;
   CostRng rng{0x5eed};
   const glm::dvec3 dims(g.dims);
@@ -141,7 +142,7 @@ double tracking_cost(const DenseGrid& g, const MajorantGrid& m, double sigma_t_p
           if (ta < t_exit) t_exit = ta, axis = a;
         }
         const double sigma_bar = m.at(cell.x, cell.y, cell.z) * sigma_t_per_density;
-        cost += sigma_bar > 0.0 ? kCellCost : kEmptyCellCost;
+        cost += sigma_bar > 0.0 ? costs.cell : costs.empty;
         while (sigma_bar > 0.0) {
           t -= std::log(1.0 - rng.next()) / sigma_bar;
           if (t >= t_exit) break;
@@ -166,7 +167,7 @@ double tracking_cost(const DenseGrid& g, const MajorantGrid& m, double sigma_t_p
   return cost / kCostRays;
 }
 
-glm::ivec3 choose_majorant_resolution(const DenseGrid& g, double sigma_t_per_density, double albedo) {
+glm::ivec3 choose_majorant_resolution(const DenseGrid& g, double sigma_t_per_density, double albedo, CellCosts costs) {
   const glm::ivec3 coarsest = default_majorant_resolution(g.dims);
   if (g.empty() || !(sigma_t_per_density > 0.0)) return coarsest;
   int finest = 0;
@@ -176,7 +177,7 @@ glm::ivec3 choose_majorant_resolution(const DenseGrid& g, double sigma_t_per_den
   glm::ivec3 best = m.res;
   double best_cost = std::numeric_limits<double>::infinity();
   for (int j = finest;; --j) {
-    const double c = tracking_cost(g, m, sigma_t_per_density, albedo);
+    const double c = tracking_cost(g, m, sigma_t_per_density, albedo, costs);
     if (c <= best_cost) best_cost = c, best = m.res;  // ties go to the coarser
     if (j == 0) break;
     // Max-pool 2×2×2: cell c of the coarser grid is cells 2c, 2c + 1 of this one.

@@ -31,23 +31,32 @@ MajorantGrid build_majorant_grid(const DenseGrid& density, glm::ivec3 res);
 
 // The majorant grid is a trade: finer cells bound the density more tightly
 // (fewer tentative collisions, each a density lookup) but a ray crosses more
-// of them (each crossing one more step of the free-flight loop). What a ray
-// costs, in density lookups, for a candidate grid: delta tracking of kCostRays
-// random rays (a uniform random line through the texture, from where it
-// enters; isotropic in world space), each continuing after a real collision
-// with probability `albedo` (up to kCostBounces times) in a new isotropic
-// direction. Empty cells cost kEmptyCellCost (the GPU walks runs of them in
-// one step), other cells kCellCost: on lavapipe a cell crossing costs about
-// what a lookup does (0.5 chose 2³-texel cells for the dense Blender fire,
-// 8 % slower at equal error than the 4³ that 1.0 chooses; docs/benchmarks.md
-// "Choosing the majorant grid's cells"). A ray stops counting at kCostCapPerRay:
-// in a nearly opaque medium every candidate pays thousands of lookups per ray
-// to cross the one texel where the density ramps up, and simulating them all
+// of them. What a ray costs, in density lookups, for a candidate grid: delta
+// tracking of kCostRays random rays (a uniform random line through the
+// texture, from where it enters; isotropic in world space), each continuing
+// after a real collision with probability `albedo` (up to kCostBounces times)
+// in a new isotropic direction. A cell crossing costs what CellCosts says,
+// which depends on how the GPU tracks (docs/benchmarks.md "Choosing the
+// majorant grid's cells"). A ray stops counting at kCostCapPerRay: in a
+// nearly opaque medium every candidate pays thousands of lookups per ray to
+// cross the one texel where the density ramps up, and simulating them all
 // would cost seconds to learn nothing (the cells then decide, and the
 // coarsest wins). Deterministic: a fixed random sequence.
+struct CellCosts {
+  double cell, empty;  // entering a non-empty / an empty cell, in density lookups
+};
+// Scenes with more than one medium: every crossing of a non-empty cell is one
+// more pass of the free-flight loop, which costs about what a lookup does on
+// lavapipe; a run of empty cells is walked in one pass (grid_majorant).
+inline constexpr CellCosts kRestartedFlightCosts{1.0, 0.05};
+// A grid that is the scene's only medium: a free flight walks the cells with
+// one sampled optical depth (grid_free_flight), each cell, empty or not, one
+// DDA step.
+inline constexpr CellCosts kWalkedFlightCosts{0.25, 0.25};
 inline constexpr int kCostRays = 2048, kCostBounces = 8;
-inline constexpr double kCellCost = 1.0, kEmptyCellCost = 0.05, kCostCapPerRay = 128.0;
-double tracking_cost(const DenseGrid& density, const MajorantGrid& m, double sigma_t_per_density, double albedo);
+inline constexpr double kCostCapPerRay = 128.0;
+double tracking_cost(const DenseGrid& density, const MajorantGrid& m, double sigma_t_per_density, double albedo,
+                     CellCosts costs = kRestartedFlightCosts);
 
 // The cheapest of the resolutions ceil(dims/16)·2^j, j = 0..3 (16, 8, 4 and 2
 // texels per cell, while the grid stays within kMaxMajorantCells) by
@@ -55,6 +64,7 @@ double tracking_cost(const DenseGrid& density, const MajorantGrid& m, double sig
 // the next one's cells max-pooled 2×2×2, which is exactly the grid
 // build_majorant_grid makes at that resolution.
 inline constexpr size_t kMaxMajorantCells = size_t(1) << 21;
-glm::ivec3 choose_majorant_resolution(const DenseGrid& density, double sigma_t_per_density, double albedo);
+glm::ivec3 choose_majorant_resolution(const DenseGrid& density, double sigma_t_per_density, double albedo,
+                                      CellCosts costs = kRestartedFlightCosts);
 
 }  // namespace pyrolume

@@ -129,6 +129,32 @@ TEST(MajorantChoice, PicksFinerCellsForAThinDenseShell) {
   EXPECT_EQ(choose_majorant_resolution(shell, 4.0, 0.0), chosen);
 }
 
+// When free flights walk the cells (a grid that is the scene's only medium:
+// kWalkedFlightCosts) a crossing costs less, so on a smooth fire-like blob the
+// model picks finer cells (16 per axis against 8: simulated costs 5.7 against
+// 6.1 lookups per ray walked, 8.9 against 8.7 restarted);
+// majorant_resolution uses the walked costs exactly when the scene has one
+// medium.
+TEST(MajorantChoice, WalkedFlightsPickFinerCells) {
+  const DenseGrid blob = field_grid([](double x, double y, double z) {
+    const double r = glm::length(glm::dvec3(x, y, z) - 32.0);
+    return float(std::max(0.0, 1.0 - r / 28.0));
+  });
+  const glm::ivec3 restarted = choose_majorant_resolution(blob, 1.0, 0.5, kRestartedFlightCosts);
+  const glm::ivec3 walked = choose_majorant_resolution(blob, 1.0, 0.5, kWalkedFlightCosts);
+  EXPECT_GT(walked.x, restarted.x) << "restarted " << restarted.x << ", walked " << walked.x;
+
+  Medium m;
+  m.sigma_a = glm::dvec3(0.5);
+  m.sigma_s = glm::dvec3(0.5);
+  Scene one;
+  one.media.push_back(m);
+  EXPECT_EQ(majorant_resolution(one, m, blob), walked);
+  Scene two = one;
+  two.media.push_back(m);
+  EXPECT_EQ(majorant_resolution(two, m, blob), restarted);
+}
+
 // choose_majorant_resolution max-pools each candidate into the next coarser
 // one; that is exactly build_majorant_grid at the coarser resolution (cell c
 // of res r spans cells 2c and 2c + 1 of res 2r, and its texel footprint is
@@ -154,11 +180,12 @@ TEST(MajorantChoice, TheFilesChoiceWins) {
   const DenseGrid shell = field_grid([](double x, double, double) { return x < 3.0 ? 1.0f : 0.0f; });
   Medium m;
   m.sigma_a = glm::dvec3(4.0);
-  Integrator in;
-  in.majorant_grid = glm::ivec3(3, 5, 7);
-  EXPECT_EQ(majorant_resolution(in, m, shell), glm::ivec3(3, 5, 7));
-  in.majorant = Majorant::Global;
-  EXPECT_EQ(majorant_resolution(in, m, shell), glm::ivec3(1));
+  Scene scene;
+  scene.media.push_back(m);
+  scene.integrator.majorant_grid = glm::ivec3(3, 5, 7);
+  EXPECT_EQ(majorant_resolution(scene, m, shell), glm::ivec3(3, 5, 7));
+  scene.integrator.majorant = Majorant::Global;
+  EXPECT_EQ(majorant_resolution(scene, m, shell), glm::ivec3(1));
 }
 
 }  // namespace

@@ -263,7 +263,7 @@ TEST_F(SparseGridTest, HeadersForALiveEditKeepTheSparseLayoutWithoutItsTables) {
   EXPECT_NE(full.grids[0].temperature_tree, 0u);
   // The majorant cells were chosen once, by the line estimator's pass, and kept.
   ASSERT_EQ(full.line.majorant_res.size(), 1u);
-  EXPECT_EQ(full.line.majorant_res[0], majorant_resolution(scene.integrator, scene.media[0], volumes[0]->density.grid));
+  EXPECT_EQ(full.line.majorant_res[0], majorant_resolution(scene, scene.media[0], volumes[0]->density.grid));
   EXPECT_EQ(glm::ivec3(full.grids[0].majorant_res.x, full.grids[0].majorant_res.y, full.grids[0].majorant_res.z),
             full.line.majorant_res[0]);
 

@@ -272,7 +272,7 @@ void add_majorant_cells(const Scene& scene, GpuScene& g) {
     const DenseGrid& density = src.density->grid;
     const bool chosen = src.medium < g.line.majorant_res.size() && g.line.majorant_res[src.medium].x > 0;
     const glm::ivec3 res = chosen ? g.line.majorant_res[src.medium]
-                                  : majorant_resolution(scene.integrator, scene.media[src.medium], density);
+                                  : majorant_resolution(scene, scene.media[src.medium], density);
     const MajorantGrid mg = build_majorant_grid(density, res);
     gpu::GpuGrid& grid = g.grids[slot];
     grid.majorant_res = gpu::uvec3(uint32_t(mg.res.x), uint32_t(mg.res.y), uint32_t(mg.res.z));
