@@ -9,6 +9,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -59,6 +62,37 @@ class VulkanVdb : public test::VdbFixture {
     s.media[0].sigma_s = glm::dvec3(4.0);
     return s;
   }
+
+  // Two constant blocks (0.75) with a wide all-zero slab between them along
+  // `axis` (32 voxels long, 10 across), absorbing and emitting, seen from
+  // `camera`: the scene and its closed-form image.
+  std::pair<Scene, std::function<glm::dvec3(int, int)>> gap_scene(int axis, int width, int height, int spp,
+                                                                   glm::dvec3 camera, double fov_deg,
+                                                                   double density_scale) {
+    glm::ivec3 lo(-5), hi(5);
+    lo[axis] = -16;
+    hi[axis] = 16;
+    const test::VoxelBox wide{lo, hi};
+    auto value = [axis](int i, int j, int k) {
+      const int c = glm::ivec3(i, j, k)[axis];
+      return (c <= -7 || c >= 7) ? 0.75f : 0.0f;
+    };
+    const std::filesystem::path file = dir / ("gap_" + std::to_string(axis) + ".vdb");
+    test::write_vdb(file, {test::make_float_grid("density", lat, wide, value)});
+    Scene s = test::vdb_base_scene(width, height, spp);
+    s.camera.position = camera;
+    s.camera.look_at = {0.0, 0.0, 0.0};
+    s.camera.fov_deg = fov_deg;
+    s.background = {0.05, 0.1, 0.2};
+    s.media.push_back(test::vdb_medium("gap", file, {0.8, 1.6, 3.2}, {0, 0, 0}, 0.0, glm::dvec3(1.0, 0.6, 0.3), 1.5));
+    s.media[0].density_scale = density_scale;
+    const test::TrilinearVoxelField f(lat, wide, value);
+    auto exact = test::exact_image(s, [&](const glm::dvec3& o, const glm::dvec3& d, int* sig) {  // tabulated here
+      if (sig) *sig = f.signature(o, d);
+      return test::uniform_albedo_radiance(s, f.optical_depth(o, d));
+    });
+    return {s, exact};
+  }
 };
 
 // A grid with a wide all-zero slab between two constant blocks (σ̄ = 0 cells
@@ -66,23 +100,8 @@ class VulkanVdb : public test::VdbFixture {
 // skipped without lookups, so the majorant grid needs fewer lookups than the
 // global majorant for the same image.
 TEST_F(VulkanVdb, ZeroMajorantRegionsAreSkipped) {
-  const test::VoxelBox wide{{-16, -5, -5}, {16, 5, 5}};
-  auto value = [](int i, int, int) { return (i <= -7 || i >= 7) ? 0.75f : 0.0f; };
-  test::write_vdb(dir / "gap.vdb", {test::make_float_grid("density", lat, wide, value)});
-  Scene s = test::vdb_base_scene(32, 24, 512);
-  s.camera.position = {0.5, 1.0, -4.0};
-  s.camera.look_at = {0.0, 0.0, 0.0};
-  s.camera.fov_deg = 45.0;
-  s.background = {0.05, 0.1, 0.2};
-  s.media.push_back(test::vdb_medium("gap", dir / "gap.vdb", {0.8, 1.6, 3.2}, {0, 0, 0}, 0.0,
-                                     glm::dvec3(1.0, 0.6, 0.3), 1.5));
-  s.media[0].density_scale = 1.5;
+  auto [s, exact] = gap_scene(0, 32, 24, 512, {0.5, 1.0, -4.0}, 45.0, 1.5);
   s.integrator.majorant_grid = glm::ivec3(35, 1, 1);  // 1-texel slabs: the middle ones are all zero
-  const test::TrilinearVoxelField f(lat, wide, value);
-  auto exact = test::exact_image(s, [&](const glm::dvec3& o, const glm::dvec3& d, int* sig) {
-    if (sig) *sig = f.signature(o, d);
-    return test::uniform_albedo_radiance(s, f.optical_depth(o, d));
-  });
   RenderResult grid = expect_closed_form(s, exact, "zero gap (grid)");
   s.integrator.majorant = Majorant::Global;
   RenderResult global = expect_closed_form(s, exact, "zero gap (global)");
@@ -97,23 +116,8 @@ TEST_F(VulkanVdb, ZeroMajorantRegionsAreSkipped) {
 // make most flights stop and go on several times, across the zero gap too:
 // the closed form still holds.
 TEST_F(VulkanVdb, FreeFlightsWalkOnPastTheWalksStepBudget) {
-  const test::VoxelBox wide{{-5, -5, -16}, {5, 5, 16}};
-  auto value = [](int, int, int k) { return (k <= -7 || k >= 7) ? 0.75f : 0.0f; };
-  test::write_vdb(dir / "gap_z.vdb", {test::make_float_grid("density", lat, wide, value)});
-  Scene s = test::vdb_base_scene(16, 12, 1024);
-  s.camera.position = {0.05, 0.1, -4.0};
-  s.camera.look_at = {0.0, 0.0, 0.0};
-  s.camera.fov_deg = 20.0;
-  s.background = {0.05, 0.1, 0.2};
-  s.media.push_back(test::vdb_medium("gap", dir / "gap_z.vdb", {0.8, 1.6, 3.2}, {0, 0, 0}, 0.0,
-                                     glm::dvec3(1.0, 0.6, 0.3), 1.5));
-  s.media[0].density_scale = 0.2;
+  auto [s, exact] = gap_scene(2, 16, 12, 1024, {0.05, 0.1, -4.0}, 20.0, 0.2);
   s.integrator.majorant_grid = glm::ivec3(1, 1, 1000);
-  const test::TrilinearVoxelField f(lat, wide, value);
-  auto exact = test::exact_image(s, [&](const glm::dvec3& o, const glm::dvec3& d, int* sig) {
-    if (sig) *sig = f.signature(o, d);
-    return test::uniform_albedo_radiance(s, f.optical_depth(o, d));
-  });
   const RenderResult r = expect_closed_form(s, exact, "1000 cells along the view");
   std::printf("1000 cells along the view: lookups/sample %.3f, %.2f s\n", per_sample(r.density_lookups, r), r.seconds);
 }
