@@ -5,11 +5,11 @@
 
 #include "color/Blackbody.h"
 #include "color/ColorSpace.h"
+#include "util/Math.h"
 
 namespace pyrolume {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 double radians(double deg) { return deg * (kPi / 180.0); }
 }  // namespace
 

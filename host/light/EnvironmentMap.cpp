@@ -10,12 +10,12 @@
 #include "image/ImageIo.h"
 #include "light/PiecewiseConstant.h"
 #include "util/Error.h"
+#include "util/Math.h"
 
 namespace pyrolume {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 int wrap(int i, int n) {
   i %= n;

@@ -6,6 +6,7 @@
 #include "color/ColorSpace.h"
 #include "light/EmissionCdf.h"
 #include "scene/MediumVolume.h"
+#include "util/Math.h"
 
 namespace pyrolume {
 
@@ -25,7 +26,6 @@ glm::ivec3 majorant_resolution(const Scene& scene, const Medium& m, const DenseG
 }
 
 namespace {
-double max3(const glm::dvec3& v) { return std::max({v.x, v.y, v.z}); }
 }  // namespace
 
 LineRates line_rates(const Medium& m, const DenseGrid& density, const DenseGrid* temperature, const MajorantGrid& mg) {

@@ -7,6 +7,7 @@
 #include "color/Blackbody.h"
 #include "color/EmissionModel.h"
 #include "util/Error.h"
+#include "util/Math.h"
 
 namespace pyrolume {
 namespace {
@@ -17,7 +18,6 @@ std::string sci(double v) {
   return buf;
 }
 
-double max3(const glm::dvec3& v) { return std::max({v.x, v.y, v.z}); }
 
 // The brightest channel a temperature-driven emission takes between 100 K
 // (the lowest the renderers evaluate) and hottest_k (the grid's hottest

@@ -10,6 +10,7 @@
 #include "scene/MediumVolume.h"
 #include "util/Error.h"
 #include "volume/MajorantGrid.h"
+#include "util/Math.h"
 
 namespace pyrolume {
 
@@ -18,7 +19,6 @@ static_assert(kMaxSampleRadiance == gpu::MAX_SAMPLE_RADIANCE);
 static_assert(kMaxEmittedRadiance == gpu::MAX_EMITTED_RADIANCE);
 namespace {
 gpu::vec3 v3(glm::dvec3 v) { return gpu::vec3(float(v.x), float(v.y), float(v.z)); }
-double max3(glm::dvec3 v) { return std::max(v.x, std::max(v.y, v.z)); }
 
 // Rows of the affine world -> texel map: u = index − origin + 0.5 (texel i's
 // centre, OpenVDB's integer index point, sits at u = i + 0.5).
