@@ -32,6 +32,9 @@ struct PixelStats {
 // Σx² − n·mean² (identical samples), not noise: treat it as exactly 0.
 inline constexpr double kZeroVarianceRel = 1e-12;
 
+// |v − ref| / |ref|: a computed value against a published or closed-form one.
+inline double relative_error(double v, double ref) { return std::abs(v - ref) / std::abs(ref); }
+
 // Sample variance of one pixel-channel from its sum and sum of squares:
 //   s² = (Σx² − n·mean²)/(n − 1)   (n − 1 degrees of freedom)
 inline double sample_variance(double sum, double sum_sq, int n) {

@@ -13,14 +13,13 @@
 #include "color/CieTables.h"
 #include "color/ColorSpace.h"
 #include "color/Planck.h"
+#include "support/Stats.h"
 #include "support/TestSupport.h"
 
 using namespace pyrolume;
 using namespace pyrolume::color;
 
-namespace {
-double rel(double v, double ref) { return std::abs(v - ref) / std::abs(ref); }
-}  // namespace
+using pyrolume::test::relative_error;
 
 TEST(CieTables, CoverVisibleRangeAt1nm) {
   for (int observer : {2, 10}) {
@@ -46,7 +45,7 @@ TEST(Blackbody, PeakModeReproducesPbrtV4) {
   const Case cases[] = {{2000, {13.055, 3.3514, 0.1058}}, {3000, {78.713, 37.532, 12.098}}, {6500, {98.754, 93.110, 97.997}}};
   for (const Case& c : cases) {
     const glm::dvec3 rgb = blackbody_rgb(c.T, BlackbodyMode::Peak);
-    for (int i = 0; i < 3; ++i) EXPECT_LT(rel(rgb[i], c.rgb[i]), 0.002) << c.T << " K channel " << i << ": " << rgb[i];
+    for (int i = 0; i < 3; ++i) EXPECT_LT(relative_error(rgb[i], c.rgb[i]), 0.002) << c.T << " K channel " << i << ": " << rgb[i];
   }
 }
 
@@ -123,7 +122,7 @@ TEST(Blackbody, PhysicalIsAbsoluteRadiance) {
     const glm::dvec3 p = blackbody_rgb(T, BlackbodyMode::Peak), phys = blackbody_rgb(T, BlackbodyMode::Physical);
     for (int i = 0; i < 3; ++i) {
       if (p[i] > 0) {
-        EXPECT_LT(rel(phys[i], p[i] * B_max_nm), 1e-9) << T << " K channel " << i;
+        EXPECT_LT(relative_error(phys[i], p[i] * B_max_nm), 1e-9) << T << " K channel " << i;
       }
     }
   }
@@ -153,9 +152,9 @@ TEST(Blackbody, AdaptationMakesTheAdaptingWhiteNeutral) {
       // In the unnormalised modes the adapted white is grey with its luminance kept.
       const glm::dvec3 p = blackbody_rgb(T, BlackbodyMode::Peak, observer, T);
       const double Y = blackbody_xyz(T, BlackbodyMode::Peak, observer).y;
-      EXPECT_LT(rel(p.r, p.g), 1e-3);
-      EXPECT_LT(rel(p.b, p.g), 1e-3);
-      EXPECT_LT(rel(srgb_luminance(p), Y), 1e-3);
+      EXPECT_LT(relative_error(p.r, p.g), 1e-3);
+      EXPECT_LT(relative_error(p.b, p.g), 1e-3);
+      EXPECT_LT(relative_error(srgb_luminance(p), Y), 1e-3);
     }
   }
   // Adapting to a hot white makes cooler flames redder than without adaptation.

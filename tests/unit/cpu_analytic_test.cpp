@@ -27,7 +27,7 @@ using test::ZTestReport;
 
 using test::settings_for;
 
-RenderResult render(const Scene& s, int threads = 0) {
+RenderResult render_analytic(const Scene& s, int threads = 0) {
   CpuRenderer r(threads);
   return r.render(s, settings_for(s), {});
 }
@@ -48,7 +48,7 @@ using test::pooled;
 // below the render's standard errors, or the z-tests above would test it instead.
 TEST(CpuAnalytic, AnalyticQuadratureConverged) {
   for (const Scene& s : {test::absorbing_sphere_scene(), test::absorbing_box_scene()}) {
-    test::PixelStats ps = test::pixel_stats(render(s), true);  // the SE the z-test uses
+    test::PixelStats ps = test::pixel_stats(render_analytic(s), true);  // the SE the z-test uses
     auto coarse = test::single_collision_exact(s);
     auto fine = test::single_collision_exact(s, 12, 7, 0.025);
     double worst = 0.0;
@@ -69,16 +69,16 @@ TEST(CpuAnalytic, AnalyticQuadratureConverged) {
 // (the classic convention mistake) is detected at the same spp.
 TEST(CpuAnalytic, ChromaticScatteringSelfConsistentAndSensitiveToG) {
   Scene s = test::chromatic_scattering_scene();
-  RenderResult a = render(s);
+  RenderResult a = render_analytic(s);
   Scene s2 = s;
   s2.film.seed = 12345;
-  RenderResult b = render(s2);
+  RenderResult b = render_analytic(s2);
   EXPECT_EQ(a.nonfinite_samples, 0u);
   ZTestReport same = test::ztest_images(a, b, pooled());
   EXPECT_TRUE(same.ok) << same.summary();
   std::printf("%s\n", same.summary().c_str());
   for (Medium& m : s2.media) m.g = -m.g;
-  ZTestReport flipped = test::ztest_images(render(s2), a, pooled());
+  ZTestReport flipped = test::ztest_images(render_analytic(s2), a, pooled());
   EXPECT_FALSE(flipped.ok) << flipped.summary();
   std::printf("g flipped: %s\n", flipped.summary().c_str());
 }
@@ -94,14 +94,14 @@ TEST(CpuAnalytic, BlackbodyEmissionInEquilibrium) {
   e.blackbody = BlackbodyMode::Seed;
   glm::dvec3 Le = 3.0 * color::blackbody_rgb(1800.0, BlackbodyMode::Seed, 2, std::nullopt);
   ASSERT_GT(Le.r, 0.0);
-  ZTestReport rep = test::ztest_against_exact(render(s), [&](int, int) { return Le; });
+  ZTestReport rep = test::ztest_against_exact(render_analytic(s), [&](int, int) { return Le; });
   EXPECT_TRUE(rep.ok) << rep.summary();
 }
 
 // The tests can fail: a 2 % brighter "exact" emission is rejected.
 TEST(CpuAnalytic, ZTestRejectsWrongExact) {
   Scene s = test::absorbing_sphere_scene();
-  RenderResult r = render(s);
+  RenderResult r = render_analytic(s);
   Scene wrong = s;
   wrong.media[0].emission.scale *= 1.02;
   ZTestReport rep = test::ztest_against_exact(r, test::single_collision_exact(wrong), pooled());
@@ -122,7 +122,7 @@ TEST(CpuAnalytic, CameraOrientation) {
   glm::dvec3 right = glm::normalize(glm::cross(f, s.camera.up));
   s.media.push_back(test::homogeneous_sphere("b", right * 1.0 + glm::dvec3(0, 1.0, 0), 0.4, {50, 50, 50},
                                              {0, 0, 0}, 0.0, glm::dvec3(1.0)));
-  RenderResult r = render(s);
+  RenderResult r = render_analytic(s);
   double cx = 0, cy = 0, w = 0;
   for (int y = 0; y < r.height; ++y)
     for (int x = 0; x < r.width; ++x) {
@@ -138,7 +138,7 @@ TEST(CpuAnalytic, CameraOrientation) {
 
 TEST(CpuRenderer, DeterministicAcrossThreadCounts) {
   Scene s = test::chromatic_scattering_scene(24, 20, 8);
-  RenderResult a = render(s, 1), b = render(s, 2), c = render(s, 3);
+  RenderResult a = render_analytic(s, 1), b = render_analytic(s, 2), c = render_analytic(s, 3);
   ASSERT_EQ(a.sum.size(), b.sum.size());
   EXPECT_TRUE(a.sum == b.sum && a.sum_sq == b.sum_sq);
   EXPECT_TRUE(a.sum == c.sum && a.sum_sq == c.sum_sq);
@@ -162,14 +162,14 @@ TEST(CpuRenderer, GrazingAndBoundaryRaysStayFinite) {
                                           glm::dvec3(0.5)));
   s.media.push_back(test::homogeneous_sphere("far", {3, 0, -1}, 1e-3, {1e6, 1e6, 1e6}, {0, 0, 0}, 0.0,
                                              glm::dvec3(1.0)));
-  RenderResult r = render(s);
+  RenderResult r = render_analytic(s);
   EXPECT_EQ(r.nonfinite_samples, 0u);
   EXPECT_TRUE(all_finite(r));
   // Extreme coefficients: near-zero and huge σ, |g| tiny and near 1.
   s.media[0].sigma_s = {1e-12, 0, 1e8};
   s.media[0].g = 1e-9;
   s.media[1].g = 0.999999;
-  r = render(s);
+  r = render_analytic(s);
   EXPECT_EQ(r.nonfinite_samples, 0u);
   EXPECT_TRUE(all_finite(r));
 }

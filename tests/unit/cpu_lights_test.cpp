@@ -23,6 +23,7 @@
 #include "support/MisScenes.h"
 #include "support/Stats.h"
 #include "support/SurfaceScenes.h"
+#include "util/Math.h"
 
 namespace pyrolume {
 namespace {
@@ -30,12 +31,11 @@ namespace {
 using test::ZTestOptions;
 using test::ZTestReport;
 
-constexpr double kPi = std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 const glm::dvec3 kAlbedo(0.8, 0.6, 0.4);  // the plane's
 const glm::dvec3 kUp(0, 1, 0);            // the plane's normal
 
-RenderResult render(const Scene& s, const char* strategy = "mis") {
+RenderResult render_lights(const Scene& s, const char* strategy = "mis") {
   CpuRenderer r(0);
   RenderResult res = r.render(s, test::settings_for(s), {});
   EXPECT_EQ(r.majorant_violations(), 0u);
@@ -208,14 +208,14 @@ glm::dvec3 pixel_sum(const RenderResult& r, int x, int y) {
 TEST(CpuLights, PointLightOnPlane) {
   Scene s = plane_scene(64);
   s.lights.push_back(point_light({0.4, 1.5, -0.3}, {2, 3, 4}));
-  expect_matches(render(s), expected_image(s), 0.005, false, "point light");
+  expect_matches(render_lights(s), expected_image(s), 0.005, false, "point light");
 }
 
 // L = ρ/π · E cos θ, the same for every sample of every pixel.
 TEST(CpuLights, DeltaSunOnPlane) {
   Scene s = plane_scene(64);
   s.lights.push_back(distant_light({0.3, 1, -0.4}, {1.5, 2, 2.5}, 0.0));
-  const RenderResult r = render(s);
+  const RenderResult r = render_lights(s);
   expect_matches(r, expected_image(s), 0.005, false, "delta sun");
   const glm::dvec3 L = kAlbedo / kPi * glm::dvec3(1.5, 2, 2.5) * s.lights[0].direction.y;
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(pixel_sum(r, 7, 9)[c] / r.spp, L[c], 1e-12 * L[c]);
@@ -227,7 +227,7 @@ TEST(CpuLights, DeltaSunOnPlane) {
 TEST(CpuLights, SphereLightOnPlane) {
   Scene s = plane_scene(256);
   s.lights.push_back(sphere_light({1.6, 1.2, -0.2}, 0.3, {3, 2, 1}));  // just outside the view
-  expect_matches(render(s), expected_image(s), 0.005, true, "sphere light");
+  expect_matches(render_lights(s), expected_image(s), 0.005, true, "sphere light");
 }
 
 // On the light's axis, a plane facing it at distance d receives
@@ -243,7 +243,7 @@ TEST(CpuLights, SphereLightOnAxis) {
   s.camera.look_at = axis_point;
   s.camera.up = {0, 1, 0};
   s.camera.fov_deg = 0.1;
-  const RenderResult res = render(s);
+  const RenderResult res = render_lights(s);
   const glm::dvec3 expected = kAlbedo / kPi * (kPi * L * (r * r / (d * d)));
   const double n = double(res.spp) * 16;
   for (int c = 0; c < 3; ++c) {
@@ -262,11 +262,11 @@ TEST(CpuLights, SphereLightOnAxis) {
 TEST(CpuLights, DiscSunMatchesDeltaSun) {
   Scene delta = plane_scene(64);
   delta.lights.push_back(distant_light({0.3, 1, -0.2}, {2, 1.5, 1}, 0.0));
-  const RenderResult rd = render(delta);
+  const RenderResult rd = render_lights(delta);
   for (double angle : {20.0, 0.53}) {
     Scene disc = delta;
     disc.lights[0].angle_deg = angle;
-    const RenderResult r = render(disc);
+    const RenderResult r = render_lights(disc);
     const std::string what = "disc sun " + std::to_string(angle) + " deg";
     expect_matches(r, expected_image(delta), 0.005, true, (what + " vs closed form").c_str());
     ZTestOptions o;
@@ -284,7 +284,7 @@ TEST(CpuLights, SpotIsPointLightInsideAndDarkOutside) {
   point.lights.push_back(point_light({0.2, 1.5, 0.1}, {3, 2, 1}));
   Scene spot = point;
   spot.lights[0] = spot_light({0.2, 1.5, 0.1}, {0.15, -1, 0.05}, {3, 2, 1}, 30.0, 10.0);
-  const RenderResult rp = render(point), rs = render(spot);
+  const RenderResult rp = render_lights(point), rs = render_lights(spot);
   expect_matches(rs, expected_image(spot), 0.005, true, "spot");
   // Angles from the spot's axis over a 9 × 9 grid of each pixel's footprint.
   int inside = 0, outside = 0;
@@ -318,7 +318,7 @@ TEST(CpuLights, SurfaceBlocksPointLight) {
   Scene s = plane_scene(64);
   s.lights.push_back(point_light({0.3, 2.0, -0.2}, {4, 3, 2}));
   s.shapes.push_back(test::sphere_shape({0.5, 0.9, 0.1}, 0.3, glm::dvec3(0.5, 0.7, 0.9)));
-  expect_matches(render(s), expected_image(s), 0.005, true, "point light, sphere's shadow");
+  expect_matches(render_lights(s), expected_image(s), 0.005, true, "point light, sphere's shadow");
 }
 
 // A sphere light blocks a delta sun (opaque) and lights the plane beside it;
@@ -328,7 +328,7 @@ TEST(CpuLights, SphereLightBlocksSun) {
   // The sphere just outside the view, its shadow in it.
   s.lights.push_back(distant_light({1.1, 1.2, -0.2}, {1, 1.2, 1.4}, 0.0));
   s.lights.push_back(sphere_light({1.6, 1.2, -0.2}, 0.35, {2, 1.5, 1}));
-  expect_matches(render(s), expected_image(s), 0.005, true, "sun and sphere light");
+  expect_matches(render_lights(s), expected_image(s), 0.005, true, "sun and sphere light");
 }
 
 // Camera rays that escape inside a disc sun's cone see its radiance
@@ -349,7 +349,7 @@ TEST(CpuLights, CameraSeesDiscSun) {
     *sig = in;
     return s.background + (in ? L : glm::dvec3(0.0));
   });
-  expect_matches(render(s, "bsdf"), exact, 0.005, false, "disc sun seen by the camera");
+  expect_matches(render_lights(s, "bsdf"), exact, 0.005, false, "disc sun seen by the camera");
 }
 
 // A sphere light behind an absorbing slab: camera rays are tracked up to it
@@ -369,12 +369,12 @@ TEST(CpuLights, CameraSeesSphereLightThroughMedium) {
     const glm::dvec3 T = glm::exp(-sigma / std::abs(d.z));
     return T * (in ? Ls : s.background);
   });
-  expect_matches(render(s, "bsdf"), exact, 0.01, false, "sphere light through a slab");
+  expect_matches(render_lights(s, "bsdf"), exact, 0.01, false, "sphere light through a slab");
 
   Scene inside = s;
   inside.media.clear();
   inside.lights[0].radius = 6.0;  // the camera is 5 from its centre
-  const RenderResult r = render(inside, "bsdf");
+  const RenderResult r = render_lights(inside, "bsdf");
   for (double v : r.sum) EXPECT_EQ(v, 0.0);
 }
 
@@ -406,7 +406,7 @@ TEST(CpuLights, DeltaLightRayIsAttenuatedAndCollectsNothing) {
     *sig = 0;
     return kAlbedo / kPi * (I * cos_t / (r * r) * glm::exp(-sigma * h / cos_t) + E_slab);
   });
-  expect_matches(render(s), exact, 0.01, true, "point light through an emissive slab");
+  expect_matches(render_lights(s), exact, 0.01, true, "point light through an emissive slab");
 }
 
 // Single scattering of a point light in a homogeneous HG medium (max_depth 1):
@@ -447,7 +447,7 @@ TEST(CpuLights, PointLightSingleScattering) {
   std::vector<glm::dvec3> means(16 * 16);
   for (int y = 0; y < 16; ++y)
     for (int x = 0; x < 16; ++x) means[y * 16 + x] = test::pixel_average(L_ray, x, y, 8, 3, 1e9);
-  expect_matches(render(s), [&](int x, int y) { return means[y * 16 + x]; }, 0.01, true,
+  expect_matches(render_lights(s), [&](int x, int y) { return means[y * 16 + x]; }, 0.01, true,
                  "point light, single scattering");
 }
 
@@ -490,7 +490,7 @@ TEST(CpuLights, EveryLightUnderSkyWithEachStrategy) {
     t.integrator.surface_light_samples = c.light_samples;
     t.integrator.ratio_tracked_continuation = c.ratio;
     if (c.guided > 0.0) t.integrator.guided_continuation = c.guided;
-    expect_matches(render(t, c.light_only ? "light_only" : "mis"), exact, 0.01, true, c.what);
+    expect_matches(render_lights(t, c.light_only ? "light_only" : "mis"), exact, 0.01, true, c.what);
   }
 }
 

@@ -30,7 +30,7 @@ using test::Strategy;
 using test::ZTestOptions;
 using test::ZTestReport;
 
-RenderResult render(const Scene& s) {
+RenderResult render_mis(const Scene& s) {
   CpuRenderer r(0);
   RenderResult res = r.render(s, test::settings_for(s), {});
   EXPECT_EQ(r.majorant_violations(), 0u);
@@ -43,13 +43,13 @@ RenderResult render(const Scene& s) {
 TEST(CpuMis, ScatteringFireOverPlaneMisAgrees) {
   const auto dir = test::temp_dir("cpu_mis_plane");
   auto scene = [&](Strategy k, int spp) { return test::fire_over_plane_scene(dir, k, true, true, 24, 18, spp); };
-  test::expect_same_image(render(scene(Strategy::Mis, 256)), render(scene(Strategy::Bsdf, 1024)), 0.02, "MIS vs BSDF only");
+  test::expect_same_image(render_mis(scene(Strategy::Mis, 256)), render_mis(scene(Strategy::Bsdf, 1024)), 0.02, "MIS vs BSDF only");
 }
 
 TEST(CpuMis, ScatteringEmissiveMediumMisAgrees) {
   const auto dir = test::temp_dir("cpu_mis_scattering");
-  RenderResult bsdf = render(test::scattering_fire_scene(dir, Strategy::Bsdf, 12, 12, 8192));
-  RenderResult mis = render(test::scattering_fire_scene(dir, Strategy::Mis, 12, 12, 4096));
+  RenderResult bsdf = render_mis(test::scattering_fire_scene(dir, Strategy::Bsdf, 12, 12, 8192));
+  RenderResult mis = render_mis(test::scattering_fire_scene(dir, Strategy::Mis, 12, 12, 4096));
   test::expect_same_image(mis, bsdf, 0.02, "MIS vs phase only");
 }
 
@@ -63,7 +63,7 @@ TEST(CpuMis, ScatteringFurnaceIsOneWithSkyAsLight) {
                                              std::nullopt));
   s.environment = Environment{test::write_uniform_sky(dir, glm::vec3(1.0f)), 1.0, 0.0};
   test::set_strategy(s, Strategy::Mis);
-  RenderResult r = render(s);
+  RenderResult r = render_mis(s);
   ZTestReport z = test::ztest_against_exact(r, [](int, int) { return glm::dvec3(1.0); }, test::pooled(0.01));
   EXPECT_TRUE(z.ok) << z.summary();
 }

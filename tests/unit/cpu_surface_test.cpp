@@ -19,6 +19,7 @@
 #include "render/cpu/Sampling.h"
 #include "support/Stats.h"
 #include "support/SurfaceSuite.h"
+#include "util/Math.h"
 
 namespace pyrolume {
 
@@ -33,9 +34,8 @@ using test::plane_shape;
 using test::pooled;
 using test::ZTestReport;
 
-constexpr double kPi = std::numbers::pi;
 
-RenderResult render(const Scene& s, int threads = 0) {
+RenderResult render_surface(const Scene& s, int threads = 0) {
   RenderSettings rs;
   rs.width = s.film.width;
   rs.height = s.film.height;
@@ -102,7 +102,7 @@ TEST(CpuSurface, SurfaceClipsMediumBehindIt) {
     s.background = glm::dvec3(3.0);  // hidden everywhere by the plane
     s.media.push_back(test::homogeneous_sphere("half", c0, R, sigma_a, glm::dvec3(0.0), 0.0, Le));
     s.shapes.push_back(plane_shape({0, 0, 0}, {0, 0, -1}, {0, 0}, glm::dvec3(0.0)));
-    RenderResult r = render(s);
+    RenderResult r = render_surface(s);
     EXPECT_EQ(r.nonfinite_samples, 0u);
     auto exact_for = [&](bool clip) {
       const int W = s.film.width, H = s.film.height;
@@ -151,7 +151,7 @@ Scene lit_plane_scene(EmissionEstimator estimator, uint32_t seed) {
 
 TEST(CpuSurface, EmissiveSphereLightsPlane) {
   Scene s = lit_plane_scene(EmissionEstimator::Collision, 3);
-  RenderResult r = render(s);
+  RenderResult r = render_surface(s);
   EXPECT_EQ(r.nonfinite_samples, 0u);
   for (double v : r.sum) ASSERT_TRUE(std::isfinite(v));
   // Bottom rows: the plane in front of the sphere (no medium on the camera ray).
@@ -159,7 +159,7 @@ TEST(CpuSurface, EmissiveSphereLightsPlane) {
   for (int x = 0; x < r.width; ++x) near_sum += pixel_mean(r, x, r.height - 1).x;
   EXPECT_GT(near_sum / r.width, 0.0);
 
-  ZTestReport same = test::ztest_images(render(lit_plane_scene(EmissionEstimator::Absorption, 4)), r, pooled(0.03));
+  ZTestReport same = test::ztest_images(render_surface(lit_plane_scene(EmissionEstimator::Absorption, 4)), r, pooled(0.03));
   EXPECT_TRUE(same.ok) << same.summary();
   std::printf("absorption vs collision: %s\n", same.summary().c_str());
 }
@@ -167,7 +167,7 @@ TEST(CpuSurface, EmissiveSphereLightsPlane) {
 TEST(CpuSurface, DeterministicAcrossThreadCounts) {
   Scene s = lit_plane_scene(EmissionEstimator::Absorption, 9);
   s.film.spp = 8;
-  RenderResult a = render(s, 1), b = render(s, 3);
+  RenderResult a = render_surface(s, 1), b = render_surface(s, 3);
   EXPECT_EQ(a.sum, b.sum);
   EXPECT_EQ(a.sum_sq, b.sum_sq);
   EXPECT_EQ(a.events, b.events);

@@ -17,12 +17,12 @@
 #include "support/Stats.h"
 #include "support/TestSupport.h"
 #include "util/Error.h"
+#include "util/Math.h"
 
 using namespace pyrolume;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // A map with structure everywhere the sampler must get right: a sky gradient,
 // a bright small "sun", a black band (zero rows' neighbours) and black columns.

@@ -19,8 +19,10 @@
 #include "scene/Scene.h"
 #include "support/LightScenes.h"
 #include "support/MisScenes.h"
+#include "support/Stats.h"
 #include "util/Error.h"
 #include "volume/StoredVolume.h"
+#include "util/Math.h"
 
 namespace pyrolume {
 namespace {
@@ -305,7 +307,6 @@ TEST_F(LightResolution, FireAloneRendersAsBefore) {
 // within; the powers are computed here from their definitions.
 
 double luminance(glm::dvec3 c) { return 0.2126729 * c.r + 0.7151522 * c.g + 0.0721750 * c.b; }
-constexpr double kPi = 3.14159265358979323846;
 
 // Every light at (0, 1, 0), the spot shining down and the sun overhead:
 // where they are does not change their power.

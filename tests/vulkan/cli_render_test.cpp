@@ -19,7 +19,7 @@ using namespace pyrolume;
 using namespace pyrolume::test;
 
 namespace {
-const char* kScene = R"({
+const char* kCliScene = R"({
   "camera": {"position": [0, 0, -4], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 40},
   "film": {"width": 24, "height": 16, "spp": 8, "seed": 3},
   "background": {"rgb": [0.1, 0.1, 0.1]},
@@ -33,7 +33,7 @@ class CliRender : public ::testing::TestWithParam<std::string> {};
 TEST_P(CliRender, WritesExrWithVarianceStatsAndSummary) {
   const std::string backend = GetParam();
   auto dir = temp_dir("render");
-  write_file(dir / "s.json", kScene);
+  write_file(dir / "s.json", kCliScene);
   CliResult r = run_cli("render " + (dir / "s.json").string() + " -o " + (dir / "o.exr").string() + " --backend " +
                         backend + " --spp 16 --width 20 --height 10 --variance --stats " + (dir / "st.json").string());
   ASSERT_EQ(r.status, 0) << r.err;
@@ -73,7 +73,7 @@ TEST_P(CliRender, PngIsSrgbWithExposure) {
   auto dir = temp_dir("png");
   // The standard view: exposure, clip, sRGB (AgX, the default, has its own tests:
   // tests/unit/image_view_transform_test.cpp).
-  std::string standard = kScene;
+  std::string standard = kCliScene;
   standard.replace(standard.find("\"seed\": 3"), 9, "\"seed\": 3, \"view\": \"standard\"");
   write_file(dir / "s.json", standard);
   CliResult a = run_cli("render " + (dir / "s.json").string() + " -o " + (dir / "a.png").string() + " --backend " + backend);
@@ -122,7 +122,7 @@ TEST(CliStats, ReportsEachGridsMajorantCells) {
 
 TEST(CliInterrupt, SigintSavesImageAndExits130) {
   auto dir = temp_dir("sigint");
-  write_file(dir / "s.json", kScene);
+  write_file(dir / "s.json", kCliScene);
   const auto out = dir / "o.exr";
   for (int wait_ms : {2500, 10000, 30000}) {
     CliProcess p = start_cli({"render", (dir / "s.json").string(), "-o", out.string(), "--spp", "10000000", "--width",
@@ -149,7 +149,7 @@ TEST(CliInterrupt, SigintSavesImageAndExits130) {
 // the CPU backend still renders.
 TEST(CliNoDevice, PointsToCpuBackend) {
   auto dir = temp_dir("nodev");
-  write_file(dir / "s.json", kScene);
+  write_file(dir / "s.json", kCliScene);
   const char* old = std::getenv("VK_ICD_FILENAMES");
   std::string saved = old ? old : "";
   setenv("VK_ICD_FILENAMES", "/nonexistent-icd.json", 1);

@@ -14,7 +14,7 @@ using namespace pyrolume;
 using namespace pyrolume::test;
 
 namespace {
-const std::string kScene = R"({"film": {"width": 24, "height": 16, "spp": 8},
+const std::string kDenoiseScene = R"({"film": {"width": 24, "height": 16, "spp": 8},
   "camera": {"position": [0, -5, 1.5], "look_at": [0, 0, 0.8]},
   "background": {"rgb": [0.2, 0.3, 0.5]},
   "shapes": [{"plane": {"center": [0, 0, 0], "normal": [0, 0, 1]}, "material": {"diffuse": {"rgb": [0.6, 0.6, 0.6]}}}],
@@ -24,7 +24,7 @@ const std::string kScene = R"({"film": {"width": 24, "height": 16, "spp": 8},
 
 TEST(CliRenderDenoise, WritesTheDenoisedImageBesideTheUntouchedRender) {
   auto dir = temp_dir("clirenderdenoise");
-  write_file(dir / "s.json", kScene);
+  write_file(dir / "s.json", kDenoiseScene);
   const auto out = dir / "out.exr", denoised = dir / "out.denoised.exr";
   CliResult r = run_cli("render " + (dir / "s.json").string() + " -o " + out.string() + " --denoise");
   ASSERT_EQ(r.status, 0) << r.err;
@@ -51,7 +51,7 @@ TEST(CliRenderDenoise, WritesTheDenoisedImageBesideTheUntouchedRender) {
 // Each says which it ran, and the two give different images.
 TEST(CliRenderDenoise, TheGuidedFilterRunsWhereTheGuideIsAndThePlainOneWhenAsked) {
   auto dir = temp_dir("clirenderguide");
-  write_file(dir / "s.json", kScene);
+  write_file(dir / "s.json", kDenoiseScene);
   CliResult r = run_cli("render " + (dir / "s.json").string() + " -o " + (dir / "a.exr").string() + " --denoise");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("denoised with the guided filter"), std::string::npos) << r.out;
@@ -75,7 +75,7 @@ TEST(CliRenderDenoise, TheGuidedFilterRunsWhereTheGuideIsAndThePlainOneWhenAsked
 
 TEST(CliRenderDenoise, AovLayersInTheExrSumToItsRgb) {
   auto dir = temp_dir("clirenderaovs");
-  write_file(dir / "s.json", kScene);
+  write_file(dir / "s.json", kDenoiseScene);
   const auto out = dir / "out.exr";
   CliResult r = run_cli("render " + (dir / "s.json").string() + " -o " + out.string() + " --aovs");
   ASSERT_EQ(r.status, 0) << r.err;

@@ -31,7 +31,7 @@ void write_frame(const fs::path& dir, int frame) {
 
 // The camera moves and the emission fades over the keys; the medium scatters,
 // so every pixel's value depends on the RNG.
-const char* kScene = R"({
+const char* kSequenceScene = R"({
   "camera": {"position": {"keys": [[1, [0, 0, -4]], [3, [0.5, 0.3, -3.5]]]}, "look_at": [0, 0, 0], "fov_deg": 40},
   "film": {"width": 20, "height": 14, "spp": 4, "seed": 5, "exposure": {"keys": [[1, 0], [3, 1]]}},
   "background": {"rgb": [0.05, 0.05, 0.08]},
@@ -42,7 +42,7 @@ const char* kScene = R"({
 
 fs::path scene_with_frames(const std::string& tag, std::initializer_list<int> frames) {
   fs::path dir = temp_dir(tag);
-  write_file(dir / "seq.json", kScene);
+  write_file(dir / "seq.json", kSequenceScene);
   for (int f : frames) write_frame(dir, f);
   return dir;
 }
@@ -102,7 +102,7 @@ TEST_P(Sequence, FrameNumberKeysTheRandomNumbers) {
   // The same grid every frame and no keys: frames differ only by their noise.
   fs::path dir = temp_dir("seq-rng");
   write_frame(dir, 2);
-  std::string still = kScene;
+  std::string still = kSequenceScene;
   auto replace = [&](const std::string& from, const std::string& to) { still.replace(still.find(from), from.size(), to); };
   replace("shell_####.vdb", "shell_0002.vdb");
   replace(R"({"keys": [[1, [0, 0, -4]], [3, [0.5, 0.3, -3.5]]]})", "[0, 0, -4]");

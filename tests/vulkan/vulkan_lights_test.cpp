@@ -71,17 +71,17 @@ std::function<glm::dvec3(int, int)> scaled(std::function<glm::dvec3(int, int)> f
 }
 
 // Light hits are hit-or-miss (Bernoulli-like): pooled, 1 % bias tolerance.
-constexpr double kBiasTolerance = 0.01;
+constexpr double kLightsBiasTolerance = 0.01;
 using test::pooled;
 
 class VulkanLights : public test::VulkanFixture {
  protected:
   // Accepts `exact` and rejects it scaled by 1.1.
   void expect_closed_form(const RenderResult& r, const std::function<glm::dvec3(int, int)>& exact, const char* what) {
-    const ZTestReport ok = test::ztest_against_exact(r, exact, pooled(kBiasTolerance));
+    const ZTestReport ok = test::ztest_against_exact(r, exact, pooled(kLightsBiasTolerance));
     EXPECT_TRUE(ok.ok) << what << ": " << ok.summary();
     std::printf("%s: %s\n", what, ok.summary().c_str());
-    const ZTestReport wrong = test::ztest_against_exact(r, scaled(exact, 1.1), pooled(kBiasTolerance));
+    const ZTestReport wrong = test::ztest_against_exact(r, scaled(exact, 1.1), pooled(kLightsBiasTolerance));
     EXPECT_FALSE(wrong.ok) << what << " ×1.1 should be rejected: " << wrong.summary();
   }
 };

@@ -31,7 +31,7 @@ using test::ZTestReport;
 // whole-image bias tolerance is 0.2 % (not 0.5 %): transmittance estimates are
 // cheap, SE_bias is ~0.02–0.1 % at these spp, and a tighter bound catches a
 // small σt error that the many T = 1 pixels around the grid would dilute.
-constexpr double kBiasTolerance = 0.002;
+constexpr double kTransmittanceBiasTolerance = 0.002;
 using test::pooled;
 
 const char* tracker_name(uint32_t mode) { return mode == 1 ? "ratio" : "delta"; }
@@ -61,7 +61,7 @@ class VulkanTransmittance : public test::VulkanFixture {
     RenderResult ratio;
     for (uint32_t mode : {1u, 2u}) {
       RenderResult r = render(s, mode);
-      ZTestReport rep = test::ztest_against_exact(r, exact, pooled(kBiasTolerance));
+      ZTestReport rep = test::ztest_against_exact(r, exact, pooled(kTransmittanceBiasTolerance));
       EXPECT_TRUE(rep.ok) << what << " [" << tracker_name(mode) << "] " << rep.summary();
       EXPECT_GT(r.density_lookups, 0.0) << what;
       EXPECT_EQ(r.events, 0.0) << what << ": transmittance estimates have no real events";
@@ -96,7 +96,7 @@ TEST_F(VulkanTransmittance, DensityRampMatchesClosedForm) {
 
   Scene wrong = s;
   wrong.media[0].density_scale *= 1.02;
-  ZTestReport rep = test::ztest_against_exact(ratio, test::transmittance_exact(wrong, f), pooled(kBiasTolerance));
+  ZTestReport rep = test::ztest_against_exact(ratio, test::transmittance_exact(wrong, f), pooled(kTransmittanceBiasTolerance));
   EXPECT_FALSE(rep.ok) << "a 2 % larger sigma_t was accepted: " << rep.summary();
   std::printf("deliberately wrong (σt +2 %%): %s\n", rep.summary().c_str());
 }
@@ -122,7 +122,7 @@ TEST_F(VulkanTransmittance, CheckerboardMatchesQuadrature) {
 
   // The check can fail: the same checkerboard one voxel over (cells swapped).
   const test::TrilinearVoxelField shifted(lat, box, [&](int i, int j, int k) { return checker(i + 1, j, k); });
-  ZTestReport rep = test::ztest_against_exact(ratio, test::transmittance_exact(s, shifted), pooled(kBiasTolerance));
+  ZTestReport rep = test::ztest_against_exact(ratio, test::transmittance_exact(s, shifted), pooled(kTransmittanceBiasTolerance));
   EXPECT_FALSE(rep.ok) << "a shifted checkerboard was accepted: " << rep.summary();
   std::printf("deliberately wrong (shifted checkerboard): %s\n", rep.summary().c_str());
 }
