@@ -530,7 +530,8 @@ int run_info(const std::string& file, bool values) { return run_info_command(fil
 
 int run_blackbody(const BlackbodyArgs& a) {
   const BlackbodyMode mode = color::parse_blackbody_mode(a.mode).value_or(BlackbodyMode::Seed);  // CLI checked the name
-  return color::run_blackbody_command(a.from_k, a.to_k, a.step_k, mode, a.observer, a.png, std::cout, std::cerr);
+  return color::run_blackbody_command(a.from_k, a.to_k, a.step_k, mode, a.observer, a.png, std::cout, std::cerr,
+                                      write_file_atomic);
 }
 
 int run_compare(const CompareArgs& a) {
