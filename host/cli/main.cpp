@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <new>
 #include <string>
 
@@ -151,9 +152,21 @@ int main(int argc, char** argv) {
   denoise->add_option("--iterations", dn.iterations,
                       "Plain filter: à-trous iterations (default 1; n reach ±(2^(n+1) − 2) px)")
       ->check(CLI::Range(0, 12));
+  // The edge-stopping widths divide differences: NaN, an infinity or 0 would
+  // write NaN (or nothing filtered) into the image. CLI::PositiveNumber lets
+  // "nan" through (every comparison with NaN is false), so check as a float.
+  const CLI::Validator finite_positive(
+      [](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || !(v > 0.0) ||
+            v > double(std::numeric_limits<float>::max()) || !(float(v) > 0.0f))
+          return "must be a finite number > 0 (single precision), not " + text;
+        return {};
+      },
+      "FINITE > 0");
   denoise->add_option("--sigma-l", dn.sigma_l,
                       "Plain filter: luminance edge-stopping, in standard deviations of the noise (default 1.5)")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_positive);
   denoise->add_flag("--features", dn.features,
                     "Plain filter: also stop at edges in the albedo, normal and depth AOVs (off: they measured worse "
                     "on the fires)");
@@ -190,7 +203,10 @@ int main(int argc, char** argv) {
     if (*denoise) {
       // The plain filter's settings ask for the plain filter.
       dn.no_guide = dn.no_guide || denoise->count("--iterations") + denoise->count("--sigma-l") + denoise->count("--features") > 0;
-      return run_denoise(dn);
+      const int status = run_denoise(dn, g_cancel);
+      if (g_signal == SIGINT) return 130;
+      if (g_signal == SIGTERM) return 143;
+      return status;
     }
   } catch (const InputError& e) {
     std::cerr << "pyrolume: " << e.what() << "\n";
