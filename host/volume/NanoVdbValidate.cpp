@@ -7,6 +7,7 @@
 // it sits in were checked, with offsets as integers (no pointer is formed
 // from an unchecked one).
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -131,6 +132,17 @@ class GridChecker {
     if (uint32_t(g.mGridType) >= uint32_t(nanovdb::GridType::End)) fail("unknown value type " + std::to_string(uint32_t(g.mGridType)));
     if (uint32_t(g.mGridClass) >= uint32_t(nanovdb::GridClass::End))
       fail("unknown grid class " + std::to_string(uint32_t(g.mGridClass)));
+    // The affine index-to-world map: finite and invertible as OpenVDB
+    // requires of every affine map (|det| >= 3e-15, AffineMap); NanoVDB's
+    // grids come from those, and nanoToOpenVDB builds one from this matrix
+    // (a singular one threw out of the loader: found by fuzz_nvdb).
+    const double* a = g.mMap.mMatD;
+    const double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
+                       a[2] * (a[3] * a[7] - a[4] * a[6]);
+    bool finite = std::isfinite(det);
+    for (int i = 0; i < 3; ++i) finite = finite && std::isfinite(g.mMap.mVecD[i]);
+    if (!finite || std::abs(det) < 3e-15)
+      fail("its index-to-world map is singular or not finite (determinant " + std::to_string(det) + ")");
     uint64_t nodes_end = size_;
     uint64_t table = 0;
     const uint64_t count = g.mBlindMetadataCount;

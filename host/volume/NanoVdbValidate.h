@@ -19,8 +19,9 @@ namespace pyrolume {
 // Checks `handle`'s one grid, bounds first (each field is read only once the
 // bytes it sits in are known to be inside the buffer):
 //  - the grid header: magic, version, size == the buffer, index and count,
-//    value type and class, name (terminated; a long name's blind data inside
-//    the buffer), the blind metadata table;
+//    value type and class, the index-to-world map (finite, invertible), the
+//    name (terminated; a long name's blind data inside the buffer), the blind
+//    metadata table;
 //  - the tree header: the root and the first upper, lower and leaf node
 //    offsets with their node counts, as tables that lie inside the buffer in
 //    NanoVDB's order (root and its tiles, uppers, lowers, leaves) without

@@ -36,6 +36,7 @@ using Bytes = std::vector<char>;
 // Byte offsets in a NanoVDB 32 grid buffer (NanoVDB.h: GridData, TreeData, RootData).
 static_assert(sizeof(nanovdb::GridData) == 672 && sizeof(nanovdb::TreeData<3>) == 64, "NanoVDB 32 layout");
 constexpr size_t kGridSize = 32, kGridType = 636, kTree = 672;
+constexpr size_t kMapD = 296 + 88;  // GridData::mMap.mMatD[0] (after the float matrices, translation and taper)
 constexpr size_t kNodeOffset = kTree, kNodeCount = kTree + 32, kVoxelCount = kTree + 56;
 constexpr size_t kRootBBox = 0, kRootTableSize = 24;
 
@@ -153,6 +154,10 @@ TEST(NanoVdbValidate, EachForgedFieldIsRefusedByEveryReaderInOneLine) {
        "is not the box of its active voxels"},
       {"value type", [](Bytes& b, size_t g) { put<uint32_t>(b, g + kGridType, uint32_t(nanovdb::GridType::Double)); },
        "its value type is double where the file lists float"},
+      // Found by fuzz_nvdb: nanoToOpenVDB (the sparse path of a root tile
+      // and of quantised grids) threw OpenVDB's ArithmeticError out of the loader.
+      {"index-to-world map", [](Bytes& b, size_t g) { put<double>(b, g + kMapD, 0.0); },
+       "index-to-world map is singular or not finite"},
       {"leaf origin",
        [](Bytes& b, size_t g) {
          const size_t leaf = g + kTree + get<uint64_t>(b, g + kNodeOffset);
