@@ -24,6 +24,14 @@ uint64_t accumulation_bytes(const std::string& backend, int width, int height) {
   return 0;
 }
 
-Checkpoint read_checkpoint(const std::filesystem::path& file) { return read_checkpoint(file, accumulation_bytes); }
+Checkpoint read_checkpoint(const std::filesystem::path& file) {
+  Checkpoint c = read_checkpoint(file, accumulation_bytes);
+  const uint64_t bad = c.state.backend == "cpu" ? CpuRenderer::nonfinite_sums(c.state) : VulkanRenderer::nonfinite_sums(c.state);
+  if (bad > 0)
+    throw input_error(file.string(), "",
+                      "corrupt checkpoint: " + std::to_string(bad) + " of its accumulated sums are NaN or infinite "
+                      "(delete it or render without --resume)");
+  return c;
+}
 
 }  // namespace pyrolume

@@ -23,7 +23,10 @@ std::string device_list(int requested);
 // that backend lays it out; 0 for an unknown backend name.
 uint64_t accumulation_bytes(const std::string& backend, int width, int height);
 
-// read_checkpoint (render/Checkpoint.h) with every backend's payload size.
+// read_checkpoint (render/Checkpoint.h) with every backend's payload size,
+// and its sums checked finite: a NaN or an infinity in them (a forged or
+// damaged file whose checksum was recomputed) is an InputError naming the
+// file, since resumed it would stay in the image for good.
 Checkpoint read_checkpoint(const std::filesystem::path& file);
 
 }  // namespace pyrolume

@@ -1,5 +1,6 @@
 #include "cli/Commands.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -87,6 +88,41 @@ double write_denoised(const std::filesystem::path& file, const Image& image, dou
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_image(file, clean, stops, view);
   return seconds;
+}
+
+// render --denoise: the denoised copy of an image already written, in an
+// output commit of its own, so that a failure of the denoiser (or of this
+// write) loses nothing but the copy. Returns the exit status the failure asks
+// for at the end of the run (2: bad input or no device, 1: anything else), 0
+// when the copy is written; a failure is said on one line, naming the raw
+// image that was kept. Prints the copy's summary line when `summary`.
+int write_denoised_copy(const std::filesystem::path& file, const std::filesystem::path& raw, const Image& image,
+                        double stops, ViewTransform view, DenoiserSession& denoiser, const std::string& tag,
+                        bool summary) {
+  std::string reason;
+  int status = 2;
+  try {
+    OutputCommit one;
+    const double seconds = write_denoised(file, image, stops, view, denoiser);
+    one.commit();
+    if (summary)
+      std::cout << file.string() << ": denoised with " << denoise_inputs(image, DenoiseOptions{}) << ", "
+                << format_seconds(seconds) << " s" << std::endl;
+    return 0;
+  } catch (const InputError& e) {
+    reason = e.what();
+  } catch (const NoDeviceError& e) {
+    reason = file.string() + ": " + e.what();
+  } catch (const std::bad_alloc&) {
+    reason = file.string() + ": out of memory (std::bad_alloc)";
+    status = 1;
+  } catch (const std::exception& e) {
+    reason = file.string() + ": internal error: " + e.what();
+    status = 1;
+  }
+  std::cerr << "pyrolume: error: " << tag << reason << "; the denoised copy is not written, " << raw.string()
+            << " is kept\n";
+  return status;
 }
 
 // Where the auto exposure line goes: stderr, for display output only (an EXR
@@ -234,6 +270,13 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
                         args.denoise ? denoised_path(image) : std::filesystem::path()};
   };
   check_frame_outputs(frame_outputs(range.first), scene_at_frame(scene, range.first), folders);
+  // --denoise: the denoiser's limits come from the film size (the same for
+  // every frame), so a film it cannot take is refused before any frame is spent.
+  DenoiserSession denoiser;  // one device for the whole sequence
+  if (args.denoise) {
+    const RenderSettings first = settings_from(args, scene_at_frame(scene, range.first));
+    denoiser.check_size(first.width, first.height, args.device, frame_outputs(range.first).denoised.string());
+  }
 
   const auto t0 = std::chrono::steady_clock::now();
   BackendOptions options;
@@ -245,16 +288,18 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
   DisplayExposure exposure(parse_exposure(args.exposure));
   const std::string ext = lower_extension(output);
   bool look_warned = false;
-  DenoiserSession denoiser;  // --denoise: one device for the whole sequence
-  int rendered = 0, skipped = 0, missing = 0;
+  int rendered = 0, skipped = 0, missing = 0, not_denoised = 0, denoise_status = 0;
   double load_seconds = 0.0, render_seconds = 0.0;
   for (int frame : range) {
     if (cancel.load()) break;
     const std::string tag = "frame " + std::to_string(frame) + ": ";
     const FrameOutputs out = frame_outputs(frame);
-    // Outputs are written atomically (temp + rename), so an existing one is complete.
+    // Outputs are written atomically (temp + rename), so an existing one is
+    // complete. With --denoise a frame is done when its denoised copy exists
+    // too: one whose denoiser failed is rendered again.
     std::error_code ec;
-    if (args.skip_existing && std::filesystem::exists(out.image, ec)) {
+    if (args.skip_existing && std::filesystem::exists(out.image, ec) &&
+        (out.denoised.empty() || std::filesystem::exists(out.denoised, ec))) {
       std::cerr << "pyrolume: " << tag << out.image.string() << " exists, skipped\n";
       ++skipped;
       continue;
@@ -299,12 +344,19 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
     const Image image = requested_image(full, args, frame_scene);
     const double stops = exposure.stops(frame_scene.film, image, display_log(out.image));
     {
-      OutputCommit both;  // the image and its stats (and the denoised image), or none
+      OutputCommit both;  // the image and its stats, or neither
       write_image(out.image, image, stops, frame_scene.film.view);
       if (!out.stats.empty()) write_stats(out.stats, args, out.image, result, frame);
-      if (!out.denoised.empty()) write_denoised(out.denoised, full, stops, frame_scene.film.view, denoiser);
       both.commit();
     }
+    // The denoised copy after the frame is safe: its failure loses only the copy.
+    if (!out.denoised.empty())
+      if (const int status = write_denoised_copy(out.denoised, out.image, full, stops, frame_scene.film.view, denoiser,
+                                                 tag, false);
+          status != 0) {
+        ++not_denoised;
+        denoise_status = std::max(denoise_status, status);
+      }
     print_warnings(result, tag);
     if (!look_warned)  // once per sequence, at the first frame it concerns
       if (const std::string w = film_look_warning(image, stops, frame_scene.film.view, ext == ".png"); !w.empty()) {
@@ -323,12 +375,16 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
                 args.frames.c_str(), rendered, skipped, missing, format_seconds(wall).c_str(),
                 format_seconds(load_seconds).c_str(), format_seconds(render_seconds).c_str());
   std::cout << line << std::endl;
+  if (not_denoised > 0)
+    std::cerr << "pyrolume: " << not_denoised << (not_denoised == 1 ? " frame has" : " frames have")
+              << " no denoised copy (the raw frames are kept; --skip-existing renders them again): exit status "
+              << denoise_status << "\n";
   if (missing > 0 && !args.allow_missing) {
     std::cerr << "pyrolume: " << missing << (missing == 1 ? " frame was" : " frames were")
               << " not rendered for missing inputs: exit status 2 (--allow-missing accepts them)\n";
-    return 2;
+    return std::max(2, denoise_status);
   }
-  return 0;
+  return denoise_status;
 }
 
 }  // namespace
@@ -397,6 +453,9 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   // the RNG is keyed with frame 0, as before animation existed.
   RenderSettings settings = settings_from(args, scene);
   settings.frame = 0;
+  // --denoise: a film too large for the denoiser is refused before the render is spent.
+  DenoiserSession denoiser;
+  if (args.denoise) denoiser.check_size(settings.width, settings.height, args.device, denoised_path(output).string());
 
   // Checkpoints: OUT.checkpoint (checkpoint_file) carries the accumulation and what it belongs to.
   CheckpointIdentity identity{args.backend, args.scene,     scene_fingerprint(args.scene), settings.width,
@@ -447,6 +506,7 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
 
   // The image and (short of the target) the checkpoint of what was rendered.
   DisplayExposure exposure(parse_exposure(args.exposure));
+  int denoise_status = 0;  // a failed denoised copy: the exit status at the end
   auto save = [&](const RenderResult& result, bool keep_checkpoint) {
     Image full = image_from_render(result, args.variance || args.denoise);
     full.transparent = scene.film.transparent;
@@ -458,15 +518,10 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
       if (!args.stats.empty()) write_stats(args.stats, args, output, result, std::nullopt);
       both.commit();
     }
-    if (args.denoise && result.spp > 0) {  // after the raw image is safe: a failure here loses nothing
-      const std::filesystem::path file = denoised_path(output);
-      OutputCommit one;
-      DenoiserSession denoiser;
-      const double seconds = write_denoised(file, full, stops, scene.film.view, denoiser);
-      one.commit();
-      std::cout << file.string() << ": denoised with " << denoise_inputs(full, DenoiseOptions{}) << ", "
-                << format_seconds(seconds) << " s" << std::endl;
-    }
+    // After the raw image is safe: a failure here loses nothing else (the
+    // checkpoint below is still saved).
+    if (args.denoise && result.spp > 0)
+      denoise_status = write_denoised_copy(denoised_path(output), output, full, stops, scene.film.view, denoiser, "", true);
     if (result.spp >= settings.spp)  // a finished render: one the user will look at
       if (const std::string w = film_look_warning(image, stops, scene.film.view, ext == ".png"); !w.empty())
         std::cerr << "pyrolume: warning: " << output.string() << ": " << w << "\n";
@@ -518,7 +573,7 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
     std::cerr << "pyrolume: stopped at " << result.spp << " of " << settings.spp << " spp (--time-limit)"
               << resume_hint(checkpointed) << "\n";
   print_summary(output, result);
-  return 0;
+  return denoise_status;
 }
 
 int run_devices(int device) {
@@ -530,14 +585,15 @@ int run_info(const std::string& file, bool values) { return run_info_command(fil
 
 int run_blackbody(const BlackbodyArgs& a) {
   const BlackbodyMode mode = color::parse_blackbody_mode(a.mode).value_or(BlackbodyMode::Seed);  // CLI checked the name
-  return color::run_blackbody_command(a.from_k, a.to_k, a.step_k, mode, a.observer, a.png, std::cout, std::cerr);
+  return color::run_blackbody_command(a.from_k, a.to_k, a.step_k, mode, a.observer, a.png, std::cout, std::cerr,
+                                      write_file_atomic);
 }
 
 int run_compare(const CompareArgs& a) {
   return run_compare_command(a.a, a.b, a.max_relmse, a.max_outliers, std::cout, std::cerr);
 }
 
-int run_denoise(const DenoiseArgs& a) {
+int run_denoise(const DenoiseArgs& a, const std::atomic<bool>& cancel) {
   const std::filesystem::path input = a.input, output = a.output;
   if (output.empty()) throw input_error(input.string(), "", "no output: give -o OUT.exr");
   const std::string ext = lower_extension(output);
@@ -558,10 +614,24 @@ int run_denoise(const DenoiseArgs& a) {
   options.use_features = a.features;
   options.use_guide = !a.no_guide;
   options.device_index = a.device;
+  // A signal (main.cpp) ends the command with nothing written: checked
+  // before the device opens, after the filter, and last before the rename.
+  auto interrupted = [&] {
+    if (!cancel.load()) return false;
+    std::cerr << "pyrolume: interrupted; " << output.string() << " is not written\n";
+    return true;
+  };
+  if (interrupted()) return 0;
   const auto t1 = std::chrono::steady_clock::now();
   const Image clean = denoise(noisy, options, input.string());
   const auto t2 = std::chrono::steady_clock::now();
-  write_image(output, clean);
+  if (interrupted()) return 0;
+  {
+    OutputCommit one;  // destroyed uncommitted, it removes the finished temp file
+    write_image(output, clean);
+    if (interrupted()) return 0;
+    one.commit();
+  }
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double filter = std::chrono::duration<double>(t2 - t1).count();
   std::cout << output.string() << ": " << noisy.width << "x" << noisy.height << ", denoised with "

@@ -60,6 +60,8 @@ struct DenoiseArgs {
   bool no_guide = false;  // the plain filter even with the guide (implied by the three above)
   int device = -1;
 };
-int run_denoise(const DenoiseArgs& args);
+// A SIGINT/SIGTERM (`cancel`) ends it before the output is committed: nothing
+// is written (main turns the signal into exit status 130/143).
+int run_denoise(const DenoiseArgs& args, const std::atomic<bool>& cancel);
 
 }  // namespace pyrolume

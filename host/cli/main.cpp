@@ -2,10 +2,13 @@
 // Exit status: 0 ok, 1 internal error, 2 bad input, 3 compare beyond limits,
 // 130/143 interrupted (the image so far is saved first).
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <new>
+#include <string>
 
 #include <malloc.h>
 #include <unistd.h>
@@ -34,6 +37,24 @@ extern "C" void on_signal(int sig) {
   }
   g_signal = sig;
 }
+
+// Seconds for --time-limit and --checkpoint: positive and finite. CLI11's
+// NonNegativeNumber took 0 (read as "no limit") and PositiveNumber took nan
+// and inf; neither checks that the whole argument is a number.
+const CLI::Validator kPositiveSeconds(
+    [](std::string& text) -> std::string {
+      double v = 0.0;
+      size_t used = 0;
+      try {
+        v = std::stod(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (text.empty() || used != text.size() || !std::isfinite(v) || !(v > 0.0))
+        return "must be a positive, finite number of seconds, got \"" + text + "\"";
+      return "";
+    },
+    "SEC>0");
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -58,8 +79,8 @@ int main(int argc, char** argv) {
   render->add_option("--width", render_args.width, "Image width (overrides film.width)")->check(CLI::Range(1, pyrolume::kMaxFilmSide));
   render->add_option("--height", render_args.height, "Image height (overrides film.height)")->check(CLI::Range(1, pyrolume::kMaxFilmSide));
   render->add_option("--seed", render_args.seed, "Random seed (overrides film.seed)");
-  render->add_option("--time-limit", render_args.time_limit, "Stop after the pass that crosses SEC seconds")
-      ->check(CLI::NonNegativeNumber);
+  render->add_option("--time-limit", render_args.time_limit, "Stop after the pass that crosses SEC seconds (SEC > 0)")
+      ->check(kPositiveSeconds);
   render->add_option("--stats", render_args.stats, "Write render statistics as JSON");
   render->add_flag("--variance", render_args.variance, "EXR: add the per-pixel variance of the mean (variance.R/G/B)");
   render->add_flag("--aovs", render_args.aovs,
@@ -80,7 +101,7 @@ int main(int argc, char** argv) {
   render->add_option("--checkpoint", render_args.checkpoint,
                      "Every SEC seconds save the accumulation to OUT.checkpoint (e.g. out.exr.checkpoint; an "
                      "interrupted render always saves it; a finished one removes it)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveSeconds);
   render->add_flag("--resume", render_args.resume,
                    "Continue from OUT.checkpoint (same scene, backend, size, seed; refused otherwise) up to --spp");
 
@@ -131,9 +152,21 @@ int main(int argc, char** argv) {
   denoise->add_option("--iterations", dn.iterations,
                       "Plain filter: à-trous iterations (default 1; n reach ±(2^(n+1) − 2) px)")
       ->check(CLI::Range(0, 12));
+  // The edge-stopping widths divide differences: NaN, an infinity or 0 would
+  // write NaN (or nothing filtered) into the image. CLI::PositiveNumber lets
+  // "nan" through (every comparison with NaN is false), so check as a float.
+  const CLI::Validator finite_positive(
+      [](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || !(v > 0.0) ||
+            v > double(std::numeric_limits<float>::max()) || !(float(v) > 0.0f))
+          return "must be a finite number > 0 (single precision), not " + text;
+        return {};
+      },
+      "FINITE > 0");
   denoise->add_option("--sigma-l", dn.sigma_l,
                       "Plain filter: luminance edge-stopping, in standard deviations of the noise (default 1.5)")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_positive);
   denoise->add_flag("--features", dn.features,
                     "Plain filter: also stop at edges in the albedo, normal and depth AOVs (off: they measured worse "
                     "on the fires)");
@@ -170,7 +203,10 @@ int main(int argc, char** argv) {
     if (*denoise) {
       // The plain filter's settings ask for the plain filter.
       dn.no_guide = dn.no_guide || denoise->count("--iterations") + denoise->count("--sigma-l") + denoise->count("--features") > 0;
-      return run_denoise(dn);
+      const int status = run_denoise(dn, g_cancel);
+      if (g_signal == SIGINT) return 130;
+      if (g_signal == SIGTERM) return 143;
+      return status;
     }
   } catch (const InputError& e) {
     std::cerr << "pyrolume: " << e.what() << "\n";

@@ -1,5 +1,7 @@
 #pragma once
 // Blackbody emission: Planck's law -> CIE XYZ -> linear sRGB (docs/blackbody.md).
+#include <filesystem>
+#include <functional>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -68,12 +70,17 @@ std::optional<BlackbodyMode> parse_blackbody_mode(std::string_view name);
 // `pyrolume blackbody`: prints CSV "kelvin,x,y,r,g,b" to `out` for T = from_k,
 // from_k + step_k, ... up to and including to_k (x, y: the CIE xy of the spectrum
 // for the observer, `nan` where it is zero; r, g, b: the mode's linear sRGB). With
-// png_path non-empty it also writes the swatch strip there (seed colours). Bad
+// png_path non-empty it also writes the swatch strip there (seed colours), through
+// `write_output` (the CLI passes write_file_atomic, which every output goes
+// through: host/color does not write files itself). Bad
 // arguments (NaN/Inf, negative, from > to, step <= 0, observer not 2|10, more than
 // kMaxBlackbodyRows rows, more swatches than the strip takes, an unwritable PNG
 // path): one line to `err`, nothing to `out`, returns 2. Otherwise returns 0.
 inline constexpr long kMaxBlackbodyRows = 1000000;
+using OutputWriter =
+    std::function<void(const std::filesystem::path&, const std::function<void(std::ostream&)>& write)>;
 int run_blackbody_command(double from_k, double to_k, double step_k, BlackbodyMode mode, int observer,
-                          const std::string& png_path, std::ostream& out, std::ostream& err);
+                          const std::string& png_path, std::ostream& out, std::ostream& err,
+                          const OutputWriter& write_output);
 
 }  // namespace pyrolume::color

@@ -23,7 +23,8 @@ std::string num(double v, const char* fmt) {
 }  // namespace
 
 int run_blackbody_command(double from_k, double to_k, double step_k, BlackbodyMode mode, int observer,
-                          const std::string& png_path, std::ostream& out, std::ostream& err) {
+                          const std::string& png_path, std::ostream& out, std::ostream& err,
+                          const OutputWriter& write_output) {
   auto bad = [&](const std::string& key, const std::string& reason) {
     err << "blackbody: " << key << ": " << reason << "\n";
     return 2;
@@ -55,7 +56,8 @@ int run_blackbody_command(double from_k, double to_k, double step_k, BlackbodyMo
       return bad("--png", std::to_string(temperatures.size()) + " temperatures, the strip takes at most " +
                               std::to_string(kMaxSwatches));
     try {
-      write_swatch_strip_png(png_path, render_swatch_strip(temperatures, observer));
+      const SwatchStrip strip = render_swatch_strip(temperatures, observer);
+      write_output(png_path, [&](std::ostream& os) { encode_swatch_strip_png(os, strip); });
     } catch (const std::exception& e) {
       return bad("--png", e.what());
     }

@@ -3,12 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
+#include <ostream>
 #include <stdexcept>
 #include <string>
-#include <system_error>
-
-#include <unistd.h>
 
 // stb_image_write's implementation is compiled once, in host/image/StbImpl.cpp.
 #include <stb_image_write.h>
@@ -112,34 +109,13 @@ SwatchStrip render_swatch_strip(const std::vector<double>& temperatures_k, int o
 
 namespace {
 void write_to_stream(void* context, void* data, int size) {
-  static_cast<std::ofstream*>(context)->write(static_cast<const char*>(data), size);
+  static_cast<std::ostream*>(context)->write(static_cast<const char*>(data), size);
 }
 }  // namespace
 
-void write_swatch_strip_png(const std::filesystem::path& path, const SwatchStrip& strip) {
-  namespace fs = std::filesystem;
-  // Write beside the destination, then rename: a failed run leaves no partial PNG.
-  const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
-  std::string tmp_name = ".";  // built with += : GCC 12 warns falsely (-Wrestrict) on "." + string
-  tmp_name += path.filename().string();
-  tmp_name += ".tmp-" + std::to_string(::getpid());
-  const fs::path tmp = dir / tmp_name;
-  bool ok = false;
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (f) {
-      ok = stbi_write_png_to_func(write_to_stream, &f, strip.width, strip.height, 3, strip.rgb.data(),
-                                  strip.width * 3) != 0;
-      f.flush();
-      ok = ok && bool(f);
-    }
-  }
-  std::error_code ec;
-  if (ok) fs::rename(tmp, path, ec);
-  if (!ok || ec) {
-    fs::remove(tmp, ec);
-    throw std::runtime_error(path.string() + ": cannot write PNG");
-  }
+void encode_swatch_strip_png(std::ostream& os, const SwatchStrip& strip) {
+  if (!stbi_write_png_to_func(write_to_stream, &os, strip.width, strip.height, 3, strip.rgb.data(), strip.width * 3))
+    throw std::runtime_error("cannot encode the swatch strip as PNG");
 }
 
 }  // namespace pyrolume::color

@@ -3,7 +3,7 @@
 // seed-normalised colour (largest channel 1) display-encoded as sRGB, with its
 // temperature written underneath. The picture a person checks first.
 #include <cstdint>
-#include <filesystem>
+#include <iosfwd>
 #include <optional>
 #include <vector>
 
@@ -22,9 +22,9 @@ inline constexpr int kMaxSwatches = 16384;
 SwatchStrip render_swatch_strip(const std::vector<double>& temperatures_k, int observer = 2,
                                 std::optional<double> adapt_to_k = std::nullopt);
 
-// Writes the strip as PNG through a temp file in the destination folder that is
-// renamed over `path` only once complete. Throws std::runtime_error naming the
-// path if it cannot be written.
-void write_swatch_strip_png(const std::filesystem::path& path, const SwatchStrip& strip);
+// Encodes the strip as PNG into `os` (the caller picks the file: the CLI
+// writes it through write_file_atomic). Throws std::runtime_error if the
+// encoder fails.
+void encode_swatch_strip_png(std::ostream& os, const SwatchStrip& strip);
 
 }  // namespace pyrolume::color

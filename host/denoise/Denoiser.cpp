@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <vector>
 
@@ -26,11 +27,42 @@ float alpha_or_1(const Image& img, size_t i) { return img.has_alpha() ? finite_o
 // perfectly correlated in blackbody light, so take the bound of full
 // correlation, Var(l) ≤ (Σ w_c σ_c)², which can only make the filter stop at
 // fewer edges, never more.
-float luminance_variance(const float* var) {
-  const float w[3] = {0.2126f, 0.7152f, 0.0722f};
-  float s = 0.0f;
-  for (int c = 0; c < 3; ++c) s += w[c] * std::sqrt(std::max(finite_or_0(var[c]), 0.0f));
-  return s * s;
+// In double, then scaled by inv_scale² (radiance_scale): the square of a
+// sum of standard deviations near 1e19 would overflow a float.
+float luminance_variance(const float* var, double inv_scale) {
+  const double w[3] = {0.2126, 0.7152, 0.0722};
+  double s = 0.0;
+  for (int c = 0; c < 3; ++c) s += w[c] * std::sqrt(std::max(double(finite_or_0(var[c])), 0.0));
+  return float(s * s * inv_scale * inv_scale);
+}
+
+// The filter squares radiance differences and sums weighted radiance over
+// 25 taps (and the guided one divides by albedos down to 0.02) in single
+// precision: past ~1e19 that overflows to infinity and then to NaN (∞ − ∞,
+// ∞/∞), which spread through every later pass. So it filters radiance
+// divided by a power of two that brings the image's largest finite radiance,
+// and the square root of its largest variance, to at most kMaxFilteredRadiance,
+// and multiplies the result back. A power of two divides exactly, and an image
+// already in range (every render of a scene within the scene format's limits)
+// is filtered exactly as before.
+constexpr double kMaxFilteredRadiance = 0x1p48;  // ~2.8e14: squares ×2500 (albedo floor) ×25 taps stay below 3.4e38
+
+double largest_finite_abs(const std::vector<float>& v, double m = 0.0) {
+  for (float x : v)
+    if (std::isfinite(x)) m = std::max(m, double(std::abs(x)));
+  return m;
+}
+
+// The power of two the radiance is divided by (1 for an image in range).
+double radiance_scale(const Image& img, bool guided) {
+  double m = std::sqrt(largest_finite_abs(img.variance));
+  m = largest_finite_abs(img.rgb, m);
+  if (guided)
+    for (const std::vector<float>* layer : {&img.aovs.emission, &img.aovs.scatter, &img.aovs.surface,
+                                            &img.aovs.background, &img.aovs.guide})
+      m = largest_finite_abs(*layer, m);
+  if (m <= kMaxFilteredRadiance) return 1.0;
+  return std::ldexp(1.0, int(std::ceil(std::log2(m / kMaxFilteredRadiance))));
 }
 
 // |∇depth| at each pixel: the larger one-sided difference towards a neighbour
@@ -129,6 +161,15 @@ std::vector<vec4> Denoiser::filter(int width, int height, const std::vector<vec4
   return out;
 }
 
+void Denoiser::check_size(int width, int height, const std::string& name) const {
+  const uint64_t bytes = uint64_t(width) * uint64_t(height) * sizeof(vec4);
+  const VkDeviceSize range = std::min<VkDeviceSize>(ctx_.properties().limits.maxStorageBufferRange, ctx_.max_allocation_size());
+  if (bytes > range)
+    throw input_error(name, "", std::to_string(width) + " x " + std::to_string(height) +
+                                    " pixels are too many to denoise on this device (" + std::to_string(bytes) +
+                                    " bytes per buffer exceed its storage-buffer range of " + std::to_string(range) + ")");
+}
+
 Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std::string& name) {
   const size_t n = noisy.pixel_count();
   if (noisy.width <= 0 || noisy.height <= 0 || noisy.rgb.size() != n * 3)
@@ -136,18 +177,18 @@ Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std
   if (!noisy.has_variance() || noisy.variance.size() != n * 3)
     throw std::logic_error("denoise: the image has no variance (render --variance)");
   if (options.iterations < 0 || options.iterations > 12) throw std::logic_error("denoise: iterations out of range");
-  const VkDeviceSize range = std::min<VkDeviceSize>(ctx_.properties().limits.maxStorageBufferRange, ctx_.max_allocation_size());
-  if (n * sizeof(vec4) > range)
-    throw input_error(name, "", std::to_string(noisy.width) + " x " + std::to_string(noisy.height) +
-                                    " pixels are too many to denoise on this device (" + std::to_string(n * sizeof(vec4)) +
-                                    " bytes per buffer exceed its storage-buffer range of " + std::to_string(range) + ")");
+  for (const float sigma : {options.sigma_l, options.sigma_n, options.sigma_z, options.sigma_a})
+    if (!std::isfinite(sigma) || !(sigma > 0.0f)) throw std::logic_error("denoise: an edge-stopping sigma is not finite and positive");
+  check_size(noisy.width, noisy.height, name);
 
   // The luminance variance, and the features (all three groups present, or
   // none: Aovs says all or nothing).
-  std::vector<float> var(n);
-  for (size_t i = 0; i < n; ++i) var[i] = luminance_variance(&noisy.variance[i * 3]);
   const Aovs& a = noisy.aovs;
   const bool guided = denoise_uses_guide(noisy, options);
+  const double scale = radiance_scale(noisy, guided);
+  const float inv = float(1.0 / scale);  // a power of two: exact
+  std::vector<float> var(n);
+  for (size_t i = 0; i < n; ++i) var[i] = luminance_variance(&noisy.variance[i * 3], inv);
   const bool features = guided || denoise_uses_features(noisy, options);
   Features f;
   if (features) {
@@ -164,15 +205,15 @@ Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std
   std::vector<vec4> color(n);
   if (!guided) {
     for (size_t i = 0; i < n; ++i)
-      color[i] = vec4(finite_or_0(noisy.rgb[i * 3]), finite_or_0(noisy.rgb[i * 3 + 1]), finite_or_0(noisy.rgb[i * 3 + 2]),
-                      alpha_or_1(noisy, i));
+      color[i] = vec4(finite_or_0(noisy.rgb[i * 3]) * inv, finite_or_0(noisy.rgb[i * 3 + 1]) * inv,
+                      finite_or_0(noisy.rgb[i * 3 + 2]) * inv, alpha_or_1(noisy, i));
     Pass p;
     p.iterations = options.iterations;
     p.flags = features ? (gpu::DENOISE_USE_NORMAL_DEPTH | gpu::DENOISE_USE_ALBEDO) : 0u;
     p.sigmas = vec4(options.sigma_l, options.sigma_n, options.sigma_z, options.sigma_a);
     color = filter(noisy.width, noisy.height, color, var, f, p);
   } else {
-    color = run_guided(noisy, var, f);
+    color = run_guided(noisy, var, f, inv);
   }
 
   Image out = make_image(noisy.width, noisy.height);
@@ -180,9 +221,22 @@ Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std
   out.spp_target = noisy.spp_target;
   out.transparent = noisy.transparent;
   if (noisy.has_alpha()) out.alpha.resize(n);
+  size_t nonfinite = 0;
   for (size_t i = 0; i < n; ++i) {
-    for (int c = 0; c < 3; ++c) out.rgb[i * 3 + c] = color[i][c];
+    for (int c = 0; c < 3; ++c) {
+      out.rgb[i * 3 + c] = float(double(color[i][c]) * scale);
+      nonfinite += !std::isfinite(out.rgb[i * 3 + c]);
+    }
     if (noisy.has_alpha()) out.alpha[i] = color[i].w;
+    nonfinite += !std::isfinite(color[i].w);
+  }
+  // Never written: an image with a value the filter could not represent.
+  if (nonfinite > 0) {
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "%.3g", scale * kMaxFilteredRadiance);
+    throw input_error(name, "", "the denoised image would have " + std::to_string(nonfinite) +
+                                    " non-finite values (its radiance was filtered in a range up to " + limit +
+                                    "); nothing is denoised");
   }
   return out;
 }
@@ -202,7 +256,8 @@ Image Denoiser::run(const Image& noisy, const DenoiseOptions& options, const std
 // much and that cost the most time: the surface pass all but surfaces, the
 // scatter pass those with no scatter, alpha or guide alpha (open sky):
 // together a third of the time at 1080p (docs/benchmarks.md "Denoiser").
-std::vector<vec4> Denoiser::run_guided(const Image& noisy, const std::vector<float>& var, const Features& f) {
+std::vector<vec4> Denoiser::run_guided(const Image& noisy, const std::vector<float>& var, const Features& f,
+                                       float inv) {
   const size_t n = noisy.pixel_count();
   const Aovs& a = noisy.aovs;
   const int w = noisy.width, h = noisy.height;
@@ -211,15 +266,15 @@ std::vector<vec4> Denoiser::run_guided(const Image& noisy, const std::vector<flo
   std::vector<vec4> E(n), S(n), R(n), albedo(n);
   std::vector<float> var_s(n);
   for (size_t i = 0; i < n; ++i) {
-    g.guide[i] = vec4(finite_or_0(a.guide[i * 3]), finite_or_0(a.guide[i * 3 + 1]), finite_or_0(a.guide[i * 3 + 2]),
-                      finite_or_0(a.guide_alpha[i]));
+    g.guide[i] = vec4(finite_or_0(a.guide[i * 3]) * inv, finite_or_0(a.guide[i * 3 + 1]) * inv,
+                      finite_or_0(a.guide[i * 3 + 2]) * inv, finite_or_0(a.guide_alpha[i]));
     vec4 al(0.0f);
     for (int c = 0; c < 3; ++c) {
       const size_t k = i * 3 + c;
-      E[i][c] = finite_or_0(a.emission[k]) + finite_or_0(a.background[k]);
+      E[i][c] = finite_or_0(a.emission[k]) * inv + finite_or_0(a.background[k]) * inv;
       al[c] = std::max(finite_or_0(a.albedo[k]), kMinAlbedo);
-      S[i][c] = finite_or_0(a.surface[k]) / al[c];
-      R[i][c] = finite_or_0(a.scatter[k]);
+      S[i][c] = finite_or_0(a.surface[k]) * inv / al[c];
+      R[i][c] = finite_or_0(a.scatter[k]) * inv;
     }
     albedo[i] = al;
     R[i][3] = alpha_or_1(noisy, i);
@@ -256,14 +311,22 @@ std::vector<vec4> Denoiser::run_guided(const Image& noisy, const std::vector<flo
   return out;
 }
 
-Image DenoiserSession::run(const Image& noisy, const DenoiseOptions& options, const std::string& name) {
+Denoiser& DenoiserSession::open(int device_index) {
   if (!denoiser_) {
     vk::Context::Options o;
-    o.device_index = options.device_index;
+    o.device_index = device_index;
     ctx_ = std::make_unique<vk::Context>(o);
     denoiser_ = std::make_unique<Denoiser>(*ctx_);
   }
-  return denoiser_->run(noisy, options, name);
+  return *denoiser_;
+}
+
+Image DenoiserSession::run(const Image& noisy, const DenoiseOptions& options, const std::string& name) {
+  return open(options.device_index).run(noisy, options, name);
+}
+
+void DenoiserSession::check_size(int width, int height, int device_index, const std::string& name) {
+  open(device_index).check_size(width, height, name);
 }
 
 static bool has_features(const Image& img) {

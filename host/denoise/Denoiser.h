@@ -55,9 +55,18 @@ class Denoiser {
   // `noisy` must have variance (render --variance); the result has the
   // denoised RGB and alpha (filtered with the same weights: premultiplied RGB
   // and A stay consistent), the noisy image's spp and transparency, and no
-  // variance or AOVs. Non-finite input values are read as 0. An image too
-  // large for the device's storage buffers is an InputError naming `name`.
+  // variance or AOVs. Non-finite input values are read as 0. Radiance is
+  // filtered divided by a power of two that keeps single precision finite
+  // (any finite input works), and the result is checked finite: one that is
+  // not is an InputError naming `name`, never written. An image too large
+  // for the device's storage buffers is an InputError naming `name`.
   Image run(const Image& noisy, const DenoiseOptions& options, const std::string& name = "image");
+
+  // Throws that InputError for a width×height image too large for this
+  // device's storage buffers (every buffer of the filter holds at most a vec4
+  // per pixel): known from the film size alone, so a render can be refused
+  // before it is spent.
+  void check_size(int width, int height, const std::string& name) const;
 
  private:
   // The guided filter's settings (measured: docs/benchmarks.md "Denoiser").
@@ -78,7 +87,8 @@ class Denoiser {
   };
   std::vector<gpu::vec4> filter(int width, int height, const std::vector<gpu::vec4>& color,
                                 const std::vector<float>& var, const Features& f, const Pass& pass);
-  std::vector<gpu::vec4> run_guided(const Image& noisy, const std::vector<float>& var, const Features& f);
+  // `inv`: the radiance scale run() filters at (a power of two, Denoiser.cpp radiance_scale).
+  std::vector<gpu::vec4> run_guided(const Image& noisy, const std::vector<float>& var, const Features& f, float inv);
 
   vk::Context& ctx_;
   vk::ComputePipeline pipeline_;
@@ -91,8 +101,14 @@ class Denoiser {
 class DenoiserSession {
  public:
   Image run(const Image& noisy, const DenoiseOptions& options, const std::string& name = "image");
+  // Opens the device (as run() would, on `device_index`) and checks that a
+  // width×height image fits it (Denoiser::check_size): render --denoise calls
+  // it before rendering.
+  void check_size(int width, int height, int device_index, const std::string& name);
 
  private:
+  Denoiser& open(int device_index);
+
   std::unique_ptr<vk::Context> ctx_;
   std::unique_ptr<Denoiser> denoiser_;
 };

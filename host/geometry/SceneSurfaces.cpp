@@ -14,10 +14,7 @@ namespace pyrolume::geometry {
 
 namespace {
 
-// Surfaces are intersected in float on the GPU: coordinates up to 1e18 keep
-// the products of two (cross products, plane distances) within float range.
-constexpr double kMaxCoordinate = 1e18;
-
+// kMaxCoordinate (scene/Scene.h): surfaces are intersected in float on the GPU.
 void check_coordinates(const Scene& scene, const std::string& key, const glm::dvec3& p, const std::string& what) {
   if (std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate && std::abs(p.z) <= kMaxCoordinate) return;
   char buf[200];

@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "util/Error.h"
@@ -85,34 +86,99 @@ struct Dest {
   int fd = -1;  // a Stream that is one of this process's descriptors
 };
 
-// /dev/stdout, /dev/stderr, /dev/fd/N, /proc/self/fd/N: this process's own
-// descriptor N (else -1). Written through that descriptor itself, so what is
-// written shares its offset with everything else the command prints there
-// (reopening the path would start a new offset at 0 in a redirected file).
-int own_descriptor(const fs::path& dest) {
-  const std::string s = dest.lexically_normal().string();
-  if (s == "/dev/stdout") return 1;
-  if (s == "/dev/stderr") return 2;
-  for (const char* prefix : {"/dev/fd/", "/proc/self/fd/"}) {
-    const std::string p = prefix;
-    if (s.size() > p.size() && s.compare(0, p.size(), p) == 0 &&
-        s.find_first_not_of("0123456789", p.size()) == std::string::npos && s.size() - p.size() < 6)
-      return std::stoi(s.substr(p.size()));
+// A descriptor named as a path: /dev/stdout, /dev/stderr, /dev/stdin,
+// /dev/fd/N, /proc/self/fd/N, /proc/PID/fd/N, directly or through symlinks.
+struct DescriptorLink {
+  bool own = false;  // one of this process's descriptors (else another process's)
+  int fd = -1;
+  fs::path via;      // the spelling that named it, for messages
+};
+
+// The descriptor number in "PREFIX/N" (else -1).
+int descriptor_number(const std::string& s, const std::string& prefix) {
+  if (s.size() <= prefix.size() || s.size() - prefix.size() > 6 || s.compare(0, prefix.size(), prefix) != 0 ||
+      s.find_first_not_of("0123456789", prefix.size()) != std::string::npos)
+    return -1;
+  return std::stoi(s.substr(prefix.size()));
+}
+
+// Whether one spelling (absolute, normal) names a descriptor.
+std::optional<DescriptorLink> descriptor_spelling(const fs::path& p) {
+  const std::string s = p.string();
+  if (s == "/dev/stdin") return DescriptorLink{true, 0, p};
+  if (s == "/dev/stdout") return DescriptorLink{true, 1, p};
+  if (s == "/dev/stderr") return DescriptorLink{true, 2, p};
+  for (const char* own : {"/dev/fd/", "/proc/self/fd/", "/proc/thread-self/fd/"})
+    if (const int fd = descriptor_number(s, own); fd >= 0) return DescriptorLink{true, fd, p};
+  // /proc/PID/fd/N: ours when PID is this process (/proc/self resolved).
+  const std::string proc = "/proc/";
+  if (s.compare(0, proc.size(), proc) != 0) return std::nullopt;
+  const size_t slash = s.find('/', proc.size());
+  if (slash == std::string::npos) return std::nullopt;
+  const std::string pid = s.substr(proc.size(), slash - proc.size());
+  if (pid.empty() || pid.size() > 9 || pid.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
+  const int fd = descriptor_number(s, s.substr(0, slash) + "/fd/");
+  if (fd < 0) return std::nullopt;
+  return DescriptorLink{std::stol(pid) == long(::getpid()), fd, p};
+}
+
+// Whether `dest`, or a symlink on the way from it to a file, names a
+// descriptor. Each step is taken as written and with its folder resolved
+// (/dev/fd is itself a link to /proc/self/fd, which is /proc/PID/fd).
+std::optional<DescriptorLink> descriptor_link(const fs::path& dest) {
+  fs::path p = dest;
+  for (int hops = 0; hops <= 40; ++hops) {
+    std::error_code ec;
+    const fs::path spelled = fs::absolute(p, ec).lexically_normal();
+    if (auto d = descriptor_spelling(spelled)) return d;
+    const fs::path folder = fs::canonical(spelled.parent_path(), ec);
+    if (!ec)
+      if (auto d = descriptor_spelling(folder / spelled.filename())) return d;
+    if (!fs::is_symlink(fs::symlink_status(p, ec))) return std::nullopt;
+    const fs::path target = fs::read_symlink(p, ec);
+    if (ec) return std::nullopt;
+    p = target.is_absolute() ? target : p.parent_path() / target;
+  }
+  return std::nullopt;  // a loop: stat reports it
+}
+
+// The standard stream (1 or 2) open for writing on the file `st` describes,
+// else -1: an output that is the log stdout was redirected into.
+int standard_stream_on(const struct stat& st) {
+  for (int fd : {1, 2}) {
+    struct stat fst {};
+    const int flags = ::fcntl(fd, F_GETFL);
+    if (flags < 0 || (flags & O_ACCMODE) == O_RDONLY || ::fstat(fd, &fst) != 0) continue;
+    if (fst.st_dev == st.st_dev && fst.st_ino == st.st_ino) return fd;
   }
   return -1;
 }
 
-bool under_system_folder(const fs::path& p) {
-  const std::string s = p.string();
-  return s.rfind("/proc/", 0) == 0 || s.rfind("/dev/", 0) == 0 || s.rfind("/sys/", 0) == 0;
+std::string file_kind(mode_t mode) {
+  return S_ISSOCK(mode) ? "a socket" : S_ISBLK(mode) ? "a block device" : "not a regular file";
 }
 
-// Refuses what may never take an output: a folder, a socket, a block device.
+// What a destination is, decided by the type of the file it leads to (never
+// by where its path lies: /dev/shm is a tmpfs of regular files):
+//  - one of this process's descriptors (/dev/stdout, /proc/self/fd/1, a
+//    symlink to either): written through that descriptor, at its offset, so
+//    what it is open on (a terminal, a pipe, the log the shell redirected
+//    into) is added to, never replaced;
+//  - a regular file that stdout or stderr is open on: the same;
+//  - a FIFO or character device: written in place;
+//  - a regular file (or a missing one): replaced by rename;
+//  - a folder, a socket, a block device, another process's open file: refused.
 Dest resolve_dest(const fs::path& dest) {
   const std::string file = dest.string();
-  if (const int fd = own_descriptor(dest); fd >= 0) {
-    if (::fcntl(fd, F_GETFD) < 0) throw input_error(file, "", "descriptor " + std::to_string(fd) + " is not open");
-    return {dest, DestKind::Stream, fd};
+  const std::optional<DescriptorLink> link = descriptor_link(dest);
+  if (link && link->own) {
+    const int flags = ::fcntl(link->fd, F_GETFL);
+    if (flags < 0) throw input_error(file, "", "descriptor " + std::to_string(link->fd) + " is not open");
+    if ((flags & O_ACCMODE) == O_RDONLY)
+      throw input_error(file, "", "descriptor " + std::to_string(link->fd) + " is open for reading only");
+    struct stat st {};
+    if (::fstat(link->fd, &st) == 0 && S_ISDIR(st.st_mode)) throw input_error(file, "", "is a folder, not a file");
+    return {dest, DestKind::Stream, link->fd};
   }
   struct stat st {};
   if (::stat(dest.c_str(), &st) != 0) {
@@ -122,19 +188,14 @@ Dest resolve_dest(const fs::path& dest) {
   }
   if (S_ISDIR(st.st_mode)) throw input_error(file, "", "is a folder, not a file");
   if (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode)) return {dest, DestKind::Stream};
-  if (!S_ISREG(st.st_mode))
-    throw input_error(file, "",
-                      std::string("is ") + (S_ISSOCK(st.st_mode) ? "a socket" : S_ISBLK(st.st_mode) ? "a block device"
-                                                                                                 : "not a regular file") +
-                          "; only a regular file is replaced");
+  if (!S_ISREG(st.st_mode)) throw input_error(file, "", "is " + file_kind(st.st_mode) + "; only a regular file is replaced");
+  if (link)  // /proc/PID/fd/N of another process: its open file is not ours to replace
+    throw input_error(file, "", "leads through " + link->via.string() +
+                                    " to a file another process has open; name the file itself");
+  if (const int fd = standard_stream_on(st); fd >= 0) return {dest, DestKind::Stream, fd};
   std::error_code ec;
   fs::path target = fs::canonical(dest, ec);
   if (ec) throw input_error(file, "", "cannot resolve: " + ec.message());
-  // /dev/stdout, /dev/fd/N, /proc/self/fd/N lead to a regular file when the
-  // shell redirected into one: that file is open already, so it is appended
-  // to, not replaced (and nothing is ever renamed into /dev or /proc).
-  if (under_system_folder(target) || under_system_folder(fs::absolute(dest, ec)))
-    return {dest, DestKind::Stream};
   return {target, DestKind::Regular};
 }
 

@@ -5,13 +5,20 @@
 // regular file (or a missing path) is ever replaced. Usable for any output:
 // images, stats JSON, CSV, checkpoints.
 //
-// What a destination may be:
-//  - missing or a regular file: written to a hidden temp file beside it, then
-//    renamed over it (atomic on POSIX). A symlink is followed: the file it
-//    points to is replaced and the link stays.
-//  - a FIFO or a character device (/dev/null, /dev/stdout on a pipe or a
-//    terminal): written in place, in one go, since neither can be renamed over.
-//  - anything else (a folder, a socket, a block device): refused.
+// What a destination is follows from the type of the file it leads to, never
+// from where its path lies (/dev/shm is a tmpfs of regular files):
+//  - missing or a regular file, wherever it lives: written to a hidden temp
+//    file beside it, then renamed over it (atomic on POSIX). A symlink is
+//    followed: the file it points to is replaced and the link stays.
+//  - a FIFO or a character device (/dev/null, a terminal): written in place,
+//    in one go, since neither can be renamed over.
+//  - one of this process's descriptors (/dev/stdout, /dev/fd/N,
+//    /proc/self/fd/N, directly or through symlinks), or a regular file that
+//    stdout or stderr is open on (the log they were redirected into): written
+//    through that descriptor at its offset, so what was printed there stays
+//    and nothing is renamed over the log.
+//  - anything else (a folder, a socket, a block device, a file another
+//    process has open reached through /proc/PID/fd): refused.
 #include <sys/types.h>
 
 #include <cstdint>

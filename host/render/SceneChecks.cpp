@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "color/Blackbody.h"
 #include "color/EmissionModel.h"
+#include "light/AnalyticLights.h"
 #include "util/Error.h"
 #include "util/Math.h"
 
@@ -41,10 +43,46 @@ void check_emitted_radiance(const std::string& file, const std::string& at, doub
                           ", the most a render can sum in float without overflowing; lower emission.scale");
 }
 
+// Whether v, as the GPU stores it (in float), is within kMaxEmittedRadiance:
+// a light of exactly 1e12 is accepted (1e12 rounds to 1e12f). False for NaN.
+bool within_emission_bound(double v) {
+  return v <= double(std::numeric_limits<float>::max()) && float(v) <= kMaxEmittedRadiance;
+}
+
+// An analytic light's value (scale × rgb, or scale × the luminance-1
+// blackbody colour), and a disc sun's radiance, within kMaxEmittedRadiance:
+// the bound media have, so that no sample a light gives can overflow float.
+void check_light_value(const std::string& file, size_t index, const Light& l) {
+  const std::string at = "lights[" + std::to_string(index) + "]";
+  const char* value_key = l.type == Light::Type::Distant  ? "irradiance"
+                          : l.type == Light::Type::Sphere ? "radiance"
+                                                          : "intensity";
+  const double value = max3(light_value(l));
+  if (!within_emission_bound(value)) {
+    // Name the key that carries the excess: the rgb value when it alone is
+    // past the bound, else scale.
+    const bool rgb_alone = l.rgb && !within_emission_bound(max3(*l.rgb));
+    const std::string what = l.rgb ? std::string(value_key) + " (" + sci(max3(*l.rgb)) + ")"
+                                   : "the luminance-1 colour of temperature_k (" + sci(value / l.scale) + ")";
+    throw input_error(file, at + "." + (rgb_alone ? value_key : "scale"),
+                      "scale " + sci(l.scale) + " × " + what + " gives " + sci(value) + ", beyond " +
+                          sci(kMaxEmittedRadiance) + ", the most a render can sum in float without overflowing; lower " +
+                          (rgb_alone ? value_key : "scale"));
+  }
+  if (l.type != Light::Type::Distant || l.is_delta()) return;
+  const double radiance = max3(disc_radiance(l));
+  if (!within_emission_bound(radiance))
+    throw input_error(file, at + ".angle_deg",
+                      "the disc's radiance, irradiance / (π sin²(angle_deg/2)), is " + sci(radiance) + ", beyond " +
+                          sci(kMaxEmittedRadiance) + ", the most a render can sum in float without overflowing; "
+                          "widen angle_deg or lower irradiance");
+}
+
 }  // namespace
 
 void check_scene_ranges(const Scene& scene) {
   const std::string file = scene.file.string();
+  for (size_t i = 0; i < scene.lights.size(); ++i) check_light_value(file, i, scene.lights[i]);
   for (size_t i = 0; i < scene.media.size(); ++i) {
     const Medium& m = scene.media[i];
     const std::string at = "media[" + std::to_string(i) + "]";

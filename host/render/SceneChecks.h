@@ -15,7 +15,8 @@ namespace pyrolume {
 // Every medium's emission: emission.scale times the brightest colour it can
 // take (its rgb or its temperature_k's blackbody colour; a grid's, once it is
 // loaded, in check_loaded_medium) must stay within kMaxEmittedRadiance (color/EmissionModel.h);
-// σa and σs (times density_scale) within kMaxSigma.
+// σa and σs (times density_scale) within kMaxSigma. Every analytic light's
+// value (and a disc sun's radiance) within kMaxEmittedRadiance too.
 void check_scene_ranges(const Scene& scene);
 
 // What a grid medium must satisfy once loaded: its majorant optical depth

@@ -217,6 +217,21 @@ struct Shape {
   std::filesystem::path texture;  // empty: constant albedo
 };
 
+// Positions that the renderers intersect in float on the GPU (surface
+// vertices, spheres, planes, analytic lights) lie within ±kMaxCoordinate on
+// every axis: the products of two coordinates (cross products, squared
+// distances, a sphere's r²) then stay within float range.
+inline constexpr double kMaxCoordinate = 1e18;
+
+// The most analytic lights a scene may have: every ray loops over all of them
+// (the discs it may escape into, the spheres it may hit), so each light costs
+// every ray (docs/scene-format.md "lights"; measured in docs/robustness.md).
+inline constexpr size_t kMaxLights = 256;
+// A distant light's angle_deg is 0 (a delta light) or at least this: a
+// narrower disc is finer than a float direction resolves (~6e-8 rad), and its
+// 1 − cos θ underflows float long before its angle does.
+inline constexpr double kMinDiscAngleDeg = 1e-4;
+
 // A light of the scene's `lights` array (docs/lights.md "Analytic lights").
 // Its value is scale × rgb, or scale × the blackbody colour of luminance 1 at
 // temperature_k (light_value, host/light/AnalyticLights.h).

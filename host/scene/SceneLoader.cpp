@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "color/EmissionModel.h"
 #include "scene/Scene.h"
 #include "util/Error.h"
 #include "util/InputFile.h"
@@ -185,6 +186,23 @@ class Reader {
   std::set<std::string> seen_;
 };
 
+// d scaled by its largest component: the same direction, of length in [1, √3],
+// so that [1e300, 1e300, 0] (whose length overflows to infinity) stays a
+// direction; nullopt for the zero vector.
+std::optional<glm::dvec3> scaled_direction(const glm::dvec3& d) {
+  const double largest = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+  if (!(largest > 0)) return std::nullopt;
+  return d / largest;
+}
+
+// Every coordinate of p within ±kMaxCoordinate, else an error naming `key`.
+void check_coordinate(Reader& r, const std::string& key, const glm::dvec3& p, const std::string& what) {
+  for (int i = 0; i < 3; ++i)
+    if (!(std::abs(p[i]) <= kMaxCoordinate))
+      r.fail(key, what + " reaches " + json(p[i]).dump() + ", beyond the ±" + json(kMaxCoordinate).dump() +
+                      " that float ray arithmetic keeps finite");
+}
+
 std::filesystem::path resolve(const std::filesystem::path& base, const std::string& p) {
   std::filesystem::path path(p);
   return path.is_absolute() ? path : (base / path).lexically_normal();
@@ -340,11 +358,9 @@ Shape read_shape(Reader r, const std::filesystem::path& base) {
     Reader pl = r.child("plane");
     s.center = pl.vec3("center", s.center);
     s.normal = pl.vec3("normal", s.normal);
-    // Scaled by its largest component first: [1e300, 1e300, 0] is a direction
-    // too, but its length overflows to infinity.
-    const double largest = std::max({std::abs(s.normal.x), std::abs(s.normal.y), std::abs(s.normal.z)});
-    if (!(largest > 0)) pl.fail("normal", "must not be zero");
-    s.normal /= largest;
+    const std::optional<glm::dvec3> n = scaled_direction(s.normal);
+    if (!n) pl.fail("normal", "must not be zero");
+    s.normal = *n;
     if (pl.has("size")) {
       const auto& v = pl.raw("size");
       if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number() || v[0].get<double>() < 0 ||
@@ -406,8 +422,12 @@ Light read_light(Reader r) {
                                                           : "intensity";
   if (r.has(value_key)) l.rgb = r.nonnegative_rgb(value_key, {});
   if (r.has("temperature_k")) {
+    // The blackbody range the renderers evaluate (color/EmissionModel.h):
+    // below it Planck's law underflows to black, above it overflows.
     const double t = r.number("temperature_k", 0.0);
-    if (!(t > 0)) r.fail("temperature_k", "must be > 0 kelvin");
+    if (!(t >= kEmissionMinK && t <= kEmissionMaxK))
+      r.fail("temperature_k", "must be in [" + json(kEmissionMinK).dump() + ", " + json(kEmissionMaxK).dump() +
+                                  "] kelvin, got " + json(t).dump());
     l.temperature_k = t;
   }
   if (l.rgb && l.temperature_k) r.fail(value_key, std::string("give either ") + value_key + " or temperature_k, not both");
@@ -415,21 +435,30 @@ Light read_light(Reader r) {
   l.scale = r.number("scale", 1.0);
   if (l.scale < 0) r.fail("scale", "must be >= 0");
   auto unit_direction = [&](const char* key) {
-    const glm::dvec3 d = r.vec3_required(key);
-    if (!(glm::length(d) > 0)) r.fail(key, "must not be zero");
-    return glm::normalize(d);
+    const std::optional<glm::dvec3> d = scaled_direction(r.vec3_required(key));
+    if (!d) r.fail(key, "must not be zero");
+    return glm::normalize(*d);
+  };
+  auto position = [&](const char* key) {
+    const glm::dvec3 p = r.vec3_required(key);
+    check_coordinate(r, key, p, "a coordinate");
+    return p;
   };
   switch (l.type) {
     case Light::Type::Distant:
       l.direction = unit_direction("direction");
       l.angle_deg = r.number("angle_deg", 0.0);
       if (!(l.angle_deg >= 0 && l.angle_deg < 180)) r.fail("angle_deg", "must be in [0, 180) degrees");
+      if (l.angle_deg > 0 && l.angle_deg < kMinDiscAngleDeg)
+        r.fail("angle_deg", "must be 0 (a delta light) or at least " + json(kMinDiscAngleDeg).dump() +
+                                " degrees (a narrower disc is finer than float directions resolve), got " +
+                                json(l.angle_deg).dump());
       break;
     case Light::Type::Point:
-      l.position = r.vec3_required("position");
+      l.position = position("position");
       break;
     case Light::Type::Spot:
-      l.position = r.vec3_required("position");
+      l.position = position("position");
       l.direction = unit_direction("direction");
       l.cone_deg = r.number("cone_deg", l.cone_deg);
       if (!(l.cone_deg > 0 && l.cone_deg <= 180)) r.fail("cone_deg", "must be in (0, 180] degrees");
@@ -440,10 +469,12 @@ Light read_light(Reader r) {
                                json(l.cone_deg).dump() + " < falloff_deg " + json(l.falloff_deg).dump());
       break;
     case Light::Type::Sphere:
-      l.center = r.vec3_required("center");
+      l.center = position("center");
       l.radius = r.number("radius", 0.0);
       if (!r.has("radius")) r.fail("radius", "missing required key");
       if (!(l.radius > 0)) r.fail("radius", "must be > 0");
+      // Its extent, as a sphere shape's: r² and |c ± r| stay within float.
+      check_coordinate(r, "radius", glm::abs(l.center) + l.radius, "the sphere's extent |center| + radius");
       break;
   }
   r.finish();
@@ -564,6 +595,9 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
   if (r.has("lights")) {
     const json& lights = r.raw("lights");
     if (!lights.is_array()) r.fail("lights", "expected an array");
+    if (lights.size() > kMaxLights)
+      r.fail("lights", std::to_string(lights.size()) + " lights, more than the " + std::to_string(kMaxLights) +
+                           " a scene may have (every ray loops over them); merge nearby lights");
     for (size_t k = 0; k < lights.size(); ++k)
       s.lights.push_back(read_light(Reader(lights[k], "lights[" + std::to_string(k) + "]", fname)));
     if (const std::optional<IntegratorConflict> c = integrator_conflict(s.integrator, !s.lights.empty()))

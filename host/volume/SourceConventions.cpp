@@ -155,8 +155,9 @@ void fit_temperature_mapping(SourceConvention& c, const std::string& file) {
     c.source = VolumeSource::Kelvin;
     c.fit_to_range = false;
     c.mapping = {1.0, 0.0, 100.0};
-    c.mapping_text = "T = " + c.temperature_grid + " K (its largest value, " + std::to_string(int(hottest)) +
-                     ", reads as kelvin)";
+    std::ostringstream s;  // not int(hottest): a forged 1e30 overflowed to -2147483648
+    s << "T = " << c.temperature_grid << " K (its largest value, " << hottest << ", reads as kelvin)";
+    c.mapping_text = s.str();
     return;
   }
   c.mapping.scale = kFittedHottestK / hottest;

@@ -43,14 +43,6 @@ std::vector<std::string> validate_openvdb_file(const std::filesystem::path& file
 // uncompressed grids (this build has neither Blosc nor ZIP for NanoVDB).
 void validate_nanovdb_file(const std::filesystem::path& file);
 
-// A NanoVDB grid buffer as read, before any accessor walks it: the grid and
-// tree headers, and every node offset an accessor follows (root tiles ->
-// upper -> lower -> leaf nodes) inside the buffer and 32-byte aligned, FpN
-// bit widths valid. Grids of types pyrolume does not read values of are only
-// checked up to the tree header. Throws InputError naming file and grid.
-void validate_nanovdb_grid(const nanovdb::GridHandle<nanovdb::HostBuffer>& handle, const std::string& file,
-                           const std::string& grid);
-
 // openvdb::initialize() exactly once per process (it registers the grid types
 // that io::File needs to read anything).
 void ensure_openvdb_initialized();

@@ -14,6 +14,7 @@
 #include <openvdb/openvdb.h>
 
 #include "util/Error.h"
+#include "volume/NanoVdbValidate.h"
 #include "volume/SourceConventions.h"
 #include "volume/SparseGrid.h"
 #include "volume/VdbFile.h"
@@ -291,7 +292,7 @@ VolumeFileInfo read_nanovdb_info(const std::string& file, bool values_asked, con
     } catch (const std::exception& e) {
       r.note = std::string("grid unreadable: ") + e.what();
     }
-    if (h) validate_nanovdb_grid(h, file, r.name);  // before any accessor follows its offsets
+    if (h) validate_nanovdb_grid(h, file, r.name, &md);  // before any accessor follows its offsets
     if (h) {
       if (auto* g = h.grid<float>()) nano_grid(*g, values, r);
       else if (auto* g = h.grid<double>()) nano_grid(*g, values, r);

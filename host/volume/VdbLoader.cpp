@@ -34,6 +34,7 @@
 
 #include "util/Error.h"
 #include "util/Memory.h"
+#include "volume/NanoVdbValidate.h"
 #include "volume/SparseGrid.h"
 #include "volume/VdbFile.h"
 
@@ -120,6 +121,7 @@ GridChoice choose_grids(const std::vector<GridEntry>& entries, const VolumeOptio
 }
 
 uint64_t max_dense_texels = uint64_t(1) << 32;
+uint64_t max_sparse_leaves = UINT32_MAX;
 constexpr uint64_t kHostBytesPerTexel = 12;  // 4 (float array) + 4 (texture copy) + 4 (its upload)
 
 int64_t floor_div(int64_t a, int64_t k) { return a >= 0 ? a / k : -((-a + k - 1) / k); }
@@ -262,6 +264,34 @@ class DenseBuilder {
   int k_;
 };
 
+// An allocation that failed inside OpenVDB or NanoVDB while a grid was read:
+// std::bad_alloc, or the std::runtime_error NanoVDB's HostBuffer throws for
+// it ("Pool::Pool malloc failed"), which named neither file nor grid. The
+// checks before each large allocation (DenseBuilder, require_sparse_memory,
+// the grid's size before nanovdb::io reads it) should leave nothing for this
+// to catch; it names the file and grid when a smaller allocation still fails.
+template <class F>
+auto within_memory(const std::string& file, const std::string& key, F&& read) -> decltype(read()) {
+  auto ran_out = [&] {
+    return input_error(file, key, "memory ran out while reading it (" + format_bytes(memory_available_bytes()) +
+                                      " left to this process); give it more memory or add \"downsample\": k to the medium");
+  };
+  try {
+    return read();
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw ran_out();
+  } catch (const std::runtime_error& e) {
+    const std::string w = e.what();
+    if (w.rfind("Pool::", 0) == 0 && (w.find("malloc failed") != std::string::npos ||
+                                      w.find("insufficient memory") != std::string::npos ||
+                                      w.find("allocation failed") != std::string::npos))
+      throw ran_out();
+    throw;
+  }
+}
+
 // The renderers map rays into the grid with these matrices (the GPU in
 // float): entries beyond kMaxMapEntry, or non-finite ones, lose the grid and
 // turn samples non-finite (a transform scale of 1e-300 gave voxels of 1e-300
@@ -382,6 +412,37 @@ bool keep_sparse(const VolumeOptions& m, const glm::i64vec3& bbox_dims, uint64_t
   return !fits || (dense > kSparseFromBytes && dense > 2 * sparse_bytes);
 }
 
+// Host bytes one leaf of a sparse grid takes while sparse_from_openvdb builds
+// it: the OpenVDB copy's leaf and its values, then the NanoVDB leaf.
+constexpr uint64_t kSparseLeafBytes =
+    sizeof(openvdb::FloatTree::LeafNodeType) + 512 * sizeof(float) + sizeof(nanovdb::NanoLeaf<float>);
+
+// Before sparse_from_openvdb allocates: every active tile becomes leaves of
+// voxels, so a few bytes of tiles (one active 4096³ root tile: 2^27 leaves,
+// over 500 GiB) can describe more than any host holds. The leaves it would
+// build, against what this process can still allocate; past it, one line
+// naming the file and grid instead of allocating into std::bad_alloc.
+template <class GridT>
+void require_sparse_memory(const GridT& grid, const std::string& file, Role role, const std::string& name) {
+  uint64_t tile_voxels = 0;
+  auto it = grid.tree().cbeginValueOn();
+  it.setMaxDepth(GridT::TreeType::ValueOnCIter::LEAF_DEPTH - 1);  // tiles only, not voxels
+  for (; it; ++it) {
+    const uint64_t n = it.getVoxelCount();
+    tile_voxels = tile_voxels > UINT64_MAX - n ? UINT64_MAX : tile_voxels + n;
+  }
+  const uint64_t leaves = uint64_t(grid.tree().leafCount()) + tile_voxels / 512;
+  std::ostringstream what;
+  what << "keeping it sparse (" << leaves << " leaves of 8^3 voxels";
+  if (tile_voxels) what << ", " << tile_voxels << " voxels of them in active tiles";
+  what << ")";
+  const std::string hint = "a \"downsample\": k loads it dense with 1/k^3 of the texels";
+  if (leaves > max_sparse_leaves)
+    throw input_error(file, role_key(role, name),
+                      what.str() + " takes more than the " + std::to_string(max_sparse_leaves) + " leaves a sparse grid may have; " + hint);
+  require_memory(file, role_key(role, name), what.str(), leaves * kSparseLeafBytes, hint);
+}
+
 // The same values as DenseBuilder stores (NaN/Inf -> 0, negative density -> 0,
 // inactive -> 0), kept in a NanoVDB float tree instead of a dense array: only
 // the nonzero active voxels are written, into a tree with background 0, and
@@ -399,6 +460,7 @@ DenseGrid sparse_from_openvdb(const GridT& grid, const VolumeOptions& m, Role ro
   if (dims.x > (1 << 30) || dims.y > (1 << 30) || dims.z > (1 << 30) || lo.x <= INT32_MIN + 1 || lo.y <= INT32_MIN + 1 ||
       lo.z <= INT32_MIN + 1 || hi.x >= INT32_MAX - 1 || hi.y >= INT32_MAX - 1 || hi.z >= INT32_MAX - 1)
     throw input_error(file, role_key(role, out.name), "active bounding box reaches the end of the index range");
+  require_sparse_memory(grid, file, role, out.name);
   openvdb::FloatGrid::Ptr tree_grid = openvdb::FloatGrid::create(0.0f);
   auto acc = tree_grid->getAccessor();
   ValueRules rules{role == Role::Density};
@@ -478,8 +540,10 @@ VolumeGrids load_openvdb(const VolumeOptions& m, bool need_temperature, const De
                       : dense_from_openvdb(*dg, m, role, file, out.warnings, limits);
       throw input_error(file, role_key(role, e.name), "is a " + g->valueType() + " grid; expected float or double");
     };  // the sparse tree is freed here, before the next grid is read
-    out.density = load(c.density, Role::Density);
-    if (c.temperature) out.temperature = load(*c.temperature, Role::Temperature);
+    out.density = within_memory(file, role_key(Role::Density, c.density.name), [&] { return load(c.density, Role::Density); });
+    if (c.temperature)
+      out.temperature = within_memory(file, role_key(Role::Temperature, c.temperature->name),
+                                      [&] { return load(*c.temperature, Role::Temperature); });
     f.close();
   } catch (const openvdb::Exception& e) {
     throw input_error(file, "", std::string("cannot read as OpenVDB: ") + e.what());
@@ -601,6 +665,10 @@ VolumeGrids load_nanovdb(const VolumeOptions& m, bool need_temperature, const De
   for (const auto& md : metas) entries.push_back({md.gridName, nanovdb::toStr(md.gridType)});
   const GridChoice c = choose_grids(entries, m, need_temperature, file, out.warnings);
   auto load = [&](const GridEntry& e, Role role) {
+    const auto listed = std::find_if(metas.begin(), metas.end(), [&](const auto& md) { return md.gridName == e.name; });
+    // nanovdb::io allocates the whole grid at once (validate_nanovdb_file
+    // checked its size against the file's).
+    if (listed != metas.end()) require_memory(file, role_key(role, e.name), "reading it", listed->gridSize);
     nanovdb::GridHandle<nanovdb::HostBuffer> h;
     try {
       h = nanovdb::io::readGrid<nanovdb::HostBuffer>(file, e.name);
@@ -610,7 +678,8 @@ VolumeGrids load_nanovdb(const VolumeOptions& m, bool need_temperature, const De
       throw input_error(file, role_key(role, e.name), std::string("cannot read NanoVDB grid: ") + ex.what());
     }
     if (!h) throw input_error(file, role_key(role, e.name), "cannot read NanoVDB grid");
-    validate_nanovdb_grid(h, file, e.name);  // before any accessor follows its offsets
+    // Before anything follows its offsets or walks its node tables.
+    validate_nanovdb_grid(h, file, e.name, listed != metas.end() ? &*listed : nullptr);
     out.tree_mem_bytes += h.size();
     const auto& nb = h.gridMetaData()->indexBBox();
     const auto* tree_data = h.gridMetaData();
@@ -636,14 +705,17 @@ VolumeGrids load_nanovdb(const VolumeOptions& m, bool need_temperature, const De
     if (sparse) throw input_error(file, role_key(role, e.name), "NanoVDB grid type " + e.type + " cannot be kept sparse");
     throw input_error(file, role_key(role, e.name), "NanoVDB grid type " + e.type + " is not supported");
   };
-  out.density = load(c.density, Role::Density);
-  if (c.temperature) out.temperature = load(*c.temperature, Role::Temperature);
+  out.density = within_memory(file, role_key(Role::Density, c.density.name), [&] { return load(c.density, Role::Density); });
+  if (c.temperature)
+    out.temperature = within_memory(file, role_key(Role::Temperature, c.temperature->name),
+                                    [&] { return load(*c.temperature, Role::Temperature); });
   return out;
 }
 
 }  // namespace
 
 void set_max_dense_texels(uint64_t texels) { max_dense_texels = std::min(texels, uint64_t(1) << 32); }
+void set_max_sparse_leaves(uint64_t leaves) { max_sparse_leaves = std::min<uint64_t>(leaves, UINT32_MAX); }
 
 VolumeGrids load_volume(const VolumeOptions& m, const DenseLimits& limits) {
   const std::string file = m.file.string();

@@ -37,4 +37,10 @@ std::string cold_temperature_warning(const DenseGrid& temperature, const Tempera
 // volume, and allocating it teaches them nothing.
 void set_max_dense_texels(uint64_t texels);
 
+// The most leaves a grid kept sparse may have once its active tiles are
+// voxelized (default 2^32 - 1, what NanoVDB's 32-bit node counts hold);
+// beyond it load_volume throws InputError. The fuzz targets lower it, as
+// set_max_dense_texels, to stay within libFuzzer's memory limit.
+void set_max_sparse_leaves(uint64_t leaves);
+
 }  // namespace pyrolume

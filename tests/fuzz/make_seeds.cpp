@@ -1,5 +1,5 @@
 // fuzz_seeds DIR: writes small generated seed inputs for the fuzz targets into
-// DIR/{vdb,image,obj,scene}/ (tools/fuzz adds the assets/ files). Small on
+// DIR/{vdb,nvdb,image,obj,scene}/ (tools/fuzz adds the assets/ files). Small on
 // purpose: libFuzzer mutates small inputs much faster, and each one here
 // reaches a different reader path (grid types, half storage, tiles, NanoVDB;
 // EXR pixel types, compressions, tiled files, Y-only, variance; PNG/HDR).
@@ -82,6 +82,20 @@ void vdb_seeds(const fs::path& dir) {
   // The test support library's converter: instantiating openToNanoVDB here
   // as well cost the CI build about a minute of a core.
   pyrolume::test::write_nanovdb_copy(dir / "density_temperature.vdb", dir / "density_temperature.nvdb");
+}
+
+// fuzz_nvdb's: NanoVDB copies of the float VDB seeds (every node level,
+// tiles, Float16, an empty grid) and a root tile, the one kind of tile
+// sparse_in_place hands to OpenVDB. Each written grid holds a whole upper
+// node (about 270 KB, mostly zeros) unless it has no voxels at all.
+void nvdb_seeds(const fs::path& vdb, const fs::path& dir) {
+  using pyrolume::test::write_nanovdb_copy;
+  write_nanovdb_copy(vdb / "density_temperature.vdb", dir / "density_temperature.nvdb");
+  write_nanovdb_copy(vdb / "density_temperature.vdb", dir / "density_temperature_fp16.nvdb", /*fp16=*/true);
+  write_nanovdb_copy(vdb / "tile.vdb", dir / "tile.nvdb");
+  write_nanovdb_copy(vdb / "empty.vdb", dir / "empty.nvdb");
+  write_nanovdb_copy(pyrolume::test::write_tiles_vdb(dir / "root_tile.vdb", 3, 1), dir / "root_tile.nvdb");
+  fs::remove(dir / "root_tile.vdb");
 }
 
 void exr_seed(const fs::path& p, int w, int h, const std::vector<std::string>& channels, Imf::PixelType type,
@@ -204,8 +218,9 @@ int main(int argc, char** argv) {
     return 1;
   }
   const fs::path root = argv[1];
-  for (const char* sub : {"vdb", "image", "obj", "scene"}) fs::create_directories(root / sub);
+  for (const char* sub : {"vdb", "nvdb", "image", "obj", "scene"}) fs::create_directories(root / sub);
   vdb_seeds(root / "vdb");
+  nvdb_seeds(root / "vdb", root / "nvdb");
   image_seeds(root / "image");
   obj_seeds(root / "obj");
   scene_seeds(root / "scene");

@@ -2,13 +2,19 @@
 // Backend-independent accumulation checks (issue 10), run by
 // tests/unit/cpu_accumulation_test.cpp and tests/vulkan/vulkan_accumulation_test.cpp
 // on their backend.
+#include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
+#include <limits>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "backends/Backends.h"
 #include "render/Backend.h"
+#include "render/Checkpoint.h"
+#include "shared/gpu_types.h"
 #include "support/AccumulationScenes.h"
 #include "support/VdbScenes.h"
 
@@ -254,6 +260,42 @@ inline void expect_sigterm_ends_a_pathological_pass(const std::string& backend) 
     EXPECT_NE(err.find("interrupted before the first pass finished; nothing is written"), std::string::npos) << err;
   }
   std::filesystem::remove_all(dir);
+}
+
+// A checkpoint whose sums hold a NaN or an infinity under a valid checksum
+// (forged, or damaged and re-summed): `--resume` refuses it with one line
+// naming the file, exit 2, before a device opens; resumed, the value would
+// have stayed in its pixel for good. The checkpoint matches the render in
+// everything else (scene, backend, size, seed, frame), so only the sums
+// refuse it.
+inline void expect_nonfinite_checkpoint_refused(const std::string& backend) {
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    SCOPED_TRACE(bad);
+    auto dir = temp_dir("cli-nan-ckpt-" + backend);
+    write_file(dir / "s.json", kSlowBallJson);  // 4x4, seed 7
+    const auto out = dir / "o.exr", ckpt = dir / "o.exr.checkpoint";
+    const CheckpointIdentity id{backend, (dir / "s.json").string(), scene_fingerprint(dir / "s.json"), 4, 4, 7, 0, ""};
+    AccumulationState state{backend, 4, 4, 4, std::vector<unsigned char>(accumulation_bytes(backend, 4, 4), 0)};
+    // The first sum of the last pixel: a double on the CPU, a float on the GPU.
+    const size_t at = backend == "cpu" ? (4 * 4 - 1) * 3 * sizeof(double) : (4 * 4 - 1) * sizeof(gpu::AccumTexel);
+    if (backend == "cpu") {
+      const double v = bad;
+      std::memcpy(state.data.data() + at, &v, sizeof v);
+    } else {
+      std::memcpy(state.data.data() + at, &bad, sizeof bad);
+    }
+    write_checkpoint(ckpt, id, 8, state);
+    CliResult r = run_cli("render " + q(dir / "s.json") + " -o " + q(out) + " --backend " + backend +
+                          " --spp 8 --resume");
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(ckpt.string() + ": corrupt checkpoint: 1 of its accumulated sums are NaN or infinite"),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(std::filesystem::exists(out));
+    EXPECT_TRUE(std::filesystem::exists(ckpt)) << "a refused checkpoint is left as it was";
+    std::filesystem::remove_all(dir);
+  }
 }
 
 }  // namespace pyrolume::test

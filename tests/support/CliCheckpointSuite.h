@@ -21,6 +21,8 @@ TEST_P(CliCheckpoint, SigintSavesThenResumeCompletesIdentically) { expect_cli_in
 
 TEST_P(CliCheckpoint, SigtermSavesAndExits143) { expect_cli_sigterm_saves(GetParam()); }
 
+TEST_P(CliCheckpoint, NonFiniteCheckpointIsRefused) { expect_nonfinite_checkpoint_refused(GetParam()); }
+
 TEST_P(CliCheckpoint, SigtermEndsAPassThroughAPathologicallyDenseMedium) {
   expect_sigterm_ends_a_pathological_pass(GetParam());
 }

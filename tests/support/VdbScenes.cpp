@@ -71,6 +71,17 @@ std::filesystem::path write_two_voxels_vdb(const std::filesystem::path& file, co
   return write_grids(file, {g});
 }
 
+std::filesystem::path write_tiles_vdb(const std::filesystem::path& file, int level, int n) {
+  ensure_openvdb();
+  auto g = openvdb::FloatGrid::create(0.0f);
+  g->setName("density");
+  const int side = level == 1 ? 8 : level == 2 ? 128 : 4096;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) g->tree().addTile(level, openvdb::Coord(i * side, j * side, k * side), 1.0f, true);
+  return write_grids(file, {g});
+}
+
 void write_nanovdb_copy(const std::filesystem::path& vdb, const std::filesystem::path& nvdb, bool fp16) {
   ensure_openvdb();
   openvdb::io::File f(vdb.string());

@@ -107,6 +107,12 @@ std::filesystem::path write_vdb(const std::filesystem::path& file, const std::ve
 // box spans far + 1 voxels per axis.
 std::filesystem::path write_two_voxels_vdb(const std::filesystem::path& file, const glm::ivec3& far);
 
+// "density": n x n x n active tiles of value 1 from the origin, at OpenVDB
+// tree level `level` (1: a lower node's 8³ tile, 2: an upper node's 128³,
+// 3: a root tile of 4096³): a few hundred bytes of file describing
+// n³ · side³ voxels.
+std::filesystem::path write_tiles_vdb(const std::filesystem::path& file, int level, int n);
+
 // Converts every grid of a .vdb file to one .nvdb file (NanoVDB, uncompressed).
 // Float grids only (the test scenes write nothing else); others throw. With
 // fp16, as NanoVDB's 16-bit quantised grids (Float16) instead of float.

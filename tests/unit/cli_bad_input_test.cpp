@@ -127,3 +127,28 @@ TEST(Cli, AovsNeedAnExr) {
   EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
   std::filesystem::remove_all(dir);
 }
+
+// Seconds must be positive and finite: --time-limit 0 used to mean "no limit",
+// and nan, inf or a trailing unit slipped past CLI11's number checks. Refused
+// while the command line is parsed, before a backend exists: one backend suffices.
+TEST(Cli, SecondsMustBePositiveAndFinite) {
+  auto dir = temp_dir("cliseconds");
+  write_file(dir / "s.json", kSphere);
+  const auto out = dir / "o.exr";
+  const std::pair<const char*, const char*> cases[] = {
+      {"--time-limit", "0"},   {"--time-limit", "-1"},  {"--time-limit", "nan"}, {"--time-limit", "inf"},
+      {"--time-limit", "''"},  {"--time-limit", "5s"},  {"--checkpoint", "nan"}, {"--checkpoint", "inf"},
+      {"--checkpoint", "1e999"}};
+  for (auto [flag, value] : cases) {
+    CliResult r = run_cli("render " + (dir / "s.json").string() + " -o " + out.string() + " --backend cpu " + flag +
+                          " " + value);
+    const std::string label = std::string(flag) + " " + value;
+    EXPECT_EQ(r.status, 2) << label << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << label << ": " << r.err;
+    EXPECT_NE(r.err.find(std::string(flag) + ": must be a positive, finite number of seconds"), std::string::npos)
+        << label << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << label << ": " << r.out;
+    EXPECT_FALSE(std::filesystem::exists(out)) << label;
+  }
+  std::filesystem::remove_all(dir);
+}

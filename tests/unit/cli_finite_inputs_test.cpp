@@ -15,6 +15,10 @@ TEST(CliFiniteInputs, ExtremeButRepresentableValuesRenderFinite) {
   EXPECT_EQ(r.status, 0) << r.err;
 }
 
+// docs/robustness.md "Analytic lights": each at the largest accepted values
+// lights the plane, finite, with no sample dropped.
+TEST(CliFiniteInputs, LightsAtTheLargestAcceptedValuesRenderFinite) { expect_extreme_lights_render_finite("cpu"); }
+
 TEST(CliFiniteInputs, SamplesBeyondTheRadianceBoundAreCountedNotAccumulated) {
   expect_samples_beyond_the_bound_counted("cpu");
 }

@@ -83,6 +83,48 @@ TEST_F(CliMemoryLimits, ASparseGridRendersUnderTheLimitThatRefusesItsDenseArray)
   fs::remove_all(dir);
 }
 
+// Issue 45: a VDB of a few hundred bytes, one active 4096³ root tile. Kept
+// sparse its tile would become 2^27 leaves of voxels: refused before any is
+// allocated, on both backends. Without the check it allocated up to the
+// limit and ended in "out of memory ... std::bad_alloc", exit 1.
+TEST_F(CliMemoryLimits, ARootTileOfA4096CubeIsRefusedBeforeAllocating) {
+  auto dir = temp_dir("mem-root-tile");
+  const fs::path vdb = write_tiles_vdb(dir / "tile.vdb", 3, 1);
+  write_file(dir / "s.json", R"({"film": {"width": 8, "height": 8, "spp": 1},
+    "media": [{"type": "vdb", "file": "tile.vdb"}]})");
+  for (const char* backend : {"cpu", "vulkan"}) {
+    CliResult r = run_cli_with_memory_limit(
+        kGiB * 3 / 2, "render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --backend " + backend);
+    expect_refused(r, backend,
+                   {"pyrolume: " + vdb.string() + ": density grid \"density\": keeping it sparse (134217728 leaves",
+                    "68719476736 voxels of them in active tiles", "this process can still allocate"},
+                   dir / "o.exr");
+  }
+  fs::remove_all(dir);
+}
+
+// Issue 45: a grid whose dense texture does not fit under the limit, so
+// "auto" keeps it sparse, and whose sparse tree does not fit either (a
+// 1024 x 1024 x 1024 cube of one value, as 512 active 128³ tiles: 2^21
+// leaves once voxelized). Without the check it ended in "internal error:
+// Pool::Pool malloc failed" (NanoVDB's allocation failure), exit 1.
+TEST_F(CliMemoryLimits, AGridWhoseSparseTreeCannotFitEitherIsRefused) {
+  auto dir = temp_dir("mem-sparse-tree");
+  const fs::path vdb = write_tiles_vdb(dir / "cube.vdb", 2, 8);
+  write_file(dir / "s.json", R"({"film": {"width": 8, "height": 8, "spp": 1},
+    "media": [{"type": "vdb", "file": "cube.vdb"}]})");
+  for (const char* backend : {"cpu", "vulkan"}) {
+    CliResult r = run_cli_with_memory_limit(
+        kGiB * 3 / 2, "render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --backend " + backend);
+    expect_refused(r, backend,
+                   {"pyrolume: " + vdb.string() + ": density grid \"density\": keeping it sparse (2097152 leaves",
+                    "this process can still allocate", "\"downsample\""},
+                   dir / "o.exr");
+    EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+  }
+  fs::remove_all(dir);
+}
+
 TEST_F(CliMemoryLimits, AnAccumulationThatCannotFitIsRefused) {
   auto dir = temp_dir("mem-accum");
   write_file(dir / "s.json", R"({"film": {"width": 8, "height": 8, "spp": 1}})");

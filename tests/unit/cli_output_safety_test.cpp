@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
 #include <sys/un.h>
+#include <sys/wait.h>
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -191,6 +192,156 @@ TEST(CliOutputSafety, OnlyRegularFilesAreReplacedSymlinksAndStreamsAreWrittenThr
   EXPECT_EQ(nlohmann::json::parse(received)["height"], 8) << received;
   ASSERT_EQ(::lstat((dir / "fifo.json").c_str(), &st), 0);
   EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  fs::remove_all(dir);
+}
+
+// A folder on /dev/shm, a tmpfs whose files are regular files though their
+// paths start with /dev/; removed when the test ends. Empty where there is no
+// writable /dev/shm (the test then skips).
+struct ShmDir {
+  fs::path path;
+  explicit ShmDir(const std::string& tag) {
+    std::error_code ec;
+    if (!fs::is_directory("/dev/shm", ec) || ::access("/dev/shm", W_OK | X_OK) != 0) return;
+    path = fs::path("/dev/shm") / ("pyrolume-" + tag + "-" + std::to_string(::getpid()));
+    fs::remove_all(path, ec);
+    if (!fs::create_directory(path, ec)) path.clear();
+  }
+  ~ShmDir() {
+    std::error_code ec;
+    if (!path.empty()) fs::remove_all(path, ec);
+  }
+};
+
+// Regular files are replaced by rename wherever they live: on /dev/shm a
+// second render used to be appended to the first (readers saw the first
+// image) and checkpoints piled up until --resume refused them.
+TEST(CliOutputSafety, RegularFilesUnderDevAreReplacedNotAppendedTo) {
+  ShmDir shm("out-shm");
+  if (shm.path.empty()) GTEST_SKIP() << "no writable /dev/shm here";
+  auto dir = temp_dir("out-shm");
+  write_scene(dir);
+  const fs::path out = shm.path / "o.exr", stats = shm.path / "st.json", ckpt = shm.path / "o.exr.checkpoint";
+  const std::string base = "render " + q(dir / "s.json") + " --backend cpu -o " + q(out) + " --stats " + q(stats);
+  CliResult r = run_cli(base + " --spp 4");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(read_image(out).spp_target, 4);
+  // Stopped after the first pass (4 spp on the CPU) of 8, twice: each time
+  // the image, the stats and a checkpoint of 4 spp replace the last ones.
+  std::vector<uintmax_t> checkpoint_bytes;
+  for (int run = 0; run < 2; ++run) {
+    r = run_cli(base + " --spp 8 --time-limit 1e-9 --checkpoint 1000");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const Image image = read_image(out);
+    EXPECT_EQ(image.spp, 4);
+    EXPECT_EQ(image.spp_target, 8) << "run " << run << ": readers still see the first image";
+    EXPECT_EQ(nlohmann::json::parse(read_file(stats))["spp_target"], 8) << read_file(stats);
+    ASSERT_TRUE(fs::is_regular_file(ckpt)) << r.err;
+    checkpoint_bytes.push_back(fs::file_size(ckpt));
+  }
+  EXPECT_EQ(checkpoint_bytes[1], checkpoint_bytes[0]) << "the second checkpoint piled up on the first";
+  // --resume takes the checkpoint and finishes the render.
+  r = run_cli(base + " --spp 8 --resume");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(read_image(out).spp, 8);
+  EXPECT_EQ(nlohmann::json::parse(read_file(stats))["resumed_spp"], 4);
+  EXPECT_EQ(listing(shm.path), (std::vector<std::string>{"o.exr", "st.json"})) << "temp files or the checkpoint left";
+  fs::remove_all(dir);
+}
+
+// Runs the CLI as a farm job logs: stdout appended (>>) to `log`.
+CliResult run_cli_into_log(const std::string& args, const fs::path& log) {
+  const fs::path err = log.parent_path() / "stderr.txt";
+  const int raw = std::system((std::string(PYROLUME_BIN) + " " + args + " >>" + q(log) + " 2>" + q(err)).c_str());
+  CliResult r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  r.err = read_file(err);
+  fs::remove(err);
+  return r;
+}
+
+// --stats that leads to the log stdout is redirected into (/dev/stdout,
+// /proc/self/fd/1, a symlink to either, the log by name) adds the JSON to the
+// log through stdout: what the log held stays, the summary line follows, and
+// nothing is renamed over the log or a link.
+TEST(CliOutputSafety, StatsThatLeadToStdoutsLogAddToItNeverReplaceIt) {
+  auto dir = temp_dir("out-stdout-log");
+  write_scene(dir);
+  const fs::path log = dir / "job.log";
+  fs::create_symlink("/dev/stdout", dir / "to_stdout.json");
+  fs::create_symlink("/proc/self/fd/1", dir / "to_fd1.json");
+  const fs::path spellings[] = {"/dev/stdout", "/proc/self/fd/1", dir / "to_stdout.json", dir / "to_fd1.json", log};
+  for (const fs::path& stats : spellings) {
+    const std::string earlier = "an earlier job's lines\n";
+    write_file(log, earlier);
+    struct stat before {};
+    ASSERT_EQ(::stat(log.c_str(), &before), 0);
+    CliResult r = run_cli_into_log("render " + q(dir / "s.json") + " --backend cpu -o " + q(dir / "o.exr") +
+                                       " --stats " + q(stats),
+                                   log);
+    ASSERT_EQ(r.status, 0) << stats << ": " << r.err;
+    const std::string text = read_file(log);
+    ASSERT_EQ(text.rfind(earlier, 0), 0u) << stats << ": the log lost its content: " << text;
+    const size_t end = text.rfind("}\n");
+    ASSERT_NE(end, std::string::npos) << stats << ": " << text;
+    EXPECT_EQ(nlohmann::json::parse(text.substr(earlier.size(), end + 2 - earlier.size()))["width"], 8) << text;
+    EXPECT_EQ(text.substr(end + 2).rfind((dir / "o.exr").string() + ": 8x8", 0), 0u) << stats << ": " << text;
+    struct stat after {};
+    ASSERT_EQ(::stat(log.c_str(), &after), 0);
+    EXPECT_EQ(after.st_ino, before.st_ino) << stats << ": the log was replaced";
+  }
+  EXPECT_TRUE(fs::is_symlink(dir / "to_stdout.json"));
+  EXPECT_TRUE(fs::is_symlink(dir / "to_fd1.json"));
+
+  // Another process's open file, reached through /proc/PID/fd/N, is not ours
+  // to write: refused before the render (here this test's own descriptor,
+  // which the CLI does not inherit).
+  write_file(dir / "theirs.log", "their lines\n");
+  const int theirs = ::open((dir / "theirs.log").c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+  ASSERT_GE(theirs, 0);
+  const fs::path via = "/proc/" + std::to_string(::getpid()) + "/fd/" + std::to_string(theirs);
+  CliResult r = run_cli("render " + q(dir / "s.json") + " --backend cpu -o " + q(dir / "o2.exr") + " --stats " + q(via));
+  ::close(theirs);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find(via.string() + ": "), std::string::npos) << r.err;
+  EXPECT_EQ(read_file(dir / "theirs.log"), "their lines\n");
+  EXPECT_FALSE(fs::exists(dir / "o2.exr"));
+  fs::remove_all(dir);
+}
+
+// blackbody --png goes through the same rules as every output: a symlink is
+// followed (the file it points to is replaced, the link stays), a FIFO is
+// written in place (it used to write its own temp file and rename it over
+// whatever was there).
+TEST(CliOutputSafety, BlackbodyPngFollowsTheOutputRules) {
+  auto dir = temp_dir("out-swatch");
+  const std::string args = "blackbody --from 1000 --to 3000 --step 1000 --png ";
+  write_file(dir / "real.png", "old");
+  fs::create_symlink("real.png", dir / "link.png");
+  CliResult r = run_cli(args + q(dir / "link.png"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::is_symlink(dir / "link.png"));
+  EXPECT_EQ(read_file(dir / "real.png").substr(1, 3), "PNG");
+
+  ASSERT_EQ(::mkfifo((dir / "fifo.png").c_str(), 0600), 0);
+  std::string received;
+  std::thread reader([&] {
+    std::ifstream in(dir / "fifo.png", std::ios::binary);
+    received.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  });
+  r = run_cli(args + q(dir / "fifo.png"));
+  if (r.status != 0) ::close(::open((dir / "fifo.png").c_str(), O_WRONLY | O_NONBLOCK));  // release the reader
+  reader.join();
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(received, read_file(dir / "real.png"));  // the same strip
+  struct stat st {};
+  ASSERT_EQ(::lstat((dir / "fifo.png").c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  std::vector<std::string> names;  // by name: listing() would resolve link.png
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"fifo.png", "link.png", "real.png"})) << "temp files left";
   fs::remove_all(dir);
 }
 

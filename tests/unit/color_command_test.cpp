@@ -12,6 +12,7 @@
 
 #include "color/Blackbody.h"
 #include "color/SwatchStrip.h"
+#include "image/AtomicFile.h"
 #include "support/TestSupport.h"
 
 using namespace pyrolume;
@@ -27,7 +28,7 @@ struct CommandRun {
 CommandRun run(double from, double to, double step, BlackbodyMode mode = BlackbodyMode::Seed, int observer = 2,
         const std::string& png = "") {
   std::ostringstream out, err;
-  const int status = run_blackbody_command(from, to, step, mode, observer, png, out, err);
+  const int status = run_blackbody_command(from, to, step, mode, observer, png, out, err, write_file_atomic);
   return {status, out.str(), err.str()};
 }
 

@@ -110,6 +110,18 @@ TEST_F(SceneSetupTest, AGuessReadsKelvinAsKelvinAndUnitlessValuesAsHoudini) {
   EXPECT_EQ(c.mapping.scale, 1.0);
 }
 
+// Numbers in the mapping's words are printed as numbers: a temperature of
+// 1e30 came out as -2147483648 (an int cast).
+TEST_F(SceneSetupTest, AHugeTemperatureIsPrintedAsANumber) {
+  const SourceConvention c = convention({plume("density", 1.0f, false), plume("temperature", 1e30f, false)}, {});
+  ASSERT_EQ(c.source, VolumeSource::Kelvin);
+  const std::string said = "its largest value, ";
+  const size_t at = c.mapping_text.find(said);
+  ASSERT_NE(at, std::string::npos) << c.mapping_text;
+  const double printed = std::stod(c.mapping_text.substr(at + said.size()));
+  EXPECT_NEAR(printed / double(plume_max(1e30f)), 1.0, 1e-5) << c.mapping_text;
+}
+
 // Keys the file writes win; the convention fills the rest; a convention with
 // nothing to glow from turns the emission off unless the file asked for it.
 TEST_F(SceneSetupTest, ExplicitKeysWinOverTheConvention) {

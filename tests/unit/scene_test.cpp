@@ -1,6 +1,8 @@
 // Scene format v1: a full example scene parses; every malformed case names the key.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "scene/Scene.h"
 #include "support/TestSupport.h"
 #include "util/Error.h"
@@ -245,6 +247,30 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"both value and temperature",
                 R"({"lights": [{"type": "point", "position": [0, 1, 0], "intensity": [1, 1, 1], "temperature_k": 3000}]})",
                 "lights[0].intensity: give either"},
+        // Range rules (docs/robustness.md "Analytic lights"): the blackbody
+        // range the renderers evaluate, coordinates float keeps finite, a
+        // disc that float directions resolve.
+        BadCase{"light temperature 10 K",
+                R"({"lights": [{"type": "point", "position": [0, 1, 0], "temperature_k": 10}]})",
+                "lights[0].temperature_k: must be in [100.0, 1000000.0] kelvin, got 10.0"},
+        BadCase{"light temperature 1e300 K",
+                R"({"lights": [{"type": "distant", "direction": [0, 1, 0], "temperature_k": 1e300}]})",
+                "lights[0].temperature_k: must be in [100.0, 1000000.0] kelvin, got 1e+300"},
+        BadCase{"sphere light radius 1e300",
+                R"({"lights": [{"type": "sphere", "center": [0, 1, 0], "radius": 1e300, "radiance": [1, 1, 1]}]})",
+                "lights[0].radius: the sphere's extent |center| + radius reaches 1e+300, beyond the ±1e+18"},
+        BadCase{"sphere light centre beyond 1e18",
+                R"({"lights": [{"type": "sphere", "center": [0, -2e18, 0], "radius": 1, "radiance": [1, 1, 1]}]})",
+                "lights[0].center: a coordinate reaches -2e+18, beyond the ±1e+18"},
+        BadCase{"point light beyond 1e18",
+                R"({"lights": [{"type": "point", "position": [1e19, 1, 0], "intensity": [1, 1, 1]}]})",
+                "lights[0].position: a coordinate reaches 1e+19"},
+        BadCase{"spot light beyond 1e18",
+                R"({"lights": [{"type": "spot", "position": [0, 0, 1e300], "direction": [0, -1, 0], "intensity": [1, 1, 1]}]})",
+                "lights[0].position: a coordinate reaches 1e+300"},
+        BadCase{"disc narrower than float resolves",
+                R"({"lights": [{"type": "distant", "direction": [0, 1, 0], "irradiance": [1e-30, 0, 0], "angle_deg": 1e-300}]})",
+                "lights[0].angle_deg: must be 0 (a delta light) or at least 0.0001 degrees"},
         BadCase{"neither value nor temperature", R"({"lights": [{"type": "point", "position": [0, 1, 0]}]})",
                 "lights[0].intensity: missing"},
         BadCase{"value key of another type",
@@ -319,4 +345,41 @@ TEST(Scene, Lights) {
   EXPECT_TRUE(parse_scene(R"({"lights": [{"type": "distant", "direction": [1, 1, 1], "irradiance": [1, 1, 1]}]})",
                           "d.json").lights[0].is_delta());  // angle_deg 0
   EXPECT_TRUE(parse_scene(R"({"integrator": {"mis": false}, "lights": []})", "e.json").lights.empty());
+}
+
+// Each light's range at its limits is accepted (docs/scene-format.md
+// "lights"), and a direction whose length overflows double is still the
+// direction it names: scaled by its largest component before normalising.
+TEST(Scene, LightRangesAtTheirLimits) {
+  const Scene s = parse_scene(R"({"lights": [
+    {"type": "distant", "direction": [1e200, 1e200, 0], "temperature_k": 100},
+    {"type": "spot", "position": [-1e18, 1e18, 1e18], "direction": [0, -1e-300, 0], "temperature_k": 1e6},
+    {"type": "sphere", "center": [0, 5e17, 0], "radius": 5e17, "radiance": [1, 1, 1]},
+    {"type": "distant", "direction": [0, 1, 0], "irradiance": [1, 1, 1], "angle_deg": 0.0001}]})", "l.json");
+  ASSERT_EQ(s.lights.size(), 4u);
+  EXPECT_NEAR(s.lights[0].direction.x, std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(s.lights[0].direction.y, std::sqrt(0.5), 1e-15);
+  EXPECT_EQ(s.lights[0].direction.z, 0.0);
+  EXPECT_EQ(s.lights[1].direction, glm::dvec3(0, -1, 0));
+  EXPECT_DOUBLE_EQ(*s.lights[1].temperature_k, 1e6);
+  EXPECT_DOUBLE_EQ(s.lights[2].radius, 5e17);
+  EXPECT_FALSE(s.lights[3].is_delta());
+}
+
+// At most kMaxLights analytic lights (every ray loops over them): that many
+// load, one more is refused naming `lights` (docs/scene-format.md "lights").
+TEST(Scene, LightCountIsCapped) {
+  auto lights = [](size_t n) {
+    std::string text = R"({"lights": [)";
+    for (size_t k = 0; k < n; ++k)
+      text += std::string(k ? ", " : "") + R"({"type": "point", "position": [0, 1, 0], "intensity": [1, 1, 1]})";
+    return text + "]}";
+  };
+  EXPECT_EQ(parse_scene(lights(kMaxLights), "l.json").lights.size(), kMaxLights);
+  const std::string msg = error_of(lights(kMaxLights + 1));
+  EXPECT_NE(msg.find("bad.json: lights: " + std::to_string(kMaxLights + 1) + " lights, more than the " +
+                     std::to_string(kMaxLights)),
+            std::string::npos)
+      << msg;
+  EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
 }

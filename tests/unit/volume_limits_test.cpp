@@ -70,5 +70,34 @@ TEST(VolumeLimits, GridPastTheAllocationLimitIsRefused) {
   std::filesystem::remove_all(dir);
 }
 
+// Active tiles are a few bytes of file each, and a sparse grid turns them
+// into leaves of voxels: one active 4096³ root tile, or one upper node full
+// of active 128³ tiles, is 2^36 voxels, 2^27 leaves (over 500 GiB). Refused
+// before anything is allocated, naming the file and grid, whether "auto"
+// picks sparse (the dense box cannot fit either) or the scene asks for it;
+// a .nvdb's root tile goes the same way (issue 45). Without the check these
+// allocated until the memory limit and ended in std::bad_alloc.
+TEST(VolumeLimits, ActiveTilesTooLargeToKeepSparseAreRefusedBeforeAllocating) {
+  auto dir = test::temp_dir("vol-tiles");
+  const auto root = test::write_tiles_vdb(dir / "root.vdb", 3, 1);
+  test::write_nanovdb_copy(root, dir / "root.nvdb");
+  const auto upper = test::write_tiles_vdb(dir / "upper.vdb", 2, 32);
+  for (const std::filesystem::path& file : {root, dir / "root.nvdb", upper})
+    for (TextureFormat format : {TextureFormat::Auto, TextureFormat::Sparse}) {
+      Medium m = test::vdb_medium("tiles", file, {1, 1, 1}, {0, 0, 0});
+      m.texture_format = format;
+      const std::string err = load_error(m, DenseLimits{});
+      const std::string what = file.filename().string() + " " + to_string(format) + ": ";
+      EXPECT_EQ(err.rfind(file.string() + ": density grid \"density\": keeping it sparse (134217728 leaves of 8^3 "
+                                          "voxels, 68719476736 voxels of them in active tiles) needs ",
+                          0),
+                0u)
+          << what << err;
+      EXPECT_NE(err.find("this process can still allocate"), std::string::npos) << what << err;
+      EXPECT_NE(err.find("\"downsample\""), std::string::npos) << what << err;
+    }
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace pyrolume

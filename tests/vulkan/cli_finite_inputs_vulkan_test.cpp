@@ -18,6 +18,10 @@ TEST(CliFiniteInputsVulkan, ExtremeButRepresentableValuesRenderFinite) {
   EXPECT_NE(r.err.find("wide.png: 65536 x 1 texels exceed this device's 2D texture limit"), std::string::npos) << r.err;
 }
 
+// docs/robustness.md "Analytic lights": each at the largest accepted values
+// lights the plane, finite, with no sample dropped.
+TEST(CliFiniteInputsVulkan, LightsAtTheLargestAcceptedValuesRenderFinite) { expect_extreme_lights_render_finite("vulkan"); }
+
 TEST(CliFiniteInputsVulkan, SamplesBeyondTheRadianceBoundAreCountedNotAccumulated) {
   expect_samples_beyond_the_bound_counted("vulkan");
 }

@@ -315,3 +315,79 @@ TEST_F(DenoiseGpu, CliWritesANewFileAndLeavesTheInput) {
   EXPECT_LT(spread(out, 0, [](int, int) { return true; }).sd, 0.1);  // the input's is 0.2
   std::filesystem::remove_all(dir);
 }
+
+namespace {
+// `img` with every radiance value (RGB, light layers, guide) times `k` and
+// its variance times k², in single precision as an EXR would hold them (a
+// variance past 3.4e38 becomes infinite there too).
+Image scaled(Image img, double k) {
+  auto times = [](std::vector<float>& v, double f) {
+    for (float& x : v) x = float(double(x) * f);
+  };
+  times(img.rgb, k);
+  times(img.variance, k * k);
+  for (std::vector<float>* layer : {&img.aovs.emission, &img.aovs.scatter, &img.aovs.surface, &img.aovs.background,
+                                    &img.aovs.guide})
+    times(*layer, k);
+  return img;
+}
+
+size_t nonfinite_values(const Image& img) {
+  size_t n = 0;
+  for (float v : img.rgb) n += !std::isfinite(v);
+  for (float v : img.alpha) n += !std::isfinite(v);
+  return n;
+}
+}  // namespace
+
+// Radiance near the top of single precision: the filter's squares and sums
+// overflowed (the guided filter returned NaN everywhere from ~1e20, the plain
+// one at 3e38). It now filters in a normalised range: the output is finite
+// everywhere and is the input's result at that scale. A flat 3e38 image stays
+// 3e38; the noisy square at 2^60 (its variance still finite) is denoised as
+// at 1 (expect_square_flat after dividing the scale back out); at 2^70 and
+// 2^126 (its variance past single precision, so read as unknown, 0) it is
+// finite and keeps its mean.
+TEST_F(DenoiseGpu, HugeRadianceIsFilteredFinite) {
+  for (const bool guided : {false, true}) {
+    SCOPED_TRACE(guided ? "guided" : "plain");
+    const DenoiseOptions options = guided ? DenoiseOptions{} : tested();
+    // The guided filter's layers: all emission, guided by the truth.
+    auto with_guide = [&](Image img, const std::vector<float>& truth) {
+      if (guided) add_guided_aovs(img, Layer::Emission, truth);
+      return img;
+    };
+    // Flat 3e38 (× tint), variance 1e30: every output value within 1e-5 of it.
+    Image flat = noisy_image(32, 32, [](int, int) { return 3e38f; }, [](int, int) { return 0.0f; }, 5);
+    flat.variance.assign(flat.variance.size(), 1e30f);
+    const Image flat_out = denoiser_->run(with_guide(flat, flat.rgb), options);
+    ASSERT_EQ(nonfinite_values(flat_out), 0u);
+    for (size_t i = 0; i < flat_out.rgb.size(); ++i)
+      ASSERT_NEAR(flat_out.rgb[i] / flat.rgb[i], 1.0, 1e-5) << "value " << i;
+
+    const Image noisy = noisy_square_image();
+    std::vector<float> truth(noisy.pixel_count() * 3);
+    for (int y = 0; y < noisy.height; ++y)
+      for (int x = 0; x < noisy.width; ++x)
+        for (int c = 0; c < 3; ++c) truth[noisy.index(x, y, c)] = in_square(x, y) ? 2.0f * kTint[c] : 0.0f;
+    const Image square = with_guide(noisy, truth);
+    auto interior = [](int x, int y) {
+      return x >= kSquareLo + 4 && x < kSquareHi - 4 && y >= kSquareLo + 4 && y < kSquareHi - 4;
+    };
+    for (const int e : {60, 70, 126}) {
+      SCOPED_TRACE("scale 2^" + std::to_string(e));
+      const double k = std::ldexp(1.0, e);
+      const Image out = denoiser_->run(scaled(square, k), options);
+      ASSERT_EQ(nonfinite_values(out), 0u);
+      const Image back = scaled(out, 1.0 / k);  // exact: a power of two
+      if (e == 60) {
+        expect_square_flat(square, back, guided ? "guided_2e60" : "plain_2e60");
+      } else {
+        for (int c = 0; c < 3; ++c) {
+          const Spread in = spread(square, c, interior), den = spread(back, c, interior);
+          EXPECT_LT(std::abs(den.mean - 2.0 * kTint[c]), 4.0 * in.sd / std::sqrt(double(in.n))) << "channel " << c;
+        }
+      }
+    }
+  }
+}

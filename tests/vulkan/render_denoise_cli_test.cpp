@@ -4,11 +4,15 @@
 // the EXR add up to its RGB.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
 #include "image/ImageIo.h"
+#include "render/vulkan/Context.h"
+#include "scene/Scene.h"
 #include "support/TestSupport.h"
+#include "util/Error.h"
 
 using namespace pyrolume;
 using namespace pyrolume::test;
@@ -91,5 +95,86 @@ TEST(CliRenderDenoise, AovLayersInTheExrSumToItsRgb) {
     layer_total[3] += img.aovs.background[i];
   }
   for (double t : layer_total) EXPECT_GT(t, 0.0);
+  std::filesystem::remove_all(dir);
+}
+
+namespace {
+// An emissive ball in front of a background: cheap at any size (no
+// scattering, one bounce), for the tests that must not wait for a render.
+const std::string kCheapScene = R"({"film": {"width": 8, "height": 8, "spp": 1},
+  "camera": {"position": [0, 0, -4], "look_at": [0, 0, 0], "fov_deg": 40},
+  "background": {"rgb": [0.2, 0.3, 0.5]},
+  "media": [{"type": "homogeneous", "bounds": {"sphere": {"center": [0, 0, 0], "radius": 1}},
+             "sigma_a": [1, 1, 1], "sigma_s": [0, 0, 0], "emission": {"rgb": [2, 1, 0.4]}}]})";
+
+size_t files_in(const std::filesystem::path& dir) {
+  return size_t(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()));
+}
+}  // namespace
+
+// The denoiser's storage-buffer limit follows from the film size, so a film
+// past it is refused before the render is spent: one line naming the
+// denoised file, exit 2, nothing written, for a single render and a sequence
+// on either backend. (Before, the render ran to the end and then failed.)
+TEST(CliRenderDenoise, AFilmTooLargeForTheDenoiserIsRefusedBeforeTheRender) {
+  VkDeviceSize range = 0;
+  try {
+    vk::Context ctx(vk::Context::Options{});
+    range = std::min<VkDeviceSize>(ctx.properties().limits.maxStorageBufferRange, ctx.max_allocation_size());
+  } catch (const NoDeviceError& e) {
+    GTEST_SKIP() << e.what();
+  }
+  // The smallest square film whose vec4 per pixel passes the range.
+  const int side = int(std::sqrt(double(range) / 16.0)) + 1;
+  if (side > kMaxFilmSide) GTEST_SKIP() << "this device's storage-buffer range takes any film";
+  auto dir = temp_dir("clidenoiselimit");
+  write_file(dir / "s.json", kCheapScene);
+  const std::string size = " --width " + std::to_string(side) + " --height " + std::to_string(side);
+  for (const std::string backend : {"cpu", "vulkan"})
+    for (const bool sequence : {false, true}) {
+      SCOPED_TRACE(backend + (sequence ? " --frames 1-2" : ""));
+      const std::string out = (dir / (sequence ? "o_####.exr" : "o.exr")).string();
+      const std::string denoised = (dir / (sequence ? "o_0001.denoised.exr" : "o.denoised.exr")).string();
+      CliResult r = run_cli("render " + (dir / "s.json").string() + " -o " + out + " --backend " + backend + size +
+                            " --denoise" + (sequence ? " --frames 1-2" : ""));
+      EXPECT_EQ(r.status, 2) << r.err;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+      EXPECT_NE(r.err.find(denoised + ": " + std::to_string(side) + " x " + std::to_string(side) +
+                           " pixels are too many to denoise on this device"),
+                std::string::npos)
+          << r.err;
+      EXPECT_EQ(files_in(dir), 1u) << "only the scene: nothing rendered, nothing written";
+    }
+  std::filesystem::remove_all(dir);
+}
+
+// A sequence commits each frame independently of its denoised copy: when the
+// copy of frame 1 cannot be written (here it leads to /dev/full: ENOSPC),
+// that is said on one line, frame 1's raw image is kept, frame 2 is rendered
+// and denoised, and the run ends with exit status 2. --skip-existing then
+// renders again only the frame without its copy. (Before, the raw frame was
+// committed together with its copy, so it was lost too, and the run ended.)
+TEST(CliRenderDenoise, ASequenceKeepsTheRawFrameWhenItsDenoisedCopyFails) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  auto dir = temp_dir("clidenoiseseq");
+  write_file(dir / "s.json", kCheapScene);
+  std::filesystem::create_symlink("/dev/full", dir / "o_0001.denoised.exr");
+  const std::string base =
+      "render " + (dir / "s.json").string() + " -o " + (dir / "o_####.exr").string() + " --backend cpu --denoise --frames 1-2";
+  CliResult r = run_cli(base);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("frame 1: " + (dir / "o_0001.denoised.exr").string() + ": "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find((dir / "o_0001.exr").string() + " is kept"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("1 frame has no denoised copy"), std::string::npos) << r.err;
+  EXPECT_EQ(read_image(dir / "o_0001.exr").width, 8);
+  EXPECT_EQ(read_image(dir / "o_0002.exr").width, 8);
+  EXPECT_EQ(read_image(dir / "o_0002.denoised.exr").width, 8);
+  EXPECT_TRUE(std::filesystem::is_symlink(dir / "o_0001.denoised.exr"));
+
+  std::filesystem::remove(dir / "o_0001.denoised.exr");
+  r = run_cli(base + " --skip-existing");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("1 rendered, 1 skipped"), std::string::npos) << r.out;
+  EXPECT_EQ(read_image(dir / "o_0001.denoised.exr").width, 8);
   std::filesystem::remove_all(dir);
 }

@@ -925,6 +925,18 @@ uint64_t CpuRenderer::accumulation_bytes(int width, int height) {
   return uint64_t(width) * uint64_t(height) * 8 * sizeof(double) + sizeof(CpuCounters);
 }
 
+uint64_t CpuRenderer::nonfinite_sums(const AccumulationState& state) {
+  const size_t sums = size_t(state.width) * size_t(state.height) * 8;  // the doubles before the counters
+  if (state.data.size() < sums * sizeof(double)) throw std::logic_error("cpu reference: accumulation too short");
+  uint64_t count = 0;
+  for (size_t i = 0; i < sums; ++i) {
+    double v;
+    std::memcpy(&v, state.data.data() + i * sizeof v, sizeof v);
+    count += !std::isfinite(v);
+  }
+  return count;
+}
+
 CpuRenderer::CpuRenderer(int threads) {
   if (threads <= 0) threads = int(std::thread::hardware_concurrency());
   threads_ = std::max(1, threads);

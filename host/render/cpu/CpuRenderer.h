@@ -36,6 +36,9 @@ class CpuRenderer : public Backend {
   // Bytes of its AccumulationState for a width×height render: Σ L, Σ L², Σα
   // and Σα² as doubles, then three uint64 counters (CpuRenderer.cpp save_state).
   static uint64_t accumulation_bytes(int width, int height);
+  // Non-finite sums in such a state (a checkpoint must have none: resumed,
+  // each would be a NaN pixel however many samples follow).
+  static uint64_t nonfinite_sums(const AccumulationState& state);
 
   // Samples per pixel per progressive pass (progress/cancel/time-limit granularity).
   static constexpr int kPassSpp = 4;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 
@@ -49,7 +50,12 @@ void check_loaded_media(const Scene& scene, const std::vector<std::optional<Stor
     if (volumes[i]) check_loaded_medium(scene, i, *volumes[i]);
 }
 
-std::string mib(double bytes) { return std::to_string(int(bytes / (1024.0 * 1024.0) + 0.5)) + " MiB"; }
+// Printed as a number, not through int: a forged size past 2^31 MiB would wrap.
+std::string mib(double bytes) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.0f MiB", bytes / (1024.0 * 1024.0));
+  return text;
+}
 }  // namespace
 
 RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderSettings& settings)

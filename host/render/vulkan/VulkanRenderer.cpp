@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 #include "render/vulkan/Context.h"
@@ -38,6 +39,18 @@ void VulkanRenderer::set_frame_reuse(bool on) {
 
 uint64_t VulkanRenderer::accumulation_bytes(int width, int height) {
   return uint64_t(width) * uint64_t(height) * (sizeof(gpu::AccumTexel) + sizeof(gpu::AlphaTexel));
+}
+
+uint64_t VulkanRenderer::nonfinite_sums(const AccumulationState& state) {
+  static_assert(sizeof(gpu::AccumTexel) % sizeof(float) == 0 && sizeof(gpu::AlphaTexel) % sizeof(float) == 0,
+                "the texels are read as floats");
+  uint64_t count = 0;
+  for (size_t i = 0; i + sizeof(float) <= state.data.size(); i += sizeof(float)) {
+    float v;
+    std::memcpy(&v, state.data.data() + i, sizeof v);
+    count += !std::isfinite(v);
+  }
+  return count;
 }
 
 int VulkanRenderer::spp_per_pass(int width, int height, int spp, int rays_per_vertex) {

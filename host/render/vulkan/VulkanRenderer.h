@@ -25,6 +25,9 @@ class VulkanRenderer : public Backend {
   // Bytes of its AccumulationState for a width×height render: one
   // gpu::AccumTexel per pixel, then one gpu::AlphaTexel per pixel (RenderSession::save_state).
   static uint64_t accumulation_bytes(int width, int height);
+  // Non-finite values in such a state (every member of both texels is a
+  // float sum or count; a checkpoint must have none).
+  static uint64_t nonfinite_sums(const AccumulationState& state);
 
   // Samples per pixel per dispatch: a fixed function of the image size, so the
   // pass schedule (and with it the float summation order) never depends on

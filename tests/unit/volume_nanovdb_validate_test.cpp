@@ -1,0 +1,212 @@
+// Forged NanoVDB files (docs/robustness.md "Forged NanoVDB trees"): a .nvdb
+// whose counts, offsets, sizes, bounding box or value type were changed is
+// refused before anything walks it, with one line naming the file, the grid
+// and the field, by the dense load, the sparse load (which walks the node
+// tables linearly and writes into them) and `pyrolume info --values`.
+// Without the checks the large forgeries crashed (SIGSEGV) and the small ones
+// loaded silently.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <vector>
+
+#include <nanovdb/NanoVDB.h>
+#include <nanovdb/util/IO.h>
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+
+#include "scene/MediumVolume.h"
+#include "support/TestSupport.h"
+#include "support/VdbScenes.h"
+#include "util/Error.h"
+#include "volume/SparseGrid.h"
+#include "volume/VdbInfo.h"
+#include "volume/VdbLoader.h"
+
+namespace pyrolume {
+namespace {
+
+namespace fs = std::filesystem;
+using Bytes = std::vector<char>;
+
+// Byte offsets in a NanoVDB 32 grid buffer (NanoVDB.h: GridData, TreeData, RootData).
+static_assert(sizeof(nanovdb::GridData) == 672 && sizeof(nanovdb::TreeData<3>) == 64, "NanoVDB 32 layout");
+constexpr size_t kGridSize = 32, kGridType = 636, kTree = 672;
+constexpr size_t kMapD = 296 + 88;  // GridData::mMap.mMatD[0] (after the float matrices, translation and taper)
+constexpr size_t kNodeOffset = kTree, kNodeCount = kTree + 32, kVoxelCount = kTree + 56;
+constexpr size_t kRootBBox = 0, kRootTableSize = 24;
+
+template <class T>
+T get(const Bytes& b, size_t at) {
+  T v;
+  std::memcpy(&v, b.data() + at, sizeof v);
+  return v;
+}
+template <class T>
+void put(Bytes& b, size_t at, T v) {
+  std::memcpy(b.data() + at, &v, sizeof v);
+}
+
+// "density": voxels in three leaves under two lower nodes (x = 0 and 200),
+// and an active 8³ tile of a lower node: every node level, tiles included.
+// Returns the .nvdb's bytes.
+Bytes small_nvdb(const fs::path& dir) {
+  openvdb::initialize();
+  auto g = openvdb::FloatGrid::create(0.0f);
+  g->setName("density");
+  auto acc = g->getAccessor();
+  acc.setValue({0, 0, 0}, 0.5f);
+  acc.setValue({9, 1, 2}, 1.0f);
+  acc.setValue({200, 3, 4}, 2.0f);
+  g->tree().addTile(1, openvdb::Coord(16, 0, 0), 1.5f, true);
+  openvdb::io::File(((dir / "small.vdb").string())).write({g});
+  test::write_nanovdb_copy(dir / "small.vdb", dir / "small.nvdb");
+  std::ifstream in(dir / "small.nvdb", std::ios::binary);
+  return Bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// Where the grid's buffer starts in a one-grid file: the segment header,
+// the grid's metadata record and its name.
+size_t grid_start(const Bytes& b) {
+  const size_t meta = sizeof(nanovdb::io::Header);
+  return meta + sizeof(nanovdb::io::MetaData) + get<uint32_t>(b, meta + offsetof(nanovdb::io::MetaData, nameSize));
+}
+
+std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
+
+fs::path write(const fs::path& p, const Bytes& b) {
+  std::ofstream(p, std::ios::binary | std::ios::trunc).write(b.data(), std::streamsize(b.size()));
+  return p;
+}
+
+// The three readers a .nvdb meets: "" when it was read, else the InputError.
+std::string read_error(const fs::path& p, const std::string& reader) {
+  try {
+    if (reader == "info --values") {
+      std::ostringstream out;
+      run_info_command(p, /*values=*/true, out);
+    } else {
+      Medium m = test::vdb_density_medium("forged", p, {1, 1, 1}, {0, 0, 0});
+      m.texture_format = reader == "sparse" ? TextureFormat::Sparse : TextureFormat::R32F;
+      load_volume(m, false);
+    }
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+struct Forgery {
+  const char* field;
+  std::function<void(Bytes&, size_t grid)> forge;
+  const char* reason;  // in the message
+};
+
+TEST(NanoVdbValidate, TheUnforgedFileIsReadByEveryReader) {
+  const fs::path dir = test::temp_dir("nvdb-valid");
+  const fs::path p = write(dir / "ok.nvdb", small_nvdb(dir));
+  for (const char* reader : {"dense", "sparse", "info --values"}) EXPECT_EQ(read_error(p, reader), "") << reader;
+  Medium m = test::vdb_density_medium("ok", p, {1, 1, 1}, {0, 0, 0});
+  m.texture_format = TextureFormat::Sparse;
+  const VolumeGrids g = load_volume(m, false);
+  ASSERT_TRUE(g.density.is_sparse());
+  EXPECT_EQ(g.density.sparse->active_voxels(), 3u + 512u);
+  fs::remove_all(dir);
+}
+
+TEST(NanoVdbValidate, EachForgedFieldIsRefusedByEveryReaderInOneLine) {
+  const fs::path dir = test::temp_dir("nvdb-forged");
+  const Bytes valid = small_nvdb(dir);
+  const size_t g0 = grid_start(valid);
+  const size_t root = g0 + kTree + get<uint64_t>(valid, g0 + kNodeOffset + 3 * 8);
+  const uint32_t leaves = get<uint32_t>(valid, g0 + kNodeCount);
+  ASSERT_EQ(leaves, 3u);
+  ASSERT_EQ(get<uint32_t>(valid, g0 + kNodeCount + 4), 2u);  // lower nodes
+  ASSERT_EQ(get<uint32_t>(valid, g0 + kNodeCount + 8), 1u);  // upper nodes
+  auto add32 = [](size_t field, int64_t d) {
+    return [=](Bytes& b, size_t g) { put<uint32_t>(b, g + field, uint32_t(int64_t(get<uint32_t>(b, g + field)) + d)); };
+  };
+  auto add64 = [](size_t field, int64_t d) {
+    return [=](Bytes& b, size_t g) { put<uint64_t>(b, g + field, get<uint64_t>(b, g + field) + uint64_t(d)); };
+  };
+  const int64_t leaf_bytes = sizeof(nanovdb::NanoLeaf<float>);
+  const std::vector<Forgery> forgeries = {
+      {"leaf count (large)", add32(kNodeCount, 1000000), "leaf nodes of"},
+      {"leaf count (one more)", add32(kNodeCount, 1), "run past the nodes' end"},
+      {"leaf count (one fewer)", add32(kNodeCount, -1), "is outside the leaf node table"},
+      {"lower node count", add32(kNodeCount + 4, 1), "lower internal nodes of"},
+      {"upper node count", add32(kNodeCount + 8, 5000), "upper internal nodes of"},
+      {"first-leaf offset (past the end)", add64(kNodeOffset, int64_t(1) << 40), "first leaf node offset"},
+      {"first-leaf offset (one leaf back)", add64(kNodeOffset, -leaf_bytes), "overlaps the nodes before it"},
+      {"first-leaf offset (one leaf on)", add64(kNodeOffset, leaf_bytes), "run past the nodes' end"},
+      {"first-leaf offset (unaligned)", add64(kNodeOffset, 4), "not 32-byte aligned"},
+      {"first lower node offset", add64(kNodeOffset + 8, -int64_t(sizeof(nanovdb::NanoUpper<float>))),
+       "overlaps the nodes before it"},
+      {"root offset", add64(kNodeOffset + 24, int64_t(1) << 33), "root node offset"},
+      {"grid size", add64(kGridSize, 32), "do not describe the one grid"},
+      {"active voxel count", add64(kVoxelCount, 1), "active voxel count 516 is not the 515 its nodes hold"},
+      {"root table size", [&](Bytes& b, size_t) { put<uint32_t>(b, root + kRootTableSize, 100000000); }, "root table of"},
+      {"index bounding box", [&](Bytes& b, size_t) { put<int32_t>(b, root + kRootBBox, -1); },
+       "is not the box of its active voxels"},
+      {"value type", [](Bytes& b, size_t g) { put<uint32_t>(b, g + kGridType, uint32_t(nanovdb::GridType::Double)); },
+       "its value type is double where the file lists float"},
+      // Found by fuzz_nvdb: nanoToOpenVDB (the sparse path of a root tile
+      // and of quantised grids) threw OpenVDB's ArithmeticError out of the loader.
+      {"index-to-world map", [](Bytes& b, size_t g) { put<double>(b, g + kMapD, 0.0); },
+       "index-to-world map is singular or not finite"},
+      {"leaf origin",
+       [](Bytes& b, size_t g) {
+         const size_t leaf = g + kTree + get<uint64_t>(b, g + kNodeOffset);
+         put<int32_t>(b, leaf, get<int32_t>(b, leaf) + 8);
+       },
+       "where its parent puts"},
+  };
+  for (const Forgery& f : forgeries) {
+    Bytes b = valid;
+    f.forge(b, g0);
+    ASSERT_NE(b, valid) << f.field;
+    const fs::path p = write(dir / "forged.nvdb", b);
+    for (const char* reader : {"dense", "sparse", "info --values"}) {
+      const std::string err = read_error(p, reader);
+      const std::string what = std::string(f.field) + ", " + reader + ": ";
+      EXPECT_EQ(err.rfind(p.string() + ": grid \"density\": corrupt NanoVDB grid: ", 0), 0u) << what << err;
+      EXPECT_NE(err.find(f.reason), std::string::npos) << what << err;
+      EXPECT_EQ(err.find('\n'), std::string::npos) << what << err;
+    }
+  }
+  fs::remove_all(dir);
+}
+
+// The command line: exit 2, the one line, no image, on both backends (the
+// grid is refused while the scene loads, before either renders).
+TEST(NanoVdbValidate, TheCommandLineRefusesAForgedLeafCountWithExit2) {
+  const fs::path dir = test::temp_dir("nvdb-cli");
+  Bytes b = small_nvdb(dir);
+  const size_t g0 = grid_start(b);
+  put<uint32_t>(b, g0 + kNodeCount, 1000000);
+  const fs::path nvdb = write(dir / "forged.nvdb", b);
+  test::write_file(dir / "s.json", R"({"film": {"width": 8, "height": 8, "spp": 1},
+    "media": [{"type": "vdb", "file": "forged.nvdb", "texture_format": "sparse"}]})");
+  const std::string line = nvdb.string() + ": grid \"density\": corrupt NanoVDB grid: ";
+  for (const char* backend : {"cpu", "vulkan"}) {
+    const fs::path out = dir / (std::string(backend) + ".exr");
+    const test::CliResult r =
+        test::run_cli("render " + q(dir / "s.json") + " -o " + q(out) + " --backend " + backend);
+    EXPECT_EQ(r.status, 2) << backend << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << backend << ": " << r.err;
+    EXPECT_NE(r.err.find(line), std::string::npos) << backend << ": " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << backend;
+  }
+  const test::CliResult info = test::run_cli("info --values " + q(nvdb));
+  EXPECT_EQ(info.status, 2) << info.err;
+  EXPECT_EQ(std::count(info.err.begin(), info.err.end(), '\n'), 1) << info.err;
+  EXPECT_NE(info.err.find(line), std::string::npos) << info.err;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace pyrolume
