@@ -158,9 +158,10 @@ class GridChecker {
       const uint64_t meta = table + (count - 1) * sizeof(GridBlindMetaData);
       const auto& m = at<GridBlindMetaData>(meta);
       if (m.mDataClass != nanovdb::GridBlindDataClass::GridName) fail("long grid name flag set without a name in its blind data");
-      if (m.mElementCount == 0 || m.mElementCount > size_) fail("long grid name of " + std::to_string(m.mElementCount) + " bytes does not fit");
-      const uint64_t name = locate(meta, m.mByteOffset, m.mElementCount, "long grid name", /*aligned=*/false);
-      if (!std::memchr(base_ + name, 0, m.mElementCount)) fail("long grid name is not terminated");
+      // Its element count says nothing of its length (OpenToNanoVDB writes
+      // 1): the name ends at its terminator, before the grid's end.
+      const uint64_t name = locate(meta, m.mByteOffset, 1, "long grid name", /*aligned=*/false);
+      if (!std::memchr(base_ + name, 0, size_ - name)) fail("long grid name is not terminated");
     } else if (!std::memchr(g.mGridName, 0, nanovdb::GridData::MaxNameSize)) {
       fail("grid name is not terminated");
     }
@@ -207,6 +208,10 @@ class TreeChecker : public GridChecker {
     if (root < tree + sizeof(nanovdb::TreeData<3>)) fail("root node overlaps the tree header");
     const auto& r = at<RootDataT>(root);
     const uint64_t tiles = r.mTableSize;
+    // Written with statistics off (StatsMode::Disable), a grid has no
+    // bounding boxes; the loaders size the volume by the root's.
+    if (t.mVoxelCount > 0 && r.mBBox.empty() && !(at<nanovdb::GridData>(0).mFlags & uint32_t(nanovdb::GridFlags::HasBBox)))
+      fail("it has no index bounding box (written with statistics disabled); convert it again with bounding boxes on");
     if (root + sizeof(RootT) > nodes_end || tiles > (nodes_end - root - sizeof(RootT)) / sizeof(Tile))
       fail("root table of " + std::to_string(tiles) + " tiles runs past the nodes' end at byte " +
            std::to_string(nodes_end));
@@ -308,13 +313,22 @@ class TreeChecker : public GridChecker {
   template <class NodeT>
   void internal(uint64_t at_byte, const Coord& expected, int level) {
     const NodeT& node = at<NodeT>(at_byte);
-    if (node.origin() != expected)
+    // origin() is the min of the node's bounding box, which GridStats leaves
+    // empty in a node without active values (a leaf whose voxels were all
+    // turned off): such a node has no origin to check, and must stay empty
+    // (nanoToOpenVDB places nodes by origin()).
+    const bool unplaced = node.origin() != expected;
+    if (unplaced && !node.bbox().empty())
       fail(std::string(kLevelNames[level]) + " node at byte " + std::to_string(at_byte) + " has origin " + text(node.origin()) +
            " where its parent puts " + text(expected));
+    const uint64_t active_before = voxels_.count;
     using ChildT = typename NodeT::ChildNodeType;
     const auto* d = node.data();
     for (uint32_t n = 0; n < NodeT::SIZE; ++n) {
-      const Coord o = node.offsetToGlobalCoord(n);
+      // From the origin the parent gives, not origin() (see above).
+      Coord o = NodeT::OffsetToLocalCoord(n);
+      o <<= ChildT::TOTAL;
+      o += expected;
       if (d->mChildMask.isOn(n)) {
         const uint64_t c = child_node(at_byte, d->mTable[n].child, level - 1,
                                       std::string(kLevelNames[level]) + " node's child " + std::to_string(n));
@@ -324,6 +338,9 @@ class TreeChecker : public GridChecker {
         voxels_.add_box(o, ChildT::DIM);
       }
     }
+    if (unplaced && voxels_.count != active_before)
+      fail(std::string(kLevelNames[level]) + " node at byte " + std::to_string(at_byte) +
+           " holds active values but has an empty bounding box");
   }
 
   void leaf(uint64_t at_byte, const Coord& expected) {

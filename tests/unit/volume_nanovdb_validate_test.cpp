@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <climits>
 #include <cstring>
 #include <fstream>
 #include <functional>
@@ -16,6 +17,7 @@
 
 #include <nanovdb/NanoVDB.h>
 #include <nanovdb/util/IO.h>
+#include <nanovdb/util/OpenToNanoVDB.h>
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
@@ -23,6 +25,7 @@
 #include "support/TestSupport.h"
 #include "support/VdbScenes.h"
 #include "util/Error.h"
+#include "volume/NanoVdbValidate.h"
 #include "volume/SparseGrid.h"
 #include "volume/VdbInfo.h"
 #include "volume/VdbLoader.h"
@@ -158,6 +161,17 @@ TEST(NanoVdbValidate, EachForgedFieldIsRefusedByEveryReaderInOneLine) {
       // and of quantised grids) threw OpenVDB's ArithmeticError out of the loader.
       {"index-to-world map", [](Bytes& b, size_t g) { put<double>(b, g + kMapD, 0.0); },
        "index-to-world map is singular or not finite"},
+      // A node's origin is its bounding box's min, unchecked where the box
+      // is empty (a node without active values): this one has some.
+      {"lower node bounding box (emptied)",
+       [](Bytes& b, size_t g) {
+         const size_t lower = g + kTree + get<uint64_t>(b, g + kNodeOffset + 8);
+         for (int a = 0; a < 3; ++a) {
+           put<int32_t>(b, lower + 4 * a, INT32_MAX);
+           put<int32_t>(b, lower + 12 + 4 * a, INT32_MIN);
+         }
+       },
+       "holds active values but has an empty bounding box"},
       {"leaf origin",
        [](Bytes& b, size_t g) {
          const size_t leaf = g + kTree + get<uint64_t>(b, g + kNodeOffset);
@@ -178,6 +192,88 @@ TEST(NanoVdbValidate, EachForgedFieldIsRefusedByEveryReaderInOneLine) {
       EXPECT_EQ(err.find('\n'), std::string::npos) << what << err;
     }
   }
+  fs::remove_all(dir);
+}
+
+// A grid with what a forgery check can mistake for a forgery: voxels at
+// negative coordinates, active tiles of a lower and an upper node and of the
+// root (when `large`), an inactive root tile, and leaves whose voxels are all off, one
+// beside active voxels (its lower node holds no active value) and one alone
+// (its upper node neither): OpenToNanoVDB leaves such nodes an empty
+// bounding box, whose min is what NanoVDB's origin() returns.
+template <class GridT>
+typename GridT::Ptr awkward_grid(const std::string& name, bool large) {
+  auto g = GridT::create(0);
+  g->setName(name);
+  auto acc = g->getAccessor();
+  acc.setValue({-5, 3, -700}, 0.5);
+  acc.setValue({9, 1, 2}, 1.0);
+  acc.setValueOff({3000, 3000, 3000}, 2.0);
+  acc.setValueOff({5000, 5000, 5000}, 2.0);
+  g->tree().addTile(1, openvdb::Coord(16, 0, 0), 1.5, true);
+  if (large) {
+    g->tree().addTile(2, openvdb::Coord(-128, 0, 0), 0.25, true);
+    g->tree().addTile(3, openvdb::Coord(8192, 0, 0), 1.5, true);
+  }
+  g->tree().addTile(3, openvdb::Coord(-8192, 0, 0), 1.5, false);
+  return g;
+}
+
+std::string validate_error(const nanovdb::GridHandle<nanovdb::HostBuffer>& h, const std::string& grid = "density",
+                           const nanovdb::io::GridMetaData* listed = nullptr) {
+  try {
+    validate_nanovdb_grid(h, "valid.nvdb", grid, listed);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Grids as NanoVDB's own converter writes them, in every value type
+// pyrolume reads and every statistics mode that writes bounding boxes:
+// none is refused. Without statistics there are no bounding boxes (the
+// loaders size a volume by the root's): refused in one line saying so.
+TEST(NanoVdbValidate, GridsThatNanoVdbWritesAreAccepted) {
+  openvdb::initialize();
+  using nanovdb::HostBuffer;
+  using nanovdb::StatsMode;
+  const auto f = awkward_grid<openvdb::FloatGrid>("density", true);
+  const auto d = awkward_grid<openvdb::DoubleGrid>("density", true);
+  for (StatsMode s : {StatsMode::BBox, StatsMode::MinMax, StatsMode::All}) {
+    const std::string what = "stats mode " + std::to_string(int(s)) + ", ";
+    EXPECT_EQ(validate_error(nanovdb::openToNanoVDB(*f, s)), "") << what << "float";
+    EXPECT_EQ(validate_error(nanovdb::openToNanoVDB(*d, s)), "") << what << "double";
+    EXPECT_EQ(validate_error(nanovdb::openToNanoVDB<HostBuffer, openvdb::FloatTree, nanovdb::Fp4>(*f, s)), "") << what << "Fp4";
+    EXPECT_EQ(validate_error(nanovdb::openToNanoVDB<HostBuffer, openvdb::FloatTree, nanovdb::Fp8>(*f, s)), "") << what << "Fp8";
+    EXPECT_EQ(validate_error(nanovdb::openToNanoVDB<HostBuffer, openvdb::FloatTree, nanovdb::Fp16>(*f, s)), "") << what << "Fp16";
+    EXPECT_EQ(validate_error(nanovdb::openToNanoVDB<HostBuffer, openvdb::FloatTree, nanovdb::FpN>(*f, s)), "") << what << "FpN";
+  }
+  const std::string no_box = validate_error(nanovdb::openToNanoVDB(*f, StatsMode::Disable));
+  EXPECT_EQ(no_box.rfind("valid.nvdb: grid \"density\": corrupt NanoVDB grid: it has no index bounding box", 0), 0u) << no_box;
+
+  // One file of several grids, one with a name longer than the grid header
+  // holds (NanoVDB keeps it as blind data), one with no active voxel, one
+  // quantised: each as read from the file, with the file's record of it,
+  // and the file through every reader.
+  const fs::path dir = test::temp_dir("nvdb-written");
+  const std::string long_name(300, 'n');
+  auto empty = openvdb::FloatGrid::create(0.0f);
+  empty->setName("empty");
+  std::vector<nanovdb::GridHandle<HostBuffer>> handles;
+  handles.push_back(nanovdb::openToNanoVDB(*awkward_grid<openvdb::FloatGrid>("density", false)));
+  handles.push_back(nanovdb::openToNanoVDB(*awkward_grid<openvdb::FloatGrid>(long_name, false)));
+  handles.push_back(nanovdb::openToNanoVDB(*empty));
+  handles.push_back(nanovdb::openToNanoVDB<HostBuffer, openvdb::FloatTree, nanovdb::FpN>(
+      *awkward_grid<openvdb::FloatGrid>("fpn", false)));
+  const fs::path p = dir / "written.nvdb";
+  nanovdb::io::writeGrids<HostBuffer, std::vector>(p.string(), handles);
+  const auto metas = nanovdb::io::readGridMetaData(p.string());
+  ASSERT_EQ(metas.size(), 4u);
+  for (const auto& md : metas) {
+    const auto h = nanovdb::io::readGrid<HostBuffer>(p.string(), md.gridName);
+    EXPECT_EQ(validate_error(h, md.gridName, &md), "") << md.gridName.substr(0, 10);
+  }
+  for (const char* reader : {"dense", "sparse", "info --values"}) EXPECT_EQ(read_error(p, reader), "") << reader;
   fs::remove_all(dir);
 }
 
