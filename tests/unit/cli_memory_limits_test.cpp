@@ -106,8 +106,11 @@ TEST_F(CliMemoryLimits, ARootTileOfA4096CubeIsRefusedBeforeAllocating) {
 // Issue 45: a grid whose dense texture does not fit under the limit, so
 // "auto" keeps it sparse, and whose sparse tree does not fit either (a
 // 1024 x 1024 x 1024 cube of one value, as 512 active 128³ tiles: 2^21
-// leaves once voxelized). Without the check it ended in "internal error:
-// Pool::Pool malloc failed" (NanoVDB's allocation failure), exit 1.
+// leaves once voxelized). Without any check it ended in "out of memory: an
+// allocation failed (std::bad_alloc)", exit 1 (a denser grid reached
+// NanoVDB's "internal error: Pool::Pool malloc failed" instead); with only the
+// catch of allocation failures, in "memory ran out while reading it", exit 2,
+// after allocating up to the limit.
 TEST_F(CliMemoryLimits, AGridWhoseSparseTreeCannotFitEitherIsRefused) {
   auto dir = temp_dir("mem-sparse-tree");
   const fs::path vdb = write_tiles_vdb(dir / "cube.vdb", 2, 8);
