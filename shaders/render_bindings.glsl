@@ -36,14 +36,26 @@ layout(constant_id = SPEC_LIGHT_COUNT) const uint LIGHT_COUNT = 0;
 // film.aovs: the light layers and first-hit features; off compiles their code out.
 layout(constant_id = SPEC_AOVS) const bool AOVS = false;
 
-layout(std140, set = 0, binding = BINDING_FRAME) uniform FrameBlock { FrameConstants frame; };
-// Media and grids are uniform blocks: every lane reads the same entries, which
-// uniform loads serve without per-lane gathers.
-layout(std140, set = 0, binding = BINDING_MEDIA) uniform MediaBlock { GpuMedium media[MAX_MEDIA]; };
+// The frame, the media and the light headers are storage buffers, though every
+// lane reads the same entries: lavapipe (Mesa 22.x) inlines uniform-block and
+// push-constant values that alone decide a branch or a loop count (say
+// frame.p_env > 0, a medium's shape) and JIT-compiles a new variant of this
+// shader every time a pass binds them, never freed: a compile and ~0.5 MB per
+// pass (docs/robustness.md "Constant memory over a long sequence"). Values in
+// storage buffers are never inlined. std140 keeps the host's layouts.
+layout(std140, set = 0, binding = BINDING_FRAME) readonly buffer FrameBlock { FrameConstants frame; };
+layout(std140, set = 0, binding = BINDING_MEDIA) readonly buffer MediaBlock { GpuMedium media[MAX_MEDIA]; };
 layout(std430, set = 0, binding = BINDING_ACCUM) buffer AccumBlock { AccumTexel accum[]; };
 layout(std430, set = 0, binding = BINDING_ALPHA) buffer AlphaBlock { AlphaTexel alpha_accum[]; };
 layout(std430, set = 0, binding = BINDING_AOV_LIGHTS) buffer AovLightBlock { AovLightTexel aov_lights[]; };
 layout(std430, set = 0, binding = BINDING_AOV_FEATURES) buffer AovFeatureBlock { AovFeatureTexel aov_features[]; };
+// The grids stay a uniform block: the free-flight loop reads them every step,
+// where a uniform load is one scalar read and a storage buffer's a per-lane
+// gather (as a storage buffer they made assets/scenes/fire.json render 1.8×
+// slower). lavapipe inlines none of their values (measured: one compile per
+// pipeline with dense, sparse and several grids); should a change make a
+// grid value alone decide a branch, the memory tests in
+// tests/vulkan/sequence_memory_test.cpp fail.
 layout(std140, set = 0, binding = BINDING_GRIDS) uniform GridBlock { GpuGrid grids[MAX_GRIDS]; };
 // A uniform texel buffer, not a storage buffer: on lavapipe a texel fetch is
 // the cheaper gather, and the free-flight loop reads a cell every step
@@ -61,7 +73,8 @@ layout(set = 0, binding = BINDING_DENSITY_TEXELS) uniform samplerBuffer density_
 layout(constant_id = SPEC_SPARSE_GRIDS) const bool SPARSE_GRIDS = false;
 layout(set = 0, binding = BINDING_SPARSE) uniform usamplerBuffer sparse_tex;
 #include "sparse.glsl"
-layout(push_constant) uniform PassBlock { PassConstants pass_constants; };
+// A storage buffer, not push constants, for the same reason (vk::ParameterBuffer).
+layout(std430, set = 0, binding = BINDING_PASS) readonly buffer PassBlock { PassConstants pass_constants; };
 layout(std430, set = 0, binding = BINDING_PASS_STATUS) buffer PassStatusBlock { PassStatus pass_status; };
 // Surfaces (shaders/bvh.glsl's contract).
 layout(std430, set = 0, binding = BINDING_BVH_NODES) readonly buffer BvhNodes { GpuBvhNode bvh_nodes[]; };
@@ -80,7 +93,7 @@ layout(set = 0, binding = BINDING_TEXTURES) uniform sampler2D albedo_tex[MAX_TEX
 #define LIGHTS_ENVIRONMENT
 layout(std430, set = 0, binding = BINDING_ENV_TEXELS) readonly buffer EnvTexelBlock { vec4 env_texels[]; };
 layout(std430, set = 0, binding = BINDING_ENV_CDF) readonly buffer EnvCdfBlock { float env_cdf[]; };
-layout(std140, set = 0, binding = BINDING_ENV_HEADER) uniform EnvHeaderBlock { GpuEnvironment environment; };
+layout(std140, set = 0, binding = BINDING_ENV_HEADER) readonly buffer EnvHeaderBlock { GpuEnvironment environment; };
 #define LIGHTS_EMISSION
 layout(std430, set = 0, binding = BINDING_EMISSION_CDF) readonly buffer EmissionCdfBlock { float emission_cdf[]; };
 layout(std430, set = 0, binding = BINDING_EMISSION_CELLS) readonly buffer EmissionCellBlock { uint emission_cells[]; };
@@ -88,7 +101,7 @@ layout(std430, set = 0, binding = BINDING_EMISSION_PMF) readonly buffer Emission
 layout(std430, set = 0, binding = BINDING_EMISSION_CLUSTERS) readonly buffer EmissionClusterBlock {
   GpuEmissionCluster emission_clusters[];
 };
-layout(std140, set = 0, binding = BINDING_EMISSION_HEADERS) uniform EmissionHeaderBlock {
+layout(std140, set = 0, binding = BINDING_EMISSION_HEADERS) readonly buffer EmissionHeaderBlock {
   GpuEmissionCdf emission_lights[MAX_GRIDS];  // by grid slot
 };
 #include "lights.glsl"

@@ -58,6 +58,7 @@ PYRO_CONST uint BINDING_AOV_LIGHTS = 27;    // buffer AovLightTexel[] (one per p
 PYRO_CONST uint BINDING_AOV_FEATURES = 28;  // buffer AovFeatureTexel[] (one per pixel; film.aovs)
 PYRO_CONST uint BINDING_SPARSE = 29;  // usamplerBuffer (rgba32ui): every sparse grid's NanoVDB tree and leaf table (shaders/sparse.glsl)
 PYRO_CONST uint BINDING_DENSITY_TEXELS = 30;  // samplerBuffer[MAX_GRIDS] (r16f or r32f): each dense grid's density texels, for stochastic lookups
+PYRO_CONST uint BINDING_PASS = 31;  // readonly buffer PassConstants: this dispatch's samples and rows (not push constants: vk::ParameterBuffer)
 PYRO_CONST uint SPARSE_ZERO_LEAF = 32;  // byte offset of 512 zero floats in that buffer: the values of every absent leaf
 
 // Specialisation constants of render.comp: a scene pays only for what it uses.
@@ -211,7 +212,7 @@ struct FrameConstants {
   uint ratio_tracked_continuation;
 };
 
-// Per-pass values (push constants).
+// Per-pass values (buffer BINDING_PASS, written before each dispatch).
 struct PassConstants {
   uint sample_offset;  // index of this pass's first sample per pixel
   uint spp;            // samples per pixel in this pass

@@ -79,6 +79,22 @@ void ComputePipeline::push(VkCommandBuffer cmd, const void* data, uint32_t bytes
   vkCmdPushConstants(cmd, layout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, data);
 }
 
+ParameterBuffer::ParameterBuffer(Context& ctx, VkDeviceSize bytes, const char* name)
+    : buffer_(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+              MemoryKind::DeviceLocal, name) {}
+
+void ParameterBuffer::record(VkCommandBuffer cmd, const void* data, VkDeviceSize bytes) const {
+  // vkCmdUpdateBuffer's rules: 4-byte multiples, at most 64 KiB.
+  if (bytes == 0 || bytes % 4 != 0 || bytes > buffer_.size() || bytes > 65536)
+    throw VulkanError("ParameterBuffer: a write of " + std::to_string(bytes) + " bytes into " +
+                      std::to_string(buffer_.size()));
+  memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                 VK_ACCESS_TRANSFER_WRITE_BIT);
+  vkCmdUpdateBuffer(cmd, buffer_.buffer(), 0, bytes, data);
+  memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                 VK_ACCESS_SHADER_READ_BIT);
+}
+
 DescriptorSet::DescriptorSet(Context& ctx, const ComputePipeline& pipeline, const char* debug_name)
     : device_(ctx.device()), bindings_(pipeline.bindings()) {
   std::map<VkDescriptorType, uint32_t> counts;

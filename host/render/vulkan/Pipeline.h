@@ -36,7 +36,9 @@ class ComputePipeline {
 
   // Binds the pipeline and `set` (set = 0) for dispatch.
   void bind(VkCommandBuffer cmd, VkDescriptorSet set) const;
-  // bytes must not exceed push_constant_bytes.
+  // bytes must not exceed push_constant_bytes. Only for small shaders or
+  // values that never change: a value that changes per dispatch belongs in a
+  // ParameterBuffer (below).
   void push(VkCommandBuffer cmd, const void* data, uint32_t bytes) const;
   template <typename T>
   void push(VkCommandBuffer cmd, const T& value) const {
@@ -50,6 +52,35 @@ class ComputePipeline {
   UniqueDescriptorSetLayout set_layout_;
   UniquePipelineLayout layout_;
   UniquePipeline pipeline_;
+};
+
+// Values that change from one dispatch to the next (a pass's samples and
+// rows, a filter's step), read by the shader from a storage buffer rather
+// than from push constants or a uniform buffer. lavapipe (Mesa 22.x) inlines
+// the push-constant and uniform values that decide a branch or a loop count
+// and JIT-compiles a new variant of the shader for each dispatch that binds
+// them; the variants are never freed, so every pass cost a compile and about
+// 0.5 MB (docs/robustness.md "Constant memory over a long sequence"). Values
+// in a storage buffer are never inlined: the shader is compiled once, with
+// its pipeline.
+class ParameterBuffer {
+ public:
+  ParameterBuffer() = default;
+  ParameterBuffer(Context& ctx, VkDeviceSize bytes, const char* name);
+
+  const Buffer& buffer() const { return buffer_; }
+
+  // Records the write of `bytes` of `data` (a multiple of 4, at most the
+  // buffer's size) into the command buffer, after the shader reads of earlier
+  // dispatches and before those of later ones.
+  void record(VkCommandBuffer cmd, const void* data, VkDeviceSize bytes) const;
+  template <typename T>
+  void record(VkCommandBuffer cmd, const T& value) const {
+    record(cmd, &value, sizeof(T));
+  }
+
+ private:
+  Buffer buffer_;
 };
 
 // One descriptor set for a pipeline's set layout, from a pool of its own (freed

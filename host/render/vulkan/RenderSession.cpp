@@ -90,9 +90,11 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   check_loaded_media(scene, volumes_);
   gpu_scene_ = build_gpu_scene(scene, volumes_, /*with_luts=*/true, shared_texture_bytes(settings));
 
-  frame_buffer_ = vk::Buffer(ctx, sizeof(gpu::FrameConstants), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
-                             vk::MemoryKind::HostVisible, "frame constants");
-  media_buffer_ = vk::Buffer(ctx, gpu::MAX_MEDIA * sizeof(gpu::GpuMedium), kUniform, vk::MemoryKind::HostVisible, "media");
+  // Storage buffers, not uniform ones: lavapipe would inline their values
+  // where they decide a branch and compile a shader variant for every pass
+  // (shaders/render_bindings.glsl).
+  frame_buffer_ = vk::Buffer(ctx, sizeof(gpu::FrameConstants), kStorage, vk::MemoryKind::HostVisible, "frame constants");
+  media_buffer_ = vk::Buffer(ctx, gpu::MAX_MEDIA * sizeof(gpu::GpuMedium), kStorage, vk::MemoryKind::HostVisible, "media");
   grid_buffer_ = vk::Buffer(ctx, gpu::MAX_GRIDS * sizeof(gpu::GpuGrid), kUniform, vk::MemoryKind::HostVisible, "grids");
   create_majorant_buffer(scene);
   const VkDeviceSize pixels = VkDeviceSize(settings.width) * VkDeviceSize(settings.height);
@@ -111,12 +113,13 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                       vk::MemoryKind::DeviceLocal, "accumulation");
   accum_backup_ = vk::Buffer(ctx, accum_.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                              vk::MemoryKind::DeviceLocal, "accumulation before the pass");
+  pass_constants_ = vk::ParameterBuffer(ctx, sizeof(gpu::PassConstants), "pass constants");
   pass_status_ = vk::Buffer(ctx, sizeof(gpu::PassStatus), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                             vk::MemoryKind::HostVisible, "pass status");
   create_textures(scene);
   create_surfaces(scene);
   create_environment(scene);
-  emission_headers_ = vk::Buffer(ctx, gpu::MAX_GRIDS * sizeof(gpu::GpuEmissionCdf), kUniform,
+  emission_headers_ = vk::Buffer(ctx, gpu::MAX_GRIDS * sizeof(gpu::GpuEmissionCdf), kStorage,
                                  vk::MemoryKind::HostVisible, "emission light headers");
   upload_emission_lights(build_emission_lights(scene, volumes_, gpu_scene_));
 
@@ -124,8 +127,8 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   const std::vector<uint32_t> code = vk::load_spirv("render.comp");
   pipeline_.emplace(ctx, code,
                     std::vector<vk::ComputePipeline::Binding>{
-                        {gpu::BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
-                        {gpu::BINDING_MEDIA, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+                        {gpu::BINDING_FRAME, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_MEDIA, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_ACCUM, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_ALPHA, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_AOV_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
@@ -144,18 +147,19 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
                         {gpu::BINDING_TEXTURES, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, gpu::MAX_TEXTURES},
                         {gpu::BINDING_ENV_TEXELS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_ENV_CDF, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                        {gpu::BINDING_ENV_HEADER, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+                        {gpu::BINDING_ENV_HEADER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_EMISSION_CDF, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_EMISSION_CELLS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_EMISSION_PMF, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_EMISSION_CLUSTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                        {gpu::BINDING_EMISSION_HEADERS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+                        {gpu::BINDING_EMISSION_HEADERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_PASS_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_PATHS, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER},
                         {gpu::BINDING_SPARSE, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER},
-                        {gpu::BINDING_QUEUES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
-                    uint32_t(sizeof(gpu::PassConstants)), spec_, "render");
+                        {gpu::BINDING_QUEUES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                        {gpu::BINDING_PASS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
+                    /*push_constant_bytes=*/0, spec_, "render");
   set_.emplace(ctx, *pipeline_, "render set");
   create_wavefront(code);
   set_->write_buffer(gpu::BINDING_FRAME, frame_buffer_);
@@ -171,6 +175,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
     set_->write_buffer(gpu::BINDING_AOV_FEATURES, accum_, alpha_offset_, alpha_bytes);
   }
   set_->write_buffer(gpu::BINDING_PASS_STATUS, pass_status_);
+  set_->write_buffer(gpu::BINDING_PASS, pass_constants_.buffer());
   set_->write_buffer(gpu::BINDING_GRIDS, grid_buffer_);
   write_grid_descriptors();
   set_->write_buffer(gpu::BINDING_BVH_NODES, bvh_nodes_);
@@ -188,14 +193,12 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   // docs/rendering.md): dispatch one empty workgroup now so that cost counts as
   // loading, not rendering (docs/benchmarks.md: `seconds` starts at the first real pass).
   ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    gpu::PassConstants nothing{0u, 0u, 0u, 0u};
+    pass_constants_.record(cmd, gpu::PassConstants{0u, 0u, 0u, 0u});
     pipeline_->bind(cmd, set_->set());
-    pipeline_->push(cmd, nothing);
     vkCmdDispatch(cmd, 1, 1, 1);
     // The wavefront's stages, on empty queues (the queues are zero).
     for (const vk::ComputePipeline& stage : wavefront_stages_) {
       stage.bind(cmd, set_->set());
-      stage.push(cmd, nothing);
       vkCmdDispatch(cmd, 1, 1, 1);
     }
   });
@@ -567,7 +570,7 @@ void RenderSession::create_environment(const Scene& scene) {
   }
   env_texels_ = storage_buffer(ctx_, texels, "environment");
   env_cdf_ = storage_buffer(ctx_, cdf, "environment cdf");
-  env_header_ = vk::Buffer(ctx_, sizeof header, kUniform, vk::MemoryKind::HostVisible, "environment header");
+  env_header_ = vk::Buffer(ctx_, sizeof header, kStorage, vk::MemoryKind::HostVisible, "environment header");
   env_header_.upload(ctx_, &header, sizeof header);
 }
 
@@ -651,13 +654,13 @@ void RenderSession::record_band(VkCommandBuffer cmd, int spp, int row_begin, int
                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     needs_clear_ = false;
   }
-  gpu::PassConstants pass{uint32_t(spp_done_), uint32_t(spp), uint32_t(row_begin), uint32_t(row_end)};
+  const gpu::PassConstants pass{uint32_t(spp_done_), uint32_t(spp), uint32_t(row_begin), uint32_t(row_end)};
+  pass_constants_.record(cmd, pass);
   if (wavefront) {
     record_wavefront_start(cmd, pass);
     return;
   }
   pipeline_->bind(cmd, set_->set());
-  pipeline_->push(cmd, pass);
   const uint32_t groups_x = (uint32_t(settings_.width) + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X;
   const uint32_t groups_y = (uint32_t(row_end - row_begin) + gpu::WORKGROUP_SIZE_Y - 1) / gpu::WORKGROUP_SIZE_Y;
   vkCmdDispatch(cmd, groups_x, groups_y, 1);
@@ -712,8 +715,8 @@ void RenderSession::create_wavefront(const std::vector<uint32_t>& code) {
     for (auto& [id, value] : spec)
       if (id == gpu::SPEC_EARLY_EVENT_EXIT)
         value = stage == gpu::WAVEFRONT_TRACK && ctx_.features().subgroup_ballot ? 1u : 0u;
-    wavefront_stages_.emplace_back(ctx_, code, pipeline_->bindings(), uint32_t(sizeof(gpu::PassConstants)),
-                                   spec, "render wavefront stage");
+    wavefront_stages_.emplace_back(ctx_, code, pipeline_->bindings(), /*push_constant_bytes=*/0, spec,
+                                   "render wavefront stage");
   }
 }
 
@@ -723,10 +726,8 @@ void RenderSession::record_wavefront_start(VkCommandBuffer cmd, const gpu::PassC
   vkCmdUpdateBuffer(cmd, wavefront_queues_.buffer(), 0, sizeof start, &start);
   vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-  wavefront_pass_ = pass;
   const vk::ComputePipeline& start_stage = wavefront_stages_[gpu::WAVEFRONT_START - 1];
   start_stage.bind(cmd, set_->set());
-  start_stage.push(cmd, pass);
   const uint32_t groups_x = (uint32_t(settings_.width) + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X;
   const uint32_t groups_y = (pass.row_end - pass.row_begin + gpu::WORKGROUP_SIZE_Y - 1) / gpu::WORKGROUP_SIZE_Y;
   vkCmdDispatch(cmd, groups_x, groups_y, 1);
@@ -740,10 +741,10 @@ void RenderSession::record_wavefront_iterations(VkCommandBuffer cmd, int iterati
                        VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
   };
   auto stage = [&](uint32_t s) -> const vk::ComputePipeline& { return wavefront_stages_[s - 1]; };
-  // The stages' layouts are identically defined, so the set and the push
-  // constants stay bound across their pipelines: bound once.
+  // The stages' layouts are identically defined, so the set stays bound
+  // across their pipelines: bound once. The pass's constants stay in their
+  // buffer (record_band wrote them).
   stage(gpu::WAVEFRONT_TRACK).bind(cmd, set_->set());
-  stage(gpu::WAVEFRONT_TRACK).push(cmd, wavefront_pass_);
   // A queue stage: its one-lane sizing stage, then the stage itself, as large as its queue.
   auto run = [&](uint32_t sizing, uint32_t queued, VkDeviceSize dispatch_offset) {
     barrier();

@@ -156,6 +156,7 @@ class RenderSession {
   std::optional<vk::ComputePipeline> pipeline_;
   std::optional<vk::DescriptorSet> set_;
   std::vector<std::pair<uint32_t, uint32_t>> spec_;  // the variant pipeline_ was compiled for
+  vk::ParameterBuffer pass_constants_;  // PassConstants of the dispatch recorded last (record_band)
   vk::Buffer pass_status_, accum_backup_;  // PassStatus; the accumulation before the pass in flight
   VkDeviceSize alpha_offset_ = 0;          // where accum_'s AlphaTexels start (aligned for their binding)
   // settings.aovs: where accum_'s AovLightTexels and AovFeatureTexels start
@@ -187,7 +188,6 @@ class RenderSession {
   vk::UniqueBufferView sparse_view_;
   uint32_t wavefront_capacity_ = 0;
   bool wavefront_split_ = false;
-  gpu::PassConstants wavefront_pass_{};
   uint64_t dropped_samples_ = 0;
   int spp_done_ = 0;
   bool needs_clear_ = true;
