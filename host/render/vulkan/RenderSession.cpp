@@ -189,9 +189,10 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
   for (uint32_t slot = 0; slot < gpu::MAX_TEXTURES; ++slot)
     set_->write_image(gpu::BINDING_TEXTURES, textures_2d_[slot + 1 < textures_2d_.size() ? slot + 1 : 0], slot);
   upload_constants(scene);
-  // lavapipe compiles a pipeline inside its first dispatch (~0.1–0.5 s,
-  // docs/rendering.md): dispatch one empty workgroup now so that cost counts as
-  // loading, not rendering (docs/benchmarks.md: `seconds` starts at the first real pass).
+  // A driver may compile a pipeline inside its first dispatch (~0.1–0.5 s;
+  // lavapipe did while it inlined uniforms, docs/rendering.md): dispatch one
+  // empty workgroup now so that cost counts as loading, not rendering
+  // (docs/benchmarks.md: `seconds` starts at the first real pass).
   ctx.submit_and_wait([&](VkCommandBuffer cmd) {
     pass_constants_.record(cmd, gpu::PassConstants{0u, 0u, 0u, 0u});
     pipeline_->bind(cmd, set_->set());
