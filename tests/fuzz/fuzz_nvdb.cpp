@@ -6,12 +6,11 @@
 // .nvdb files too, but only with texture_format "auto"; here both paths run
 // on every input.
 #include <cstdint>
-#include <sstream>
 
 #include "fuzz/FuzzSupport.h"
+#include "fuzz/VolumeFuzz.h"
 #include "scene/MediumVolume.h"
 #include "volume/SparseGrid.h"
-#include "volume/VdbInfo.h"
 #include "volume/VdbLoader.h"
 
 using namespace pyrolume;
@@ -28,14 +27,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::filesystem::path& path = fuzz::write_scratch(data, size, ".nvdb");
   const std::string file = path.string();
-  for (bool values : {false, true}) {
-    try {
-      std::ostringstream out;
-      run_info_command(path, values, out);
-    } catch (const InputError& e) {
-      fuzz::check_input_error(e, file);
-    }
-  }
+  fuzz::run_info_both_ways(path, file);
   for (TextureFormat format : {TextureFormat::R32F, TextureFormat::Sparse}) {
     Medium m;
     m.type = Medium::Type::Vdb;

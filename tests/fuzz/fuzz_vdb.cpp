@@ -3,11 +3,10 @@
 // detection by magic bytes, grid listing, reading the chosen grids into
 // dense arrays).
 #include <cstdint>
-#include <sstream>
 
 #include "fuzz/FuzzSupport.h"
+#include "fuzz/VolumeFuzz.h"
 #include "scene/MediumVolume.h"
-#include "volume/VdbInfo.h"
 #include "volume/VdbLoader.h"
 
 using namespace pyrolume;
@@ -22,14 +21,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::filesystem::path& path = fuzz::write_scratch(data, size, ".vdb");
   const std::string file = path.string();
-  for (bool values : {false, true}) {
-    try {
-      std::ostringstream out;
-      run_info_command(path, values, out);
-    } catch (const InputError& e) {
-      fuzz::check_input_error(e, file);
-    }
-  }
+  fuzz::run_info_both_ways(path, file);
   Medium m;
   m.type = Medium::Type::Vdb;
   m.file = path;
