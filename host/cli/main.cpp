@@ -38,23 +38,29 @@ extern "C" void on_signal(int sig) {
   g_signal = sig;
 }
 
-// Seconds for --time-limit and --checkpoint: positive and finite. CLI11's
-// NonNegativeNumber took 0 (read as "no limit") and PositiveNumber took nan
-// and inf; neither checks that the whole argument is a number.
-const CLI::Validator kPositiveSeconds(
-    [](std::string& text) -> std::string {
-      double v = 0.0;
-      size_t used = 0;
-      try {
-        v = std::stod(text, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (text.empty() || used != text.size() || !std::isfinite(v) || !(v > 0.0))
-        return "must be a positive, finite number of seconds, got \"" + text + "\"";
-      return "";
-    },
-    "SEC>0");
+// A positive, finite number of `unit`, at most `max` (the largest float
+// where the value is stored as one). CLI11's NonNegativeNumber takes 0 (read
+// as "no limit" by --time-limit), PositiveNumber takes nan and inf, and
+// neither checks that the whole argument is a number.
+CLI::Validator positive_finite(const std::string& unit, double max = std::numeric_limits<double>::max()) {
+  return CLI::Validator(
+      [unit, max](std::string& text) -> std::string {
+        double v = 0.0;
+        size_t used = 0;
+        try {
+          v = std::stod(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (text.empty() || used != text.size() || !std::isfinite(v) || !(v > 0.0) || v > max || !(float(v) > 0.0f))
+          return "must be a positive, finite number of " + unit + ", got \"" + text + "\"";
+        return "";
+      },
+      "NUMBER>0");
+}
+
+// Seconds for --time-limit and --checkpoint.
+const CLI::Validator kPositiveSeconds = positive_finite("seconds");
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -153,17 +159,9 @@ int main(int argc, char** argv) {
                       "Plain filter: à-trous iterations (default 1; n reach ±(2^(n+1) − 2) px)")
       ->check(CLI::Range(0, 12));
   // The edge-stopping widths divide differences: NaN, an infinity or 0 would
-  // write NaN (or nothing filtered) into the image. CLI::PositiveNumber lets
-  // "nan" through (every comparison with NaN is false), so check as a float.
-  const CLI::Validator finite_positive(
-      [](std::string& text) -> std::string {
-        double v = 0.0;
-        if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || !(v > 0.0) ||
-            v > double(std::numeric_limits<float>::max()) || !(float(v) > 0.0f))
-          return "must be a finite number > 0 (single precision), not " + text;
-        return {};
-      },
-      "FINITE > 0");
+  // write NaN (or nothing filtered) into the image; the filter holds them as floats.
+  const CLI::Validator finite_positive =
+      positive_finite("standard deviations (single precision)", double(std::numeric_limits<float>::max()));
   denoise->add_option("--sigma-l", dn.sigma_l,
                       "Plain filter: luminance edge-stopping, in standard deviations of the noise (default 1.5)")
       ->check(finite_positive);
