@@ -1,6 +1,8 @@
 #!/usr/bin/python3
 """Checks every #include "..." under host/ and shaders/ against the folder
-rules in docs/architecture.md (the rules are read from there).
+rules in docs/architecture.md (the rules are read from there). A "never
+reaches" rule may also name a system header or a prefix of one
+(`<vulkan/`): no header the folder reaches may include it.
 
 usage: tools/check_includes.py [REPO_ROOT]   exit 0: all hold; 1: violations
 (one line each: FILE:LINE: FOLDER may not include TARGET); 2: bad rules.
@@ -12,6 +14,7 @@ import sys
 SOURCE_EXT = (".h", ".hpp", ".cpp", ".glsl", ".comp")
 RULE = re.compile(r"^- `([^`]+)` (may include|never reaches) (.*)$")
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
+SYSTEM_INCLUDE = re.compile(r"^\s*#\s*include\s+(<[^>]+>)")
 
 
 def read_rules(doc):
@@ -62,6 +65,7 @@ def main():
         print("check_includes: no rules found in docs/architecture.md")
         return 2
     edges = {}  # file -> [(line, included file)]
+    system = {}  # file -> [(line, <system header>)]
     for src in sources(root):
         with open(os.path.join(root, src), encoding="utf-8", errors="replace") as f:
             for n, line in enumerate(f, 1):
@@ -69,6 +73,9 @@ def main():
                 target = m and resolve(root, src, m.group(1))
                 if target:
                     edges.setdefault(src, []).append((n, target))
+                m = SYSTEM_INCLUDE.match(line)
+                if m:  # a leaf: only "never reaches" rules look at it
+                    system.setdefault(src, []).append((n, m.group(1)))
     bad = []
     for src, incs in sorted(edges.items()):
         folder = os.path.dirname(src)
@@ -88,7 +95,10 @@ def main():
                     if t not in seen:
                         seen[t] = seen[f] + [t]
                         stack.append(t)
-            hits = [c for t, c in seen.items() if t == forbidden or t.startswith(forbidden + "/")]
+            if forbidden.startswith("<"):
+                hits = [c + [h] for t, c in seen.items() for _, h in system.get(t, []) if h.startswith(forbidden)]
+            else:
+                hits = [c for t, c in seen.items() if t == forbidden or t.startswith(forbidden + "/")]
             if hits:
                 chain = min(hits, key=lambda c: (len(c), c))
                 bad.append(f"{src}: {folder} never reaches {forbidden}, but " + " -> ".join(chain))

@@ -13,7 +13,7 @@
 #include "cli/OutputCheck.h"
 #include "cli/Sequence.h"
 #include "color/Blackbody.h"
-#include "denoise/Denoiser.h"
+#include "denoise/Denoise.h"
 #include "image/AtomicFile.h"
 #include "image/Compare.h"
 #include "image/DisplayTransform.h"

@@ -311,22 +311,27 @@ std::vector<vec4> Denoiser::run_guided(const Image& noisy, const std::vector<flo
   return out;
 }
 
-Denoiser& DenoiserSession::open(int device_index) {
-  if (!denoiser_) {
+struct DenoiserSession::Device {
+  explicit Device(int device_index) : ctx([&] {
     vk::Context::Options o;
     o.device_index = device_index;
-    ctx_ = std::make_unique<vk::Context>(o);
-    denoiser_ = std::make_unique<Denoiser>(*ctx_);
-  }
-  return *denoiser_;
-}
+    return o;
+  }()), denoiser(ctx) {}
+  vk::Context ctx;
+  Denoiser denoiser;
+};
+
+DenoiserSession::DenoiserSession() = default;
+DenoiserSession::~DenoiserSession() = default;
 
 Image DenoiserSession::run(const Image& noisy, const DenoiseOptions& options, const std::string& name) {
-  return open(options.device_index).run(noisy, options, name);
+  if (!device_) device_ = std::make_unique<Device>(options.device_index);
+  return device_->denoiser.run(noisy, options, name);
 }
 
 void DenoiserSession::check_size(int width, int height, int device_index, const std::string& name) {
-  open(device_index).check_size(width, height, name);
+  if (!device_) device_ = std::make_unique<Device>(device_index);
+  device_->denoiser.check_size(width, height, name);
 }
 
 static bool has_features(const Image& img) {
