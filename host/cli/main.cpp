@@ -1,6 +1,7 @@
 // pyrolume command line (README.md "Using it"; the scene format: docs/scene-format.md).
 // Exit status: 0 ok, 1 internal error, 2 bad input, 3 compare beyond limits,
 // 130/143 interrupted (the image so far is saved first).
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
@@ -20,6 +21,7 @@
 #include "preview/Preview.h"
 #include "render/Render.h"
 #include "util/Error.h"
+#include "util/Suggest.h"
 
 namespace {
 std::atomic<bool> g_cancel{false};
@@ -61,6 +63,31 @@ CLI::Validator positive_finite(const std::string& unit, double max = std::numeri
 
 // Seconds for --time-limit and --checkpoint.
 const CLI::Validator kPositiveSeconds = positive_finite("seconds");
+
+// " (did you mean ...?)" for the first word on the command line that names
+// no subcommand or no flag of its subcommand, "" when there is none.
+std::string flag_suggestion(CLI::App& app, int argc, char** argv) {
+  if (argc < 2) return "";
+  std::vector<std::string> commands;
+  for (const CLI::App* sub : app.get_subcommands({})) commands.push_back(sub->get_name());
+  CLI::App* sub = nullptr;
+  try {
+    sub = app.get_subcommand(argv[1]);
+  } catch (const CLI::OptionNotFound&) {
+    return argv[1][0] == '-' ? "" : pyrolume::did_you_mean(argv[1], commands);
+  }
+  std::vector<std::string> flags;
+  for (const CLI::Option* o : sub->get_options()) {
+    for (const std::string& l : o->get_lnames()) flags.push_back("--" + l);
+    for (const std::string& n : o->get_snames()) flags.push_back("-" + n);
+  }
+  for (int i = 2; i < argc; ++i) {
+    const std::string word = std::string(argv[i]).substr(0, std::string(argv[i]).find('='));
+    if (word.size() < 3 || word.compare(0, 2, "--") != 0) continue;
+    if (std::find(flags.begin(), flags.end(), word) == flags.end()) return pyrolume::did_you_mean(word, flags);
+  }
+  return "";
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -179,7 +206,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "pyrolume: " << e.what() << " (see --help)\n";
+    const bool unknown_word = dynamic_cast<const CLI::ExtrasError*>(&e) || dynamic_cast<const CLI::RequiredError*>(&e);
+    std::cerr << "pyrolume: " << e.what() << (unknown_word ? flag_suggestion(app, argc, argv) : "") << " (see --help)\n";
     return 2;
   }
 

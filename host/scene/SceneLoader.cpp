@@ -14,6 +14,7 @@
 #include "util/Error.h"
 #include "util/InputFile.h"
 #include "util/Json.h"
+#include "util/Suggest.h"
 
 namespace pyrolume {
 namespace {
@@ -32,7 +33,11 @@ class Reader {
     throw input_error(file_, key.empty() ? path_ : join(key), reason);
   }
   std::string join(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
-  bool has(const std::string& key) const { return j_.contains(key); }
+  // Every key asked about is one this object may hold: finish() suggests among them.
+  bool has(const std::string& key) const {
+    asked_.insert(key);
+    return j_.contains(key);
+  }
   const json& raw(const std::string& key) {
     seen_.insert(key);
     return j_.at(key);
@@ -150,7 +155,8 @@ class Reader {
   // After reading: any key not consumed is a typo or unsupported.
   void finish() const {
     for (auto it = j_.begin(); it != j_.end(); ++it)
-      if (!seen_.count(it.key())) fail(it.key(), "unknown key");
+      if (!seen_.count(it.key()))
+        fail(it.key(), "unknown key" + did_you_mean(it.key(), std::vector<std::string>(asked_.begin(), asked_.end())));
   }
   const std::string& path() const { return path_; }
 
@@ -184,6 +190,7 @@ class Reader {
   std::string path_;
   const std::string& file_;
   std::set<std::string> seen_;
+  mutable std::set<std::string> asked_;
 };
 
 // d scaled by its largest component: the same direction, of length in [1, √3],
