@@ -18,6 +18,7 @@
 
 #include "cli/Commands.h"
 #include "image/AtomicFile.h"
+#include "image/DisplayTransform.h"
 #include "preview/Preview.h"
 #include "render/Render.h"
 #include "util/Error.h"
@@ -63,6 +64,10 @@ CLI::Validator positive_finite(const std::string& unit, double max = std::numeri
 
 // Seconds for --time-limit and --checkpoint.
 const CLI::Validator kPositiveSeconds = positive_finite("seconds");
+
+// --exposure: "auto" or stops within ±kMaxExposureStops; '' is refused too.
+const CLI::Validator kExposure(
+    [](std::string& text) { return pyrolume::exposure_problem(text); }, "EV|auto");
 
 // " (did you mean ...?)" for the first word on the command line that names
 // no subcommand or no flag of its subcommand, "" when there is none.
@@ -122,7 +127,9 @@ int main(int argc, char** argv) {
   render->add_flag("--denoise", render_args.denoise,
                    "Also write OUT.denoised.exr (or .png) through the denoiser; OUT itself is left as it is");
   render->add_option("--exposure", render_args.exposure,
-                     "PNG: exposure in stops, or auto (overrides film.exposure on every frame; EXR stays linear)");
+                     "PNG: exposure in stops (within ±30), or auto (overrides film.exposure on every frame; EXR stays "
+                     "linear)")
+      ->check(kExposure);
   render->add_option("--device", render_args.device, "Vulkan device index (see `pyrolume devices`)")->check(CLI::NonNegativeNumber);
   render->add_option("--frames", render_args.frames,
                      "Render frames A-B[:step] (or one frame A); -o and --stats are then patterns: out_####.exr");
@@ -146,7 +153,8 @@ int main(int argc, char** argv) {
   preview->add_option("--device", pv.device, "Vulkan device index")->check(CLI::NonNegativeNumber);
   preview->add_option("--width", pv.width, "Window width (overrides film.width)")->check(CLI::Range(16, pyrolume::kMaxFilmSide));
   preview->add_option("--height", pv.height, "Window height (overrides film.height)")->check(CLI::Range(16, pyrolume::kMaxFilmSide));
-  preview->add_option("--exposure", pv.exposure, "Starting exposure in stops, or auto (overrides film.exposure)");
+  preview->add_option("--exposure", pv.exposure, "Starting exposure in stops (within ±30), or auto (overrides film.exposure)")
+      ->check(kExposure);
 
   std::string info_file;
   bool info_values = false;

@@ -65,6 +65,10 @@ inline constexpr bool spp_in_range(long long spp) { return spp >= kMinSpp && spp
 // checkpoints): 16384² pixels is also the largest EXR that is read.
 inline constexpr int kMaxFilmSide = 16384;
 
+// Exposure is at most this many stops either way (film.exposure, --exposure,
+// auto exposure): 2^30 already takes the dimmest visible value past white.
+inline constexpr double kMaxExposureStops = 30.0;
+
 struct Film {
   int width = 640;
   int height = 360;

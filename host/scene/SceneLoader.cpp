@@ -532,6 +532,12 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
       s.film.exposure_auto = true;
     } else {
       s.film.exposure = f.number_keyed("exposure", s.film.exposure, s.film.exposure_keys);
+      const std::string limit = "must be within ±" + std::to_string(int(kMaxExposureStops)) + " stops";
+      if (std::abs(s.film.exposure) > kMaxExposureStops && !s.film.exposure_keys.animated())
+        f.fail("exposure", limit + ", got " + json(s.film.exposure).dump());
+      for (size_t n = 0; n < s.film.exposure_keys.values.size(); ++n)
+        if (std::abs(s.film.exposure_keys.values[n]) > kMaxExposureStops)
+          f.fail("exposure.keys[" + std::to_string(n) + "]", limit + ", got " + json(s.film.exposure_keys.values[n]).dump());
     }
     s.film.view = f.choice("view", "agx", {"agx", "standard"}) == "agx" ? ViewTransform::AgX : ViewTransform::Standard;
     s.film.seed = static_cast<uint32_t>(f.integer("seed", static_cast<int>(s.film.seed), 0, 2147483647));

@@ -62,6 +62,28 @@ class Shot : public ::testing::Test {
 
 using namespace cli_shot_test;
 
+// --exposure: a finite number within ±30 stops or auto; anything else one
+// line and exit 2 (and film.exposure the same), nothing written.
+TEST_F(Shot, ExposureOutsideItsRangeIsRefused) {
+  write_file(dir / "s.json", R"({"film": {"width": 4, "height": 4, "spp": 1},
+    "media": [{"type": "homogeneous", "bounds": {"sphere": {"center": [0, 1, 0], "radius": 1}}}]})");
+  for (const std::string bad : {"''", "1e9", "-31", "nan", "inf", "2x"}) {
+    CliResult r = run_cli("render " + shot_q(dir / "s.json") + " --backend cpu -o " + shot_q(dir / "o.png") + " --exposure " + bad);
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
+    EXPECT_NE(r.err.find("--exposure"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "o.png"));
+  }
+  for (const std::string good : {"-30", "30", "auto", "1.5"}) {
+    CliResult r = run_cli("render " + shot_q(dir / "s.json") + " --backend cpu -o " + shot_q(dir / "o.png") + " --exposure " + good);
+    EXPECT_EQ(r.status, 0) << good << ": " << r.err;
+  }
+  write_file(dir / "e.json", R"({"film": {"exposure": 40}})");
+  CliResult r = run_cli("render " + shot_q(dir / "e.json") + " --backend cpu -o " + shot_q(dir / "x.png"));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("film.exposure: must be within"), std::string::npos) << r.err;
+}
+
 // A misspelt scene key, flag or subcommand: "did you mean" the closest known one.
 TEST_F(Shot, MisspeltKeysAndFlagsGetDidYouMean) {
   write_file(dir / "s.json", R"({"film": {"width": 4, "height": 4, "spp": 1},
