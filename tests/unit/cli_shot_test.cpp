@@ -62,6 +62,18 @@ class Shot : public ::testing::Test {
 
 using namespace cli_shot_test;
 
+// A tall cube whose temperature rises with height, up `axis`.
+fs::path write_tall(const fs::path& dir, UpAxis axis, const FileMetadata& meta = {}) {
+  const bool z = axis == UpAxis::Z;
+  const VoxelBox box{{0, 0, 0}, z ? glm::ivec3(3, 3, 11) : glm::ivec3(3, 11, 3)};
+  const fs::path f = dir / (z ? "tall_z.vdb" : "tall_y.vdb");
+  write_vdb(f, {make_float_grid("density", Lattice{}, box, [](int, int, int) { return 3.0f; }),
+                make_float_grid("temperature", Lattice{}, box,
+                                [=](int, int j, int k) { return 1000.0f + 90.0f * float(z ? k : j); })},
+            meta);
+  return f;
+}
+
 // --exposure: a finite number within ±30 stops or auto; anything else one
 // line and exit 2 (and film.exposure the same), nothing written.
 TEST_F(Shot, ExposureOutsideItsRangeIsRefused) {
@@ -118,4 +130,18 @@ TEST(Suggest, EditDistanceAndTheClosestName) {
   EXPECT_EQ(closest_name("colour", known), "");
   EXPECT_EQ(did_you_mean("sigma_z", known), " (did you mean \"sigma_s\"?)");
   EXPECT_EQ(did_you_mean("xyz", known), "");
+}
+
+// info prints a few-KiB grid's dense size in KiB, not "0.0 MiB".
+TEST_F(Shot, InfoPrintsSmallSizesInKiB) {
+  EXPECT_EQ(footprint_text(512.0), "512 B");
+  EXPECT_EQ(footprint_text(3.0 * 1024), "3.0 KiB");
+  EXPECT_EQ(footprint_text(5.5 * 1048576), "5.5 MiB");
+  EXPECT_EQ(footprint_text(2.0 * 1073741824.0), "2.0 GiB");
+  write_tall(dir, UpAxis::Z);
+  CliResult r = run_cli("info " + shot_q(dir / "tall_z.vdb"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out.find("0.0 MiB"), std::string::npos) << r.out;
+  // 4×4×12 active voxels plus one texel of padding on every side, 2 B each.
+  EXPECT_NE(r.out.find("dense " + footprint_text(2.0 * 6 * 6 * 14) + " "), std::string::npos) << r.out;
 }
