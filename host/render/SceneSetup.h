@@ -29,13 +29,19 @@ struct SceneSetup {
 // camera is framed automatically and neither the file nor the command line
 // (`film_size_fixed`) sets the film's size, a subject taller than wide turns
 // the film upright (width and height swapped) when it is over 1.2 times taller than wide. Throws InputError for
-// unreadable files.
+// unreadable files. An omitted camera.up follows the up axis (default_camera_up).
 SceneSetup complete_scene(Scene& scene, int frame, bool film_size_fixed);
 
 // Where a camera sits to frame `boxes` from the front (looking along +Z for a
-// Y-up scene, along +Y for a Z-up one) with a vertical field of view of
-// fov_deg: every corner inside the picture with a 5 % margin.
-Camera framing_camera(const std::vector<WorldBox>& boxes, UpAxis up, double fov_deg, double aspect);
+// Y-up scene, along +Y for a Z-up one), tilted down by tilt_deg, with a
+// vertical field of view of fov_deg: every corner inside the picture with a
+// 5 % margin.
+Camera framing_camera(const std::vector<WorldBox>& boxes, UpAxis up, double fov_deg, double aspect,
+                      double tilt_deg = 0.0);
+
+// The automatic camera's downward tilt over a ground plane: the horizon then
+// lies a third of the way from the centre to the top of the picture.
+double ground_tilt_deg(double fov_deg);
 
 // "" when something in the scene gives light (an emitting medium, a
 // background, an environment, or `lights` with something to light: a

@@ -86,6 +86,7 @@ Scene scene_at_frame(const Scene& scene, int frame) {
   }
   // What keys can break: the parse-time checks, now at this frame.
   const glm::dvec3 forward = s.camera.look_at - s.camera.position;
+  if (!s.camera.up_given) s.camera.up = default_camera_up(s.up_axis.value_or(UpAxis::Y), forward);
   const std::string at = " at frame " + std::to_string(frame);
   if (glm::length(forward) == 0)
     throw input_error(scene.file.string(), "camera.look_at", "must differ from position" + at);

@@ -37,13 +37,27 @@ struct Keyframes {
   }
 };
 
+// The world's up axis as a vector.
+inline glm::dvec3 up_axis_vector(UpAxis axis) { return axis == UpAxis::Z ? glm::dvec3(0, 0, 1) : glm::dvec3(0, 1, 0); }
+
+// A camera's up when the file gives none: the scene's up axis, unless the view
+// runs (nearly) along it; a view from above or below then has the world's
+// front-to-back axis at the top of the image, as Blender's top view has +Y
+// (Z up) and Maya's and Houdini's have −Z (Y up).
+inline glm::dvec3 default_camera_up(UpAxis axis, const glm::dvec3& view_direction) {
+  const glm::dvec3 up = up_axis_vector(axis);
+  const double len = glm::length(view_direction);
+  if (!(len > 0.0) || glm::length(glm::cross(view_direction / len, up)) > 1e-3) return up;
+  return axis == UpAxis::Z ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, -1);
+}
+
 struct Camera {
   glm::dvec3 position{0, 1, -6};
   glm::dvec3 look_at{0, 1, 0};
   // The file gives neither position nor look_at: the camera frames the scene's
   // media and shapes (host/render/SceneSetup, docs/scene-format.md "camera").
   bool framed_automatically = false;
-  bool up_given = false;
+  bool up_given = false;  // else `up` follows the up axis (default_camera_up)
   Keyframes<glm::dvec3> position_keys, look_at_keys;
   glm::dvec3 up{0, 1, 0};
   double fov_deg = 40.0;  // vertical field of view

@@ -517,9 +517,13 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
     if (!(s.camera.fov_deg > 0 && s.camera.fov_deg < 180)) c.fail("fov_deg", "must be in (0, 180) degrees");
     glm::dvec3 f = s.camera.look_at - s.camera.position;
     if (glm::length(f) == 0) c.fail("look_at", "must differ from position");
-    if (glm::length(glm::cross(glm::normalize(f), s.camera.up)) < 1e-9) c.fail("up", "must not be parallel to the view direction");
+    if (s.camera.up_given && glm::length(glm::cross(glm::normalize(f), s.camera.up)) < 1e-9)
+      c.fail("up", "must not be parallel to the view direction");
     c.finish();
   }
+  // Settled again once the up axis is known (render/SceneSetup), and per frame.
+  if (!s.camera.up_given)
+    s.camera.up = default_camera_up(s.up_axis.value_or(UpAxis::Y), s.camera.look_at - s.camera.position);
   if (r.has("film")) {
     Reader f = r.child("film");
     s.film.size_given = f.has("width") || f.has("height");

@@ -74,6 +74,113 @@ fs::path write_tall(const fs::path& dir, UpAxis axis, const FileMetadata& meta =
   return f;
 }
 
+// An omitted camera.up follows the up axis, the file's or up_axis's, seen
+// along each axis; along the up axis itself it falls back to the front axis.
+TEST_F(Shot, AnOmittedUpFollowsTheUpAxisSeenAlongEachAxis) {
+  write_tall(dir, UpAxis::Z, {{"creator", "Blender/Smoke"}});
+  write_tall(dir, UpAxis::Y, {{"creator", "Houdini/SOP_OpenVDB_Write"}});
+  for (UpAxis axis : {UpAxis::Z, UpAxis::Y}) {
+    const glm::dvec3 up = up_axis_vector(axis);
+    for (int a = 0; a < 3; ++a)
+      for (double sign : {-1.0, 1.0}) {
+        glm::dvec3 d(0.0);
+        d[a] = sign;
+        const std::string pos = "[" + std::to_string(5 * d.x) + ", " + std::to_string(5 * d.y) + ", " +
+                                std::to_string(5 * d.z) + "]";
+        // The file's axis (detected), and the same written as up_axis over a kelvin file.
+        for (const std::string extra : {std::string(), std::string(axis == UpAxis::Z ? R"("up_axis": "z", )" : R"("up_axis": "y", )")}) {
+          const std::string file = axis == UpAxis::Z ? "tall_z.vdb" : "tall_y.vdb";
+          write_file(dir / "c.json", "{" + extra + R"("camera": {"position": )" + pos +
+                                         R"(, "look_at": [0, 0, 0]}, "media": [{"type": "vdb", "file": ")" + file +
+                                         "\"" + (extra.empty() ? "" : R"(, "source": "kelvin")") + "}]}");
+          Scene s = load_scene(dir / "c.json");
+          complete_scene(s, 0, true);
+          const Scene at = scene_at_frame(s, 0);
+          const bool along_up = std::abs(glm::dot(d, up)) > 0.5;
+          const glm::dvec3 expect = !along_up ? up : axis == UpAxis::Z ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, -1);
+          EXPECT_EQ(at.camera.up, expect) << "axis " << int(axis) << " from " << pos << " " << extra;
+        }
+      }
+  }
+}
+
+// Rendered: seen from the side along either horizontal axis, the tall cube
+// stands upright with its hot end at the top; from above it renders too.
+TEST_F(Shot, AnUprightCubeRendersUprightFromEverySide) {
+  write_tall(dir, UpAxis::Z);
+  write_tall(dir, UpAxis::Y);
+  for (UpAxis axis : {UpAxis::Z, UpAxis::Y}) {
+    const glm::dvec3 up = up_axis_vector(axis);
+    const glm::dvec3 centre = 0.1 * (axis == UpAxis::Z ? glm::dvec3(1.5, 1.5, 5.5) : glm::dvec3(1.5, 5.5, 1.5));
+    for (int a = 0; a < 3; ++a)
+      for (double sign : {-1.0, 1.0}) {
+        glm::dvec3 d(0.0);
+        d[a] = sign;
+        const bool along_up = std::abs(glm::dot(d, up)) > 0.5;
+        if (along_up && sign < 0) continue;  // one view from above is enough
+        const glm::dvec3 p = centre + 4.0 * d;
+        char cam[200];
+        std::snprintf(cam, sizeof cam, R"("camera": {"position": [%g, %g, %g], "look_at": [%g, %g, %g]})", p.x, p.y,
+                      p.z, centre.x, centre.y, centre.z);
+        const std::string name = axis == UpAxis::Z ? "tall_z.vdb" : "tall_y.vdb";
+        write_file(dir / "v.json", std::string("{\"up_axis\": \"") + (axis == UpAxis::Z ? "z" : "y") + "\", " + cam +
+                                       R"(, "media": [{"type": "vdb", "file": ")" + name + R"(", "source": "kelvin"}]})");
+        CliResult r = run_cli("render " + shot_q(dir / "v.json") + " --backend cpu --spp 2 --width 24 --height 24 -o " +
+                              shot_q(dir / "v.exr"));
+        ASSERT_EQ(r.status, 0) << name << " from " << d.x << "," << d.y << "," << d.z << ": " << r.err;
+        if (along_up) continue;
+        const Image im = read_image(dir / "v.exr");
+        const double peak = border_and_peak(im).second;
+        int x0 = im.width, x1 = -1, y0 = im.height, y1 = -1;
+        double sum = 0.0, sum_y = 0.0;
+        for (int y = 0; y < im.height; ++y)
+          for (int x = 0; x < im.width; ++x) {
+            const double l = shot_lum(im, x, y);
+            if (l <= 0.01 * peak) continue;
+            x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+            sum += l, sum_y += l * y;
+          }
+        const std::string at = name + " from " + std::to_string(a) + (sign > 0 ? "+" : "-");
+        ASSERT_GT(sum, 0.0) << at;
+        EXPECT_GT(y1 - y0, 2 * (x1 - x0)) << at << ": not upright";
+        EXPECT_LT(sum_y / sum, 0.5 * (y0 + y1)) << at << ": upside down (the hot end is the top)";
+      }
+  }
+}
+
+// Over a ground plane the automatic camera looks down by atan(tan(fov/2)/3):
+// the horizon a third of the way up from the centre, every corner still inside.
+TEST(ShotFraming, OverAGroundTheCameraLooksDownAndTheHorizonIsOffCentre) {
+  const std::vector<WorldBox> boxes = {{{-1, -1, 0}, {1, 1, 3}, "a"}};
+  const double fov = 40.0, aspect = 16.0 / 9.0, tan_v = std::tan(fov / 2 * std::numbers::pi / 180.0);
+  const Camera cam = framing_camera(boxes, UpAxis::Z, fov, aspect, ground_tilt_deg(fov));
+  const glm::dvec3 f = glm::normalize(cam.look_at - cam.position);
+  const glm::dvec3 r = glm::normalize(glm::cross(f, cam.up)), u = glm::cross(r, f);
+  EXPECT_LT(f.z, 0.0);  // looks down
+  const glm::dvec3 horizon(0, 1, 0);  // straight ahead, level
+  EXPECT_NEAR(glm::dot(horizon, u) / glm::dot(horizon, f) / tan_v, 1.0 / 3.0, 1e-12);
+  double fill = 0.0;
+  for (int c = 0; c < 8; ++c) {
+    const glm::dvec3 q = glm::dvec3((c & 1) ? 1 : -1, (c & 2) ? 1 : -1, (c & 4) ? 3 : 0) - cam.position;
+    fill = std::max({fill, std::abs(glm::dot(q, r)) / glm::dot(q, f) / (tan_v * aspect),
+                     std::abs(glm::dot(q, u)) / glm::dot(q, f) / tan_v});
+  }
+  EXPECT_NEAR(fill, 1.0 / 1.05, 1e-9);
+
+  // complete_scene tilts only where a plane lies across the up axis.
+  const fs::path dir = temp_dir("shot-ground");
+  write_tall(dir, UpAxis::Z);
+  for (const bool ground : {false, true}) {
+    write_file(dir / "g.json", std::string(R"({"up_axis": "z", "media": [{"type": "vdb", "file": "tall_z.vdb"}])") +
+                                   (ground ? R"(, "shapes": [{"plane": {"normal": [0, 0, 1]}}]})" : "}"));
+    Scene s = load_scene(dir / "g.json");
+    complete_scene(s, 0, true);
+    const glm::dvec3 g = glm::normalize(s.camera.look_at - s.camera.position);
+    EXPECT_NEAR(-g.z, ground ? std::sin(ground_tilt_deg(s.camera.fov_deg) * std::numbers::pi / 180.0) : 0.0, 1e-12);
+  }
+  fs::remove_all(dir);
+}
+
 // --exposure: a finite number within ±30 stops or auto; anything else one
 // line and exit 2 (and film.exposure the same), nothing written.
 TEST_F(Shot, ExposureOutsideItsRangeIsRefused) {
