@@ -170,7 +170,7 @@ std::string nothing_emits(const Scene& scene) {
          "so the image will be black: add background.rgb or an environment to light smoke";
 }
 
-SceneSetup complete_scene(Scene& scene, int frame, bool film_size_fixed) {
+SceneSetup complete_scene(Scene& scene, bool film_size_fixed) {
   SceneSetup out;
   std::optional<UpAxis> source_up;
   for (size_t i = 0; i < scene.media.size(); ++i) {
@@ -182,10 +182,23 @@ SceneSetup complete_scene(Scene& scene, int frame, bool film_size_fixed) {
       out.boxes.push_back(w);
       continue;
     }
-    const std::string file =
-        has_frame_pattern(m.file.string()) ? expand_frame_pattern(m.file.string(), frame) : m.file.string();
+    // A frame pattern is read as the whole shot: its key frame decides the
+    // source and mapping, every frame's box the framing (docs/render-farm.md).
+    std::string file = m.file.string();
+    std::vector<std::string> shot{file};
+    if (has_frame_pattern(file)) {
+      const std::vector<int> frames = frames_on_disk(m.file);
+      if (frames.empty()) continue;  // no frame at all: the render says which are missing
+      const int middle = frames[(frames.size() - 1) / 2];
+      if (!out.key_frame) out.key_frame = middle;
+      // A medium without the first pattern's key frame reads its own middle one.
+      const int key = std::binary_search(frames.begin(), frames.end(), *out.key_frame) ? *out.key_frame : middle;
+      shot.clear();
+      for (int f : frames) shot.push_back(expand_frame_pattern(file, f));
+      file = expand_frame_pattern(file, key);
+    }
     std::error_code ec;
-    if (!std::filesystem::exists(file, ec)) continue;  // a missing frame: the render says so
+    if (!std::filesystem::exists(file, ec)) continue;  // a missing file: the render says so
     const VolumeFileInfo info = read_volume_file_info(file, false);
     SourceConvention c = source_convention(info, m.source, m.temperature_grid);
     if (!m.given.temperature_scale) fit_temperature_mapping(c, file);
@@ -199,8 +212,15 @@ SceneSetup complete_scene(Scene& scene, int frame, bool film_size_fixed) {
     if (c.guessed && guess_decides)
       out.notes.push_back(file + ": source " + std::string(to_string(c.source)) + " (" + c.why +
                           "; set media[" + std::to_string(i) + "].source to choose): " + c.mapping_text);
-    const Box b = grid_box(info, m, file);
-    if (!b.empty()) out.boxes.push_back({b.min, b.max, at + " (" + std::filesystem::path(file).filename().string() + ")"});
+    Box b;
+    for (const std::string& f : shot) {
+      const Box fb = f == file ? grid_box(info, m, f) : grid_box(read_volume_file_info(f, false), m, f);
+      if (fb.empty()) continue;
+      b.add(fb.min);
+      b.add(fb.max);
+    }
+    const std::string name = std::filesystem::path(shot.size() > 1 ? m.file : std::filesystem::path(file)).filename().string();
+    if (!b.empty()) out.boxes.push_back({b.min, b.max, at + " (" + name + ")"});
   }
   for (size_t i = 0; i < scene.shapes.size(); ++i) {
     const Shape& s = scene.shapes[i];

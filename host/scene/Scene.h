@@ -325,6 +325,10 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
 bool has_frame_pattern(const std::string& pattern);
 // Every pattern in `pattern` replaced by `frame`.
 std::string expand_frame_pattern(const std::string& pattern, int frame);
+// The frames whose files exist for a path whose file name holds a frame
+// pattern, ascending (the folder's names are read, no file is opened). Empty
+// when none exists or the name holds no pattern.
+std::vector<int> frames_on_disk(const std::filesystem::path& pattern);
 // True when any medium file is a pattern or any parameter has keys.
 bool scene_is_animated(const Scene& scene);
 bool scene_has_file_patterns(const Scene& scene);

@@ -62,6 +62,33 @@ class Shot : public ::testing::Test {
 
 using namespace cli_shot_test;
 
+// Frame 3 alone and within --frames 1-4: the same camera, film and auto
+// exposure (from the shot's key frame), so the same bits; every frame whole.
+TEST_F(Shot, AFrameAloneIsBitIdenticalToItInTheRangeAndNoFrameIsCutOff) {
+  for (int f = 1; f <= 4; ++f) write_moving_blob(dir, f);
+  write_file(dir / "s.json", R"({"media": [{"type": "vdb", "file": "blob_####.vdb", "source": "kelvin"}]})");
+  const std::string scene = shot_q(dir / "s.json");
+  CliResult r = render(scene, "--frames 3 -o " + shot_q(dir / "alone_####.png") + " --exposure auto");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("key frame 2"), std::string::npos) << r.err;  // the middle of frames 1..4
+  r = render(scene, "--frames 1-4 -o " + shot_q(dir / "all_####.png") + " --exposure auto");
+  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_TRUE(fs::exists(dir / "alone_0003.png"));
+  EXPECT_EQ(read_file(dir / "alone_0003.png"), read_file(dir / "all_0003.png"));
+  EXPECT_FALSE(fs::exists(dir / "alone_0002.png"));  // the key frame is not written unless asked for
+
+  ASSERT_EQ(render(scene, "--frames 3 -o " + shot_q(dir / "alone_####.exr")).status, 0);
+  ASSERT_EQ(render(scene, "--frames 1-4:1 -o " + shot_q(dir / "all_####.exr")).status, 0);
+  const Image alone = read_image(dir / "alone_0003.exr");
+  EXPECT_EQ(alone.rgb, read_image(dir / "all_0003.exr").rgb);
+  for (int f = 1; f <= 4; ++f) {
+    const Image im = read_image(dir / ("all_000" + std::to_string(f) + ".exr"));
+    const auto [border, peak] = border_and_peak(im);
+    EXPECT_GT(peak, 0.0) << "frame " << f;
+    EXPECT_LT(border, 1e-3 * peak) << "frame " << f << " touches the image's edge";
+  }
+}
+
 // A tall cube whose temperature rises with height, up `axis`.
 fs::path write_tall(const fs::path& dir, UpAxis axis, const FileMetadata& meta = {}) {
   const bool z = axis == UpAxis::Z;
@@ -94,7 +121,7 @@ TEST_F(Shot, AnOmittedUpFollowsTheUpAxisSeenAlongEachAxis) {
                                          R"(, "look_at": [0, 0, 0]}, "media": [{"type": "vdb", "file": ")" + file +
                                          "\"" + (extra.empty() ? "" : R"(, "source": "kelvin")") + "}]}");
           Scene s = load_scene(dir / "c.json");
-          complete_scene(s, 0, true);
+          complete_scene(s, true);
           const Scene at = scene_at_frame(s, 0);
           const bool along_up = std::abs(glm::dot(d, up)) > 0.5;
           const glm::dvec3 expect = !along_up ? up : axis == UpAxis::Z ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, -1);
@@ -174,7 +201,7 @@ TEST(ShotFraming, OverAGroundTheCameraLooksDownAndTheHorizonIsOffCentre) {
     write_file(dir / "g.json", std::string(R"({"up_axis": "z", "media": [{"type": "vdb", "file": "tall_z.vdb"}])") +
                                    (ground ? R"(, "shapes": [{"plane": {"normal": [0, 0, 1]}}]})" : "}"));
     Scene s = load_scene(dir / "g.json");
-    complete_scene(s, 0, true);
+    complete_scene(s, true);
     const glm::dvec3 g = glm::normalize(s.camera.look_at - s.camera.position);
     EXPECT_NEAR(-g.z, ground ? std::sin(ground_tilt_deg(s.camera.fov_deg) * std::numbers::pi / 180.0) : 0.0, 1e-12);
   }
