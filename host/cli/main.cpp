@@ -109,7 +109,9 @@ int main(int argc, char** argv) {
 
   RenderArgs render_args;
   auto* render = app.add_subcommand("render", "Render a scene to EXR or PNG");
-  render->add_option("scene", render_args.scene, "Scene JSON file")->required();
+  render->add_option("scene", render_args.scene,
+                     "Scene JSON file, or a .vdb/.nvdb file (a #### pattern with --frames) as the shortest scene naming it")
+      ->required();
   render->add_option("-o,--output", render_args.output, "Output image (.exr linear float, .png sRGB)");
   render->add_option("--backend", render_args.backend, "vulkan (default) or cpu")->check(CLI::IsMember({"vulkan", "cpu"}));
   render->add_option("--spp", render_args.spp, "Samples per pixel (overrides film.spp), at most 2^24")
@@ -147,7 +149,7 @@ int main(int argc, char** argv) {
 
   PreviewArgs pv;
   auto* preview = app.add_subcommand("preview", "Open a window that shows the render converging");
-  preview->add_option("scene", pv.scene, "Scene JSON file")->required();
+  preview->add_option("scene", pv.scene, "Scene JSON file, or a .vdb/.nvdb file")->required();
   preview->add_option("--frames", pv.frames, "Show N display frames, save --screenshot, exit")->check(CLI::PositiveNumber);
   preview->add_option("--screenshot", pv.screenshot, "PNG of what the window shows (with --frames)");
   preview->add_option("--device", pv.device, "Vulkan device index")->check(CLI::NonNegativeNumber);

@@ -315,7 +315,13 @@ std::optional<IntegratorConflict> integrator_conflict(const Integrator& integrat
 // Parse and validate. Throws InputError("FILE: key.path: reason").
 // Keyframed values are also stored evaluated at frame 0 (clamped), the frame
 // a render without --frames shows; medium files keep their frame patterns.
+// A .vdb or .nvdb file (or a frame pattern of them) loads as the shortest
+// scene naming it, shortest_scene_text.
 Scene load_scene(const std::filesystem::path& file);
+// Whether `file` ends in .vdb or .nvdb (any case).
+bool is_volume_file(const std::filesystem::path& file);
+// {"media": [{"type": "vdb", "file": NAME}]}, NAME the volume's file name.
+std::string shortest_scene_text(const std::filesystem::path& volume);
 Scene parse_scene(const std::string& json_text, const std::filesystem::path& file);
 
 // ---- animation (host/scene/Animation.cpp, docs/animation.md) ----

@@ -2,6 +2,7 @@
 // types and out-of-range values are errors that name the file and key path, so a
 // typo never silently renders something else.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -624,8 +625,27 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
   return s;
 }
 
+bool is_volume_file(const std::filesystem::path& file) {
+  std::string e = file.extension().string();
+  for (char& c : e) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return e == ".vdb" || e == ".nvdb";
+}
+
+std::string shortest_scene_text(const std::filesystem::path& volume) {
+  json medium = {{"type", "vdb"}, {"file", volume.filename().string()}};
+  return json{{"media", json::array({medium})}}.dump();
+}
+
 Scene load_scene(const std::filesystem::path& file) {
   std::error_code ec;
+  if (is_volume_file(file)) {
+    if (has_frame_pattern(file.filename().string())) {
+      if (frames_on_disk(file).empty()) throw input_error(file.string(), "", "no file matches this frame pattern");
+    } else if (!std::filesystem::exists(file, ec)) {
+      throw input_error(file.string(), "", "no such file");
+    }
+    return parse_scene(shortest_scene_text(file), file);
+  }
   if (!std::filesystem::exists(file, ec)) throw input_error(file.string(), "", "no such file");
   // nlohmann::json holds about ten times the text's size while parsing.
   return parse_scene(read_input_file(file, kMaxSceneBytes, "scene", 10.0), file);

@@ -89,6 +89,35 @@ TEST_F(Shot, AFrameAloneIsBitIdenticalToItInTheRangeAndNoFrameIsCutOff) {
   }
 }
 
+// `render FILE.vdb` is the shortest scene naming it, bit for bit; a pattern
+// with --frames too. A missing or unreadable file: one line, exit 2.
+TEST_F(Shot, ABareVdbRendersAsTheShortestSceneNamingIt) {
+  for (int f = 1; f <= 4; ++f) write_moving_blob(dir, f);
+  write_file(dir / "one.json", R"({"media": [{"type": "vdb", "file": "blob_0002.vdb"}]})");
+  ASSERT_EQ(render(shot_q(dir / "one.json"), "-o " + shot_q(dir / "scene.exr")).status, 0);
+  CliResult r = render(shot_q(dir / "blob_0002.vdb"), "-o " + shot_q(dir / "bare.exr"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(read_image(dir / "bare.exr").rgb, read_image(dir / "scene.exr").rgb);
+
+  write_file(dir / "seq.json", R"({"media": [{"type": "vdb", "file": "blob_####.vdb"}]})");
+  ASSERT_EQ(render(shot_q(dir / "seq.json"), "--frames 4 -o " + shot_q(dir / "s_####.exr")).status, 0);
+  r = render(shot_q(dir / "blob_####.vdb"), "--frames 4 -o " + shot_q(dir / "b_####.exr"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(read_image(dir / "b_0004.exr").rgb, read_image(dir / "s_0004.exr").rgb);
+
+  write_file(dir / "junk.vdb", "this is not a vdb");
+  for (const std::string bad : {"nope.vdb", "junk.vdb", "none_####.vdb"}) {
+    const std::string frames = bad.find('#') != std::string::npos ? " --frames 1 -o " + shot_q(dir / "x_####.exr")
+                                                                   : " -o " + shot_q(dir / "x.exr");
+    r = render(shot_q(dir / bad), frames);
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
+    EXPECT_NE(r.err.find(bad), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.err.find("JSON"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "x.exr") || fs::exists(dir / "x_0001.exr"));
+  }
+}
+
 // A tall cube whose temperature rises with height, up `axis`.
 fs::path write_tall(const fs::path& dir, UpAxis axis, const FileMetadata& meta = {}) {
   const bool z = axis == UpAxis::Z;
