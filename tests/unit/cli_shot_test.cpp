@@ -74,7 +74,7 @@ TEST_F(Shot, AFrameAloneIsBitIdenticalToItInTheRangeAndNoFrameIsCutOff) {
   r = render(scene, "--frames 1-4 -o " + shot_q(dir / "all_####.png") + " --exposure auto");
   ASSERT_EQ(r.status, 0) << r.err;
   ASSERT_TRUE(fs::exists(dir / "alone_0003.png"));
-  EXPECT_EQ(read_file(dir / "alone_0003.png"), read_file(dir / "all_0003.png"));
+  EXPECT_TRUE(read_file(dir / "alone_0003.png") == read_file(dir / "all_0003.png")) << "frame 3's PNG differs";
   EXPECT_FALSE(fs::exists(dir / "alone_0002.png"));  // the key frame is not written unless asked for
 
   ASSERT_EQ(render(scene, "--frames 3 -o " + shot_q(dir / "alone_####.exr")).status, 0);
