@@ -105,7 +105,15 @@ TEST_F(Shot, ABareVdbRendersAsTheShortestSceneNamingIt) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(read_image(dir / "b_0004.exr").rgb, read_image(dir / "s_0004.exr").rgb);
 
+  // preview loads it the same way: past the loading, only the window (no display here) may stop it.
+  r = run_cli("preview " + shot_q(dir / "blob_0002.vdb") + " --frames 1 --width 16 --height 16");
+  EXPECT_TRUE(r.status == 0 || r.err.find("pyrolume render") != std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("JSON"), std::string::npos) << r.err;
+
   write_file(dir / "junk.vdb", "this is not a vdb");
+  r = run_cli("preview " + shot_q(dir / "junk.vdb") + " --frames 1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("junk.vdb: not an OpenVDB"), std::string::npos) << r.err;
   for (const std::string bad : {"nope.vdb", "junk.vdb", "none_####.vdb"}) {
     const std::string frames = bad.find('#') != std::string::npos ? " --frames 1 -o " + shot_q(dir / "x_####.exr")
                                                                    : " -o " + shot_q(dir / "x.exr");
