@@ -42,21 +42,6 @@ struct RenderSettings {
   uint32_t seed = 1;
   uint32_t frame = 0;        // animation frame; feeds the RNG key
   double time_limit = 0.0;   // seconds, 0 = none; stops after the pass that crosses it
-  // Test hook (no scene key): 1 = camera rays return the ratio-tracking
-  // transmittance through the media, 2 = the delta-tracking one (per channel).
-  uint32_t debug_mode = 0;
-  // Test hook (no scene key): false keeps every lane of a SIMD group in the
-  // free-flight loop until the group's last event, as before the early exit
-  // (Vulkan; the image is the same bit for bit either way).
-  bool early_event_exit = true;
-  // Test and bench hook (no scene key): false reads the density by the
-  // sampler's trilinear filter in free flights too, instead of one texel of its
-  // footprint (Vulkan; docs/rendering.md "Stochastic density lookups").
-  bool stochastic_density = true;
-  // Test hook (no scene key): false keeps the temperature in a texture of its
-  // own even where it could be the density texture's second channel (Vulkan;
-  // GpuScene::temperature_in_density).
-  bool temperature_in_density = true;
   // film.aovs or --aovs (docs/compositing.md "AOVs"): also accumulate the
   // light layers and first-hit features (RenderResult::aov_sum).
   bool aovs = false;

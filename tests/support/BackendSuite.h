@@ -28,6 +28,7 @@
 
 #include "backends/Backends.h"
 #include "render/cpu/CpuRenderer.h"
+#include "render/vulkan/VulkanRenderer.h"
 #include "support/AnalyticScenes.h"
 
 namespace pyrolume::test {
@@ -74,6 +75,15 @@ class BackendFixture : public ::testing::Test {
   }
 
   RenderResult render(const Scene& s) { return render(s, settings_for(s)); }
+  // A Vulkan render with the test switches of render/vulkan/VulkanHooks.h,
+  // which are back at their defaults afterwards.
+  RenderResult render_with(const Scene& s, const VulkanHooks& hooks) {
+    auto& v = dynamic_cast<VulkanRenderer&>(vulkan_backend());
+    v.set_hooks(hooks);
+    RenderResult r = render(s);
+    v.set_hooks({});
+    return r;
+  }
   RenderResult render(const Scene& s, const RenderSettings& rs) {
     RenderResult r;
     if (cpu()) {

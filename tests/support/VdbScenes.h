@@ -427,7 +427,7 @@ struct TrilinearVoxelField {
 };
 
 // Per-channel transmittance exp(−σt_c·density_scale·τ) along each camera ray
-// to infinity, pixel-averaged (what RenderSettings::debug_mode 1/2 estimates)
+// to infinity, pixel-averaged (what VulkanHooks::debug_mode 1/2 estimates)
 // for a single grid medium whose density is `field`.
 template <class Field>
 std::function<glm::dvec3(int, int)> transmittance_exact(const Scene& s, const Field& field, int base = 4,

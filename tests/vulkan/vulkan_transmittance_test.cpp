@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "render/Backend.h"
+#include "render/vulkan/VulkanRenderer.h"
 #include "support/VulkanFixture.h"
 #include "support/AnalyticScenes.h"
 #include "support/Stats.h"
@@ -45,8 +46,12 @@ class VulkanTransmittance : public test::VulkanFixture {
     rs.height = s.film.height;
     rs.spp = s.film.spp;
     rs.seed = s.film.seed + debug_mode;
-    rs.debug_mode = debug_mode;
+    VulkanHooks hooks;
+    hooks.debug_mode = debug_mode;
+    auto& vulkan = dynamic_cast<VulkanRenderer&>(*backend_);
+    vulkan.set_hooks(hooks);
     RenderResult r = backend_->render(s, rs, {});
+    vulkan.set_hooks({});
     EXPECT_EQ(r.spp, s.film.spp);
     for (size_t i = 0; i < r.sum.size(); ++i) {
       EXPECT_TRUE(std::isfinite(r.sum[i])) << i;

@@ -303,9 +303,9 @@ TEST_F(VulkanVdb, GuideAgreesWithCpuOnProceduralFire) {
 // absorption estimator's emission at absorptions.
 TEST_F(VulkanVdb, EarlyEventExitRendersTheSameImageBitForBit) {
   Scene s = lookup_bound_fire(24, 32, 16);
-  RenderSettings waiting = settings_for(s);
+  VulkanHooks waiting;
   waiting.early_event_exit = false;
-  const RenderResult early = render(s), late = render(s, waiting);
+  const RenderResult early = render(s), late = render_with(s, waiting);
   ASSERT_EQ(early.light_strategy, "bsdf");
   ASSERT_EQ(early.sum.size(), late.sum.size());
   size_t differing = 0;
@@ -325,9 +325,9 @@ TEST_F(VulkanVdb, EarlyEventExitRendersTheSameImageBitForBit) {
 // total. It is a different estimator, so the sums differ wherever the fire is.
 TEST_F(VulkanVdb, StochasticDensityLookupsAgreeWithTheFilteredDensity) {
   Scene s = lookup_bound_fire(48, 48, 256);
-  RenderSettings filtered = settings_for(s);
+  VulkanHooks filtered;
   filtered.stochastic_density = false;
-  const RenderResult stochastic = render(s), trilinear = render(s, filtered);
+  const RenderResult stochastic = render(s), trilinear = render_with(s, filtered);
   size_t differing = 0;
   for (size_t i = 0; i < stochastic.sum.size(); ++i) differing += stochastic.sum[i] != trilinear.sum[i];
   // (Pixels that see only the background are the same in both.)
@@ -406,9 +406,9 @@ TEST_F(VulkanVdb, TemperatureOnTheDensityLatticeSharesItsTexture) {
   same.film.spp = 64;
   same.integrator.max_depth = 4;
   same.integrator.emission_estimator = EmissionEstimator::Collision;
-  RenderSettings apart = settings_for(same);
+  VulkanHooks apart;
   apart.temperature_in_density = false;
-  const RenderResult shared = render(same), own = render(same, apart);
+  const RenderResult shared = render(same), own = render_with(same, apart);
   ASSERT_EQ(shared.sum.size(), own.sum.size());
   size_t differing = 0;
   double total = 0.0;

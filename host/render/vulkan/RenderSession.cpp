@@ -58,8 +58,9 @@ std::string mib(double bytes) {
 }
 }  // namespace
 
-RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderSettings& settings)
-    : ctx_(ctx), settings_(settings) {
+RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderSettings& settings,
+                             const VulkanHooks& hooks)
+    : ctx_(ctx), settings_(settings), hooks_(hooks) {
   // The accumulation buffer is one storage buffer: check it fits the device
   // (lavapipe allows 128 MiB, about 1448² pixels) and its host readback
   // (texels plus double sums) fits the machine, before loading anything.
@@ -88,7 +89,7 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
     for (const auto& w : volumes_[i]->warnings) warnings_.push_back(w);
   }
   check_loaded_media(scene, volumes_);
-  gpu_scene_ = build_gpu_scene(scene, volumes_, /*with_luts=*/true, shared_texture_bytes(settings));
+  gpu_scene_ = build_gpu_scene(scene, volumes_, /*with_luts=*/true, shared_texture_bytes());
 
   // Storage buffers, not uniform ones: lavapipe would inline their values
   // where they decide a branch and compile a shader variant for every pass
@@ -207,8 +208,8 @@ RenderSession::RenderSession(vk::Context& ctx, const Scene& scene, const RenderS
 
 // The largest density texture that may take its temperature as a second
 // channel: one allocation; 0 (never) when the test hook turns it off.
-uint64_t RenderSession::shared_texture_bytes(const RenderSettings& settings) const {
-  return settings.temperature_in_density ? uint64_t(ctx_.max_allocation_size()) : 0;
+uint64_t RenderSession::shared_texture_bytes() const {
+  return hooks_.temperature_in_density ? uint64_t(ctx_.max_allocation_size()) : 0;
 }
 
 DenseLimits RenderSession::dense_limits() const {
@@ -228,9 +229,9 @@ std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const S
           {gpu::SPEC_HAS_EMISSION, flag(g.has_emission)},
           {gpu::SPEC_TEMPERATURE_IN_DENSITY, flag(g.temperature_in_density)},
           {gpu::SPEC_SPARSE_GRIDS, flag(g.has_sparse())},
-          {gpu::SPEC_STOCHASTIC_DENSITY, flag(stochastic_density(g, settings))},
+          {gpu::SPEC_STOCHASTIC_DENSITY, flag(stochastic_density(g))},
           {gpu::SPEC_COLLISION_ESTIMATOR, flag(lights.estimator != EmissionEstimator::Absorption)},
-          {gpu::SPEC_DEBUG_MODE, settings.debug_mode},
+          {gpu::SPEC_DEBUG_MODE, hooks_.debug_mode},
           {gpu::SPEC_MEDIUM_COUNT, uint32_t(g.media.size())},
           {gpu::SPEC_GRID_COUNT, uint32_t(g.grids.size())},
           {gpu::SPEC_HAS_SURFACES, flag(!scene.shapes.empty())},
@@ -250,7 +251,7 @@ std::vector<std::pair<uint32_t, uint32_t>> RenderSession::spec_constants(const S
           // costs more than the wait (docs/benchmarks.md "Lanes in the
           // free-flight loop").
           {gpu::SPEC_EARLY_EVENT_EXIT,
-           flag(settings.early_event_exit && lights.strategy == LightStrategy::Bsdf && scene.shapes.empty() &&
+           flag(hooks_.early_event_exit && lights.strategy == LightStrategy::Bsdf && scene.shapes.empty() &&
                 ctx_.features().subgroup_ballot)}};
 }
 
@@ -279,11 +280,7 @@ void RenderSession::write_grid_descriptors() {
 }
 
 bool RenderSession::load_frame(const Scene& scene, const RenderSettings& settings) {
-  if (settings.width != settings_.width || settings.height != settings_.height ||
-      settings.debug_mode != settings_.debug_mode ||
-      settings.early_event_exit != settings_.early_event_exit ||
-      settings.stochastic_density != settings_.stochastic_density ||
-      settings.temperature_in_density != settings_.temperature_in_density || scene.media.size() != volumes_.size())
+  if (settings.width != settings_.width || settings.height != settings_.height || scene.media.size() != volumes_.size())
     return false;
   // Load into locals first: a bad frame (or a different variant) leaves the
   // session as it was.
@@ -294,7 +291,7 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
   check_loaded_media(scene, volumes);
   // The blackbody LUTs depend only on the emission's mode, observer and
   // adaptation: bake them once per sequence and reuse them frame after frame.
-  GpuScene gpu_scene = build_gpu_scene(scene, volumes, /*with_luts=*/false, shared_texture_bytes(settings));
+  GpuScene gpu_scene = build_gpu_scene(scene, volumes, /*with_luts=*/false, shared_texture_bytes());
   for (size_t slot = 0; slot < gpu_scene.grid_sources.size(); ++slot) {
     GpuGridSource& src = gpu_scene.grid_sources[slot];
     if (!src.temperature) continue;
@@ -414,8 +411,8 @@ void RenderSession::create_textures(const Scene& scene) {
   }
 }
 
-bool RenderSession::stochastic_density(const GpuScene& g, const RenderSettings& settings) const {
-  if (!settings.stochastic_density || g.grid_sources.empty()) return false;
+bool RenderSession::stochastic_density(const GpuScene& g) const {
+  if (!hooks_.stochastic_density || g.grid_sources.empty()) return false;
   for (const GpuGridSource& s : g.grid_sources) {
     if (s.density->grid.is_sparse() || s.density->grid.empty()) return false;
     const uint64_t texels = s.density->grid.texel_count();
@@ -447,7 +444,7 @@ void RenderSession::create_density_texels() {
   };
   const float zero = 0.0f;
   add(&zero, 1, false, "unused density texels");
-  if (!stochastic_density(gpu_scene_, settings_)) return;
+  if (!stochastic_density(gpu_scene_)) return;
   for (const GpuGridSource& s : gpu_scene_.grid_sources) {
     const StoredGrid& g = *s.density;
     if (g.format == TextureFormat::R16F) add(g.half_bits.data(), g.half_bits.size(), true, "density texels");
@@ -686,7 +683,7 @@ void RenderSession::create_wavefront(const std::vector<uint32_t>& code) {
   for (const auto& [id, value] : spec_)
     if (id == gpu::SPEC_LIGHT_COUNT) has_lights = value > 0;
   // Nor with AOVs: its path state does not carry them.
-  const bool on = (mode == "1" || mode == "2") && settings_.debug_mode == 0 && !has_lights && !settings_.aovs;
+  const bool on = (mode == "1" || mode == "2") && hooks_.debug_mode == 0 && !has_lights && !settings_.aovs;
   wavefront_split_ = on && mode == "2";
   const size_t slots = on ? size_t(settings_.width) * size_t(settings_.height) : 1;
   const size_t words = gpu::WAVEFRONT_PATH_WORDS + gpu::WAVEFRONT_PATH_WORDS_PER_MEDIUM *

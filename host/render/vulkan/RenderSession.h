@@ -14,6 +14,7 @@
 #include "render/vulkan/Memory.h"
 #include "render/vulkan/Pipeline.h"
 #include "render/vulkan/SurfacePacking.h"
+#include "render/vulkan/VulkanHooks.h"
 #include "scene/Scene.h"
 #include "shared/gpu_types.h"
 #include "shared/light_types.h"
@@ -25,7 +26,7 @@ namespace pyrolume {
 
 class RenderSession {
  public:
-  RenderSession(vk::Context& ctx, const Scene& scene, const RenderSettings& settings);
+  RenderSession(vk::Context& ctx, const Scene& scene, const RenderSettings& settings, const VulkanHooks& hooks = {});
 
   // The next frame of a sequence (docs/animation.md): reload the media's grids
   // and re-upload only what depends on them (3D textures, majorant cells,
@@ -100,14 +101,14 @@ class RenderSession {
 
  private:
   DenseLimits dense_limits() const;  // this device's 3D texture limits, for the grid loader
-  uint64_t shared_texture_bytes(const RenderSettings& settings) const;
+  uint64_t shared_texture_bytes() const;
   void upload_constants(const Scene& scene);
   void create_textures(const Scene& scene);
   void create_sparse_buffer(const Scene& scene);
   void create_majorant_buffer(const Scene& scene);
   // Whether free flights read the density stochastically: every grid is a
   // dense texture whose texels also fit a texel buffer.
-  bool stochastic_density(const GpuScene& g, const RenderSettings& settings) const;
+  bool stochastic_density(const GpuScene& g) const;
   void create_density_texels();
   void create_surfaces(const Scene& scene);
   void create_environment(const Scene& scene);
@@ -128,6 +129,7 @@ class RenderSession {
 
   vk::Context& ctx_;
   RenderSettings settings_;
+  VulkanHooks hooks_;  // fixed for the session (VulkanRenderer::set_hooks drops a kept one)
   std::vector<std::optional<StoredVolume>> volumes_;
   std::vector<std::string> warnings_;
   GpuScene gpu_scene_;

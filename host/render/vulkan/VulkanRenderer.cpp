@@ -37,6 +37,11 @@ void VulkanRenderer::set_frame_reuse(bool on) {
   if (!on) kept_.reset();
 }
 
+void VulkanRenderer::set_hooks(const VulkanHooks& hooks) {
+  hooks_ = hooks;
+  kept_.reset();
+}
+
 uint64_t VulkanRenderer::accumulation_bytes(int width, int height) {
   return uint64_t(width) * uint64_t(height) * (sizeof(gpu::AccumTexel) + sizeof(gpu::AlphaTexel));
 }
@@ -73,7 +78,7 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
     ++reused_frames_;
   } else {
     kept_.reset();  // free the previous frame's memory before allocating the next
-    fresh = std::make_unique<RenderSession>(*context_, scene, settings);
+    fresh = std::make_unique<RenderSession>(*context_, scene, settings, hooks_);
   }
   if (fresh && frame_reuse_) kept_ = std::move(fresh);
   RenderSession& session = fresh ? *fresh : *kept_;

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "render/Backend.h"
+#include "render/vulkan/VulkanHooks.h"
 
 namespace pyrolume {
 
@@ -45,9 +46,14 @@ class VulkanRenderer : public Backend {
   // Renders that reused the kept session (tests, stats).
   int reused_frames() const { return reused_frames_; }
 
+  // Test and bench switches for the renders that follow (VulkanHooks.h); a
+  // kept session of the old ones is dropped.
+  void set_hooks(const VulkanHooks& hooks);
+
  private:
   std::unique_ptr<vk::Context> context_;
   std::unique_ptr<RenderSession> kept_;
+  VulkanHooks hooks_;
   bool frame_reuse_ = false;
   int reused_frames_ = 0;
   double context_seconds_ = 0.0;  // instance + device creation, charged to the first render's load_seconds
