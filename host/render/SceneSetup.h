@@ -37,6 +37,18 @@ SceneSetup complete_scene(Scene& scene, int frame, bool film_size_fixed);
 // fov_deg: every corner inside the picture with a 5 % margin.
 Camera framing_camera(const std::vector<WorldBox>& boxes, UpAxis up, double fov_deg, double aspect);
 
+// The default rig (docs/scene-format.md "default_lights"): a dim grey
+// background and a sun keyed from above and beside the camera.
+inline constexpr double kDefaultRigBackground = 0.05;
+inline constexpr double kDefaultRigSunIrradiance = 10.0;
+inline constexpr double kDefaultRigSunK = 5500.0;
+inline constexpr double kDefaultRigSunAngleDeg = 0.53;  // the Sun's angular diameter
+
+// Adds the default rig to a scene in which nothing emits or gives light
+// (nothing_emits would say so) when its default_lights allows; after the
+// camera is settled. The note line to print, or "" when nothing was added.
+std::string add_default_rig(Scene& scene);
+
 // "" when something in the scene gives light (an emitting medium, a
 // background, an environment, or `lights` with something to light: a
 // surface or a scattering medium); otherwise a one-line reason.

@@ -43,9 +43,10 @@ struct FirstTry : ::testing::Test {
 }  // namespace
 
 TEST_F(FirstTry, HoudiniPyroExport) {
-  // Y up, unitless temperature (burning ~1.3), creator metadata.
+  // Y up, unitless temperature (burning ~1.3), a flame grid (what makes a
+  // Pyro export a fire, docs/sources.md "Smoke is smoke"), creator metadata.
   write_vdb(dir / "pyro.vdb", {plume("density", 3.0f, false), plume("temperature", 1.3f, false),
-                               plume("vel", 0.5f, false)},
+                               plume("flame", 1.0f, false), plume("vel", 0.5f, false)},
             {{"creator", "Houdini/SOP_OpenVDB_Write"}});
   std::string err;
   const FirstTryLook look = render_shortest(dir / "pyro.vdb", &err);
