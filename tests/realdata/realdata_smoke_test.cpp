@@ -33,9 +33,9 @@ class RealSmoke : public ::testing::Test {
     return c;
   }
   // The smoke check; the default rig's note is the only line on stderr.
-  void expect_smoke(const std::string& name) {
+  void expect_smoke(const std::string& name, const std::string& label) {
     std::string err;
-    const test::SmokeLook look = test::run_smoke_look(out, dir / name, "s", &err);
+    const test::SmokeLook look = test::run_smoke_look(out, dir / name, label, &err);
     std::printf("%s: %s\n", name.c_str(), look.summary().c_str());
     EXPECT_TRUE(look.visible_ok()) << look.summary();
     EXPECT_TRUE(look.shaded_ok()) << look.summary();
@@ -52,14 +52,14 @@ TEST_F(RealSmoke, MantaflowSmokeIsSmoke) {
   const SourceConvention c = convention("blender50_mantaflow_smoke_frame0001.vdb");
   EXPECT_FALSE(c.emits) << c.emission_text;  // its flame grid is empty
   EXPECT_EQ(c.index_offset, 0.5);             // Mantaflow's cell corner
-  expect_smoke("blender50_mantaflow_smoke_frame0001.vdb");
+  expect_smoke("blender50_mantaflow_smoke_frame0001.vdb", "smoke_blender50_mantaflow");
 }
 
 TEST_F(RealSmoke, HoudiniSmokeIsSmoke) {
   const SourceConvention c = convention("openvdb_smoke1_houdini.vdb");
   EXPECT_TRUE(c.temperature_grid.empty());
   EXPECT_EQ(c.index_offset, 0.0);
-  expect_smoke("openvdb_smoke1_houdini.vdb");
+  expect_smoke("openvdb_smoke1_houdini.vdb", "smoke_houdini_openvdb");
 }
 
 // The fire has flame: it still emits from heat, placed as before (2.7x caches

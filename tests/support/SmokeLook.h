@@ -5,10 +5,13 @@
 //  - shaded: among those, the 90th percentile of display luminance (Rec. 709
 //    weights on the PNG's bytes / 255, exposure 0, AgX) over the 10th;
 //  - not glowing: the image mean equals that of the same scene with
-//    emission.scale 0 within 4 standard errors (each from --variance);
+//    emission.scale 0 within 4 standard errors (each from --variance),
+//    rendered with the same seed (common random numbers: where nothing
+//    emits the two renders are the same computation; any glow shows as a
+//    difference far beyond the independent-sample SE used here);
 //  - not clipped: the fraction of all pixels with a channel at 255.
 // run_smoke_look renders the shortest scene and its emission.scale-0 twin
-// through the CLI (another seed, so the two estimates are independent).
+// through the CLI.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -29,6 +32,12 @@ struct SmokeLook {
   double clipped = 0.0;         // fraction of all pixels with a channel at 255
   double mean = 0.0, mean_se = 0.0;     // linear RGB mean and its standard error
   double mean0 = 0.0, mean0_se = 0.0;   // the same with emission.scale 0
+  // Measurement mode only (PYROLUME_SMOKE_LOOK): the twin with another seed,
+  // an independent estimate (NaN when not rendered).
+  double mean0_seed2 = NAN, mean0_seed2_se = NAN;
+  double glow_z_independent() const {
+    return (mean - mean0_seed2) / std::sqrt(mean_se * mean_se + mean0_seed2_se * mean0_seed2_se);
+  }
   double shading() const { return p10 > 0.0 ? p90 / p10 : (p90 > 0.0 ? INFINITY : 0.0); }
   double glow_z() const {
     const double se = std::sqrt(mean_se * mean_se + mean0_se * mean0_se);
@@ -93,7 +102,7 @@ inline SmokeLook smoke_look(const Image& img) {
 
 // The film the check renders at: tiny by default (tests must be cheap);
 // PYROLUME_SMOKE_LOOK="W H SPP BACKEND" measures at another size, e.g.
-// "320 240 32 vulkan" for issue 46's numbers.
+// "320 240 32 vulkan" for issue 46's numbers (docs/sources.md).
 struct SmokeLookFilm {
   int width = 48, height = 48, spp = 8;
   std::string backend = "cpu";
@@ -125,11 +134,23 @@ inline SmokeLook run_smoke_look(const std::filesystem::path& dir, const std::fil
   CliResult r = run_cli("render " + scene + " -o " + q(dir / (name + ".exr")) + " --variance" + film.flags(1));
   EXPECT_EQ(r.status, 0) << r.err;
   if (err) *err = r.err;
-  r = run_cli("render " + dark + " -o " + q(dir / (name + "_dark.exr")) + " --variance" + film.flags(2));
+  r = run_cli("render " + dark + " -o " + q(dir / (name + "_dark.exr")) + " --variance" + film.flags(1));
   EXPECT_EQ(r.status, 0) << r.err;
+  // PYROLUME_SMOKE_GALLERY=DIR: the render also as DIR/NAME.png (docs/gallery's smoke images).
+  if (const char* g = std::getenv("PYROLUME_SMOKE_GALLERY")) {
+    r = run_cli("render " + scene + " -o " + q(std::filesystem::path(g) / (name + ".png")) + film.flags(1));
+    EXPECT_EQ(r.status, 0) << r.err;
+  }
   SmokeLook look = smoke_look(read_image(dir / (name + ".exr")));
   const Image d = read_image(dir / (name + "_dark.exr"));
   image_mean(d, look.mean0, look.mean0_se);
+  if (std::getenv("PYROLUME_SMOKE_LOOK")) {
+    r = run_cli("render " + dark + " -o " + q(dir / (name + "_dark2.exr")) + " --variance" + film.flags(2));
+    EXPECT_EQ(r.status, 0) << r.err;
+    image_mean(read_image(dir / (name + "_dark2.exr")), look.mean0_seed2, look.mean0_seed2_se);
+    std::printf("%s: independent seeds: glow %+.2f SE (mean %.5g vs %.5g)\n", name.c_str(), look.glow_z_independent(),
+                look.mean, look.mean0_seed2);
+  }
   return look;
 }
 

@@ -260,7 +260,7 @@ TEST(ColdTemperatureFix, NeverProposesTheScaleInUse) {
 TEST_F(SmokeIsSmoke, BlenderStyleSmokeWithAnAllZeroFlameLooksLikeSmoke) {
   write_vdb(dir / "fluid_data_0001.vdb", blender_smoke());
   std::string err;
-  const SmokeLook look = run_smoke_look(dir, dir / "fluid_data_0001.vdb", "blender", &err);
+  const SmokeLook look = run_smoke_look(dir, dir / "fluid_data_0001.vdb", "smoke_blender_style", &err);
   std::printf("blender-style smoke: %s\n", look.summary().c_str());
   EXPECT_TRUE(look.looks_like_smoke()) << look.summary();
   EXPECT_NE(err.find("lit by the default rig"), std::string::npos) << err;
@@ -270,7 +270,7 @@ TEST_F(SmokeIsSmoke, BlenderStyleSmokeWithAnAllZeroFlameLooksLikeSmoke) {
 TEST_F(SmokeIsSmoke, HoudiniStyleDensityOnlySmokeLooksLikeSmoke) {
   write_vdb(dir / "smoke.vdb", houdini_smoke(), kHoudini);
   std::string err;
-  const SmokeLook look = run_smoke_look(dir, dir / "smoke.vdb", "houdini", &err);
+  const SmokeLook look = run_smoke_look(dir, dir / "smoke.vdb", "smoke_houdini_style", &err);
   std::printf("houdini-style smoke: %s\n", look.summary().c_str());
   EXPECT_TRUE(look.looks_like_smoke()) << look.summary();
   EXPECT_NE(err.find("lit by the default rig"), std::string::npos) << err;
@@ -291,7 +291,7 @@ TEST_F(SmokeIsSmoke, TheSmokeCheckCanFail) {
     return read_image(dir / out);
   };
   SmokeLook glow = smoke_look(render("glow.json", "glow.exr", 1));
-  image_mean(render("dark.json", "dark.exr", 2), glow.mean0, glow.mean0_se);
+  image_mean(render("dark.json", "dark.exr", 1), glow.mean0, glow.mean0_se);
   EXPECT_FALSE(glow.no_glow()) << glow.summary();
   write_file(dir / "unlit.json", R"({"default_lights": false, "media": [{"type": "vdb", "file": "s.vdb"}]})");
   const CliResult r = run_cli("render '" + (dir / "unlit.json").string() + "' -o '" + (dir / "unlit.exr").string() +
