@@ -45,7 +45,10 @@ std::string format_seconds(double s) {
 // What a black image's warning names (film_look_warning).
 FilmCause film_cause(const Scene& scene) {
   FilmCause c;
-  c.unlit = nothing_emits(scene);
+  // The pre-render warning (nothing_emits) in short: the cause and its fix.
+  if (!nothing_emits(scene).empty())
+    c.unlit = scene.lights.empty() ? "nothing in the scene gives light: add lights, background.rgb or an environment"
+                                   : "the lights light nothing: set the media's sigma_s (or add a surface)";
   c.emits = false;
   for (const Medium& m : scene.media) c.emits = c.emits || m.emission.emits();
   return c;
