@@ -93,7 +93,7 @@ struct Strategy {
 int main(int argc, char** argv) try {
   const Options o = parse(argc, argv);
   Scene base = load_scene(o.scene);
-  complete_scene(base, 0, true);  // source conventions and framing, as `render` settles them
+  complete_scene(base, true);  // source conventions and framing, as `render` settles them
   auto backend = make_backend(o.backend);
   auto render = [&](const Scene& s, int spp, uint32_t seed) {
     RenderSettings rs;

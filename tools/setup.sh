@@ -6,11 +6,12 @@ PYROLUME_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 PYROLUME_BUILD="${PYROLUME_BUILD:-$PYROLUME_ROOT/build}"
 
 # Build tools (clang + compiler-rt: the sanitizer and libFuzzer build; lld: links
-# in a third of GNU ld's time), Vulkan (loader, headers, lavapipe, validation layers, glslang),
+# in a third of GNU ld's time), Vulkan (loader, headers, lavapipe, validation layers, glslang;
+# spirv-tools: its optimizer library specialises shaders before pipeline creation),
 # and the libraries the host uses.
 PYROLUME_PACKAGES=(
   build-essential cmake ninja-build pkg-config lld
-  libvulkan-dev mesa-vulkan-drivers vulkan-tools vulkan-validationlayers glslang-tools
+  libvulkan-dev mesa-vulkan-drivers vulkan-tools vulkan-validationlayers glslang-tools spirv-tools
   libopenvdb-dev libboost-iostreams-dev libnanovdb-dev libtbb-dev
   libglfw3-dev xvfb xauth python3 python3-matplotlib libtinyobjloader-dev
   libopenexr-dev libglm-dev nlohmann-json3-dev libcli11-dev libstb-dev libgtest-dev

@@ -262,7 +262,7 @@ void print_how_to_make_inputs(const Scene& pattern_scene, const Scene& frame_sce
 // one pipeline and BVH) for every frame; each frame is rendered exactly as
 // `--frames N-N` would render it alone.
 int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesystem::path& output,
-                 const std::atomic<bool>& cancel, SceneRemarks& remarks) {
+                 const std::atomic<bool>& cancel, SceneRemarks& remarks, std::optional<int> key_frame) {
   if (args.checkpoint > 0.0 || args.resume)
     throw input_error(args.checkpoint > 0.0 ? "--checkpoint" : "--resume", "",
                       "is for single renders; a sequence resumes by frames with --skip-existing");
@@ -296,9 +296,38 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
   options.frame_reuse = true;
   auto backend = make_backend(args.backend, options);
 
-  // Auto exposure comes from the first frame rendered and holds for the rest (no flicker).
+  // Auto exposure comes from the shot's key frame (a scene with frame
+  // patterns: docs/render-farm.md), else from the first frame rendered, and
+  // holds for the rest (no flicker).
   DisplayExposure exposure(parse_exposure(args.exposure));
   const std::string ext = lower_extension(output);
+  std::optional<RenderResult> key_render;  // the key frame's, when the loop renders it too
+  if (key_frame && ext == ".png") {
+    const Scene key_scene = scene_at_frame(scene, *key_frame);
+    if (exposure.automatic(key_scene.film) && missing_inputs(scene, key_scene).empty()) {
+      RenderSettings settings = settings_from(args, key_scene);
+      settings.frame = uint32_t(*key_frame);
+      ProgressBar bar("key frame " + std::to_string(*key_frame) + " (auto exposure)");
+      RenderControl control;
+      control.progress = [&](int done, int target) {
+        remarks.say(&bar);
+        bar.update(done, target);
+      };
+      control.cancel = &cancel;
+      RenderResult result = backend->render(key_scene, settings, control);
+      remarks.say(&bar);
+      bar.finish();
+      if (result.cancelled) {
+        std::cerr << "pyrolume: interrupted in the key frame " << *key_frame << "; no frame is written\n";
+        return 0;
+      }
+      std::cerr << "pyrolume: the shot's auto exposure comes from its key frame " << *key_frame << "\n";
+      exposure.stops(key_scene.film, image_from_render(result, false), display_log(output));
+      const bool in_range = *key_frame >= range.first && *key_frame <= range.last &&
+                            (*key_frame - range.first) % range.step == 0;
+      if (in_range) key_render = std::move(result);
+    }
+  }
   bool look_warned = false;
   int rendered = 0, skipped = 0, missing = 0, not_denoised = 0, denoise_status = 0;
   double load_seconds = 0.0, render_seconds = 0.0;
@@ -341,7 +370,13 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
       bar.update(done, target);
     };
     control.cancel = &cancel;
-    RenderResult result = backend->render(frame_scene, settings, control);
+    RenderResult result;
+    if (key_render && frame == *key_frame) {
+      result = std::move(*key_render);  // rendered above for the exposure, with these settings
+      key_render.reset();
+    } else {
+      result = backend->render(frame_scene, settings, control);
+    }
     remarks.say(&bar);
     bar.finish();
     if (result.cancelled) {
@@ -407,9 +442,9 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
   Scene scene = load_scene(args.scene);
 
   const bool sequence = !args.frames.empty();
-  // Source conventions, up axis and framing, read off the first frame of a sequence.
-  const SceneSetup setup = complete_scene(scene, sequence ? parse_frame_range(args.frames).first : 0,
-                                          args.width || args.height || scene.film.size_given);
+  // Source conventions, up axis and framing; a frame pattern's from its whole
+  // shot, never from the frames asked for.
+  const SceneSetup setup = complete_scene(scene, args.width || args.height || scene.film.size_given);
   const double aspect =
       double(args.width.value_or(scene.film.width)) / double(args.height.value_or(scene.film.height));
   // Said once the render is under way (every input check passed), so that a
@@ -440,7 +475,7 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
     if (args.checkpoint > 0.0) throw input_error("--checkpoint", "", no_aovs);
   }
 
-  if (sequence) return run_sequence(args, scene, output, cancel, remarks);
+  if (sequence) return run_sequence(args, scene, output, cancel, remarks, setup.key_frame);
 
   if (args.skip_existing) throw input_error("--skip-existing", "", "needs --frames");
   if (args.strict) throw input_error("--strict", "", "needs --frames");

@@ -1,6 +1,7 @@
 // pyrolume command line (README.md "Using it"; the scene format: docs/scene-format.md).
 // Exit status: 0 ok, 1 internal error, 2 bad input, 3 compare beyond limits,
 // 130/143 interrupted (the image so far is saved first).
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
@@ -17,9 +18,11 @@
 
 #include "cli/Commands.h"
 #include "image/AtomicFile.h"
+#include "image/DisplayTransform.h"
 #include "preview/Preview.h"
 #include "render/Render.h"
 #include "util/Error.h"
+#include "util/Suggest.h"
 
 namespace {
 std::atomic<bool> g_cancel{false};
@@ -61,6 +64,35 @@ CLI::Validator positive_finite(const std::string& unit, double max = std::numeri
 
 // Seconds for --time-limit and --checkpoint.
 const CLI::Validator kPositiveSeconds = positive_finite("seconds");
+
+// --exposure: "auto" or stops within ±kMaxExposureStops; '' is refused too.
+const CLI::Validator kExposure(
+    [](std::string& text) { return pyrolume::exposure_problem(text); }, "EV|auto");
+
+// " (did you mean ...?)" for the first word on the command line that names
+// no subcommand or no flag of its subcommand, "" when there is none.
+std::string flag_suggestion(CLI::App& app, int argc, char** argv) {
+  if (argc < 2) return "";
+  std::vector<std::string> commands;
+  for (const CLI::App* sub : app.get_subcommands({})) commands.push_back(sub->get_name());
+  CLI::App* sub = nullptr;
+  try {
+    sub = app.get_subcommand(argv[1]);
+  } catch (const CLI::OptionNotFound&) {
+    return argv[1][0] == '-' ? "" : pyrolume::did_you_mean(argv[1], commands);
+  }
+  std::vector<std::string> flags;
+  for (const CLI::Option* o : sub->get_options()) {
+    for (const std::string& l : o->get_lnames()) flags.push_back("--" + l);
+    for (const std::string& n : o->get_snames()) flags.push_back("-" + n);
+  }
+  for (int i = 2; i < argc; ++i) {
+    const std::string word = std::string(argv[i]).substr(0, std::string(argv[i]).find('='));
+    if (word.size() < 3 || word.compare(0, 2, "--") != 0) continue;
+    if (std::find(flags.begin(), flags.end(), word) == flags.end()) return pyrolume::did_you_mean(word, flags);
+  }
+  return "";
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -77,7 +109,9 @@ int main(int argc, char** argv) {
 
   RenderArgs render_args;
   auto* render = app.add_subcommand("render", "Render a scene to EXR or PNG");
-  render->add_option("scene", render_args.scene, "Scene JSON file")->required();
+  render->add_option("scene", render_args.scene,
+                     "Scene JSON file, or a .vdb/.nvdb file (a #### pattern with --frames) as the shortest scene naming it")
+      ->required();
   render->add_option("-o,--output", render_args.output, "Output image (.exr linear float, .png sRGB)");
   render->add_option("--backend", render_args.backend, "vulkan (default) or cpu")->check(CLI::IsMember({"vulkan", "cpu"}));
   render->add_option("--spp", render_args.spp, "Samples per pixel (overrides film.spp), at most 2^24")
@@ -95,7 +129,9 @@ int main(int argc, char** argv) {
   render->add_flag("--denoise", render_args.denoise,
                    "Also write OUT.denoised.exr (or .png) through the denoiser; OUT itself is left as it is");
   render->add_option("--exposure", render_args.exposure,
-                     "PNG: exposure in stops, or auto (overrides film.exposure on every frame; EXR stays linear)");
+                     "PNG: exposure in stops (within ±30), or auto (overrides film.exposure on every frame; EXR stays "
+                     "linear)")
+      ->check(kExposure);
   render->add_option("--device", render_args.device, "Vulkan device index (see `pyrolume devices`)")->check(CLI::NonNegativeNumber);
   render->add_option("--frames", render_args.frames,
                      "Render frames A-B[:step] (or one frame A); -o and --stats are then patterns: out_####.exr");
@@ -113,13 +149,14 @@ int main(int argc, char** argv) {
 
   PreviewArgs pv;
   auto* preview = app.add_subcommand("preview", "Open a window that shows the render converging");
-  preview->add_option("scene", pv.scene, "Scene JSON file")->required();
+  preview->add_option("scene", pv.scene, "Scene JSON file, or a .vdb/.nvdb file")->required();
   preview->add_option("--frames", pv.frames, "Show N display frames, save --screenshot, exit")->check(CLI::PositiveNumber);
   preview->add_option("--screenshot", pv.screenshot, "PNG of what the window shows (with --frames)");
   preview->add_option("--device", pv.device, "Vulkan device index")->check(CLI::NonNegativeNumber);
   preview->add_option("--width", pv.width, "Window width (overrides film.width)")->check(CLI::Range(16, pyrolume::kMaxFilmSide));
   preview->add_option("--height", pv.height, "Window height (overrides film.height)")->check(CLI::Range(16, pyrolume::kMaxFilmSide));
-  preview->add_option("--exposure", pv.exposure, "Starting exposure in stops, or auto (overrides film.exposure)");
+  preview->add_option("--exposure", pv.exposure, "Starting exposure in stops (within ±30), or auto (overrides film.exposure)")
+      ->check(kExposure);
 
   std::string info_file;
   bool info_values = false;
@@ -179,7 +216,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "pyrolume: " << e.what() << " (see --help)\n";
+    const bool unknown_word = dynamic_cast<const CLI::ExtrasError*>(&e) || dynamic_cast<const CLI::RequiredError*>(&e);
+    std::cerr << "pyrolume: " << e.what() << (unknown_word ? flag_suggestion(app, argc, argv) : "") << " (see --help)\n";
     return 2;
   }
 

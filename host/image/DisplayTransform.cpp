@@ -107,13 +107,8 @@ AutoExposure auto_exposure(const Image& img, ViewTransform view) {
   return a;
 }
 
-ExposureOverride parse_exposure(const std::string& text, const std::string& flag) {
-  ExposureOverride e;
-  if (text.empty()) return e;
-  if (text == "auto") {
-    e.automatic = true;
-    return e;
-  }
+std::string exposure_problem(const std::string& text) {
+  if (text == "auto") return "";
   size_t used = 0;
   double v = 0.0;
   try {
@@ -121,9 +116,19 @@ ExposureOverride parse_exposure(const std::string& text, const std::string& flag
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used != text.size() || !std::isfinite(v))
-    throw input_error(flag, "", "expected a number of stops or \"auto\", got \"" + text + "\"");
-  e.stops = v;
+  if (text.empty() || used != text.size() || !std::isfinite(v))
+    return "expected a number of stops or \"auto\", got \"" + text + "\"";
+  if (std::abs(v) > kMaxExposureStops)
+    return "must be within ±" + std::to_string(int(kMaxExposureStops)) + " stops, got " + text;
+  return "";
+}
+
+ExposureOverride parse_exposure(const std::string& text, const std::string& flag) {
+  ExposureOverride e;
+  if (text.empty()) return e;  // not given
+  if (const std::string why = exposure_problem(text); !why.empty()) throw input_error(flag, "", why);
+  if (text == "auto") e.automatic = true;
+  else e.stops = std::stod(text);
   return e;
 }
 

@@ -31,7 +31,7 @@ std::vector<unsigned char> display_rgb8(const Image& img, double exposure_stops,
 // display level kAutoExposureLevel. An image without lit pixels gets 0.
 inline constexpr double kAutoExposurePercentile = 99.0;
 inline constexpr double kAutoExposureLevel = 0.8;  // 204/255
-inline constexpr double kAutoExposureLimit = 30.0; // |stops| at most
+inline constexpr double kAutoExposureLimit = kMaxExposureStops;  // |stops| at most
 struct AutoExposure {
   double stops = 0.0;
   double percentile_luminance = 0.0;  // 0 when no pixel is lit
@@ -46,6 +46,9 @@ struct ExposureOverride {
   std::optional<double> stops;
 };
 ExposureOverride parse_exposure(const std::string& text, const std::string& flag = "--exposure");
+// Why `text` is no exposure value, "" when it is one: "auto", or a finite
+// number of stops within ±kMaxExposureStops (the empty text is none).
+std::string exposure_problem(const std::string& text);
 
 // The exposure display output uses, frame after frame: the override's, else
 // film.exposure (evaluated at the frame by the caller); "auto" from either is

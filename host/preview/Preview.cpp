@@ -608,7 +608,7 @@ int run_preview_command(const PreviewArgs& args) {
   parse_exposure(args.exposure);         // InputError (a bad --exposure): exit 2
   Scene scene = load_scene(args.scene);  // InputError: the CLI prints it, exit 2
   // Source conventions, up axis and framing, as `render` settles them.
-  for (const std::string& note : complete_scene(scene, 0, args.width || args.height || scene.film.size_given).notes)
+  for (const std::string& note : complete_scene(scene, args.width || args.height || scene.film.size_given).notes)
     std::cerr << "pyrolume: note: " << note << "\n";
 
   g_signal = 0;

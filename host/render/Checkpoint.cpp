@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "image/AtomicFile.h"
+#include "scene/Scene.h"
 #include "util/Error.h"
 #include "util/InputFile.h"
 #include "util/Json.h"
@@ -48,7 +49,9 @@ fs::path checkpoint_path(const fs::path& output) {
 }
 
 uint64_t scene_fingerprint(const fs::path& scene_file) {
-  const std::string text = read_input_file(scene_file, kMaxSceneBytes, "scene", 10.0);
+  // A bare volume is the shortest scene naming it (load_scene), not its voxels.
+  const std::string text = is_volume_file(scene_file) ? shortest_scene_text(scene_file)
+                                                      : read_input_file(scene_file, kMaxSceneBytes, "scene", 10.0);
   std::string canonical = text;
   try {
     canonical = nlohmann::json::parse(text, nullptr, true, /*ignore_comments=*/true).dump();

@@ -60,7 +60,14 @@ Box grid_box(const VolumeFileInfo& info, const Medium& m, const std::string& fil
 // Z up (from −Y), Houdini's and Maya's for Y up (from +Z); both put +X to the
 // right of the picture.
 glm::dvec3 front_forward(UpAxis up) { return up == UpAxis::Z ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, -1); }
-glm::dvec3 up_vector(UpAxis up) { return up == UpAxis::Z ? glm::dvec3(0, 0, 1) : glm::dvec3(0, 1, 0); }
+glm::dvec3 up_vector(UpAxis up) { return up_axis_vector(up); }
+
+// A plane shape facing along the up axis: the automatic camera then looks down on it.
+bool has_ground_plane(const Scene& scene, UpAxis up) {
+  for (const Shape& s : scene.shapes)
+    if (s.type == Shape::Type::Plane && std::abs(glm::dot(glm::normalize(s.normal), up_vector(up))) > 0.9) return true;
+  return false;
+}
 
 Box union_of(const std::vector<WorldBox>& boxes) {
   Box all;
@@ -86,13 +93,21 @@ UpAxis axis_of(const glm::dvec3& up) { return std::abs(up.z) > std::abs(up.y) ? 
 
 }  // namespace
 
-Camera framing_camera(const std::vector<WorldBox>& boxes, UpAxis up_axis, double fov_deg, double aspect) {
+double ground_tilt_deg(double fov_deg) {
+  return std::atan(std::tan(0.5 * fov_deg * std::numbers::pi / 180.0) / 3.0) * 180.0 / std::numbers::pi;
+}
+
+Camera framing_camera(const std::vector<WorldBox>& boxes, UpAxis up_axis, double fov_deg, double aspect,
+                      double tilt_deg) {
   const Box all = union_of(boxes);
   Camera cam;
   cam.fov_deg = fov_deg;
   cam.up = up_vector(up_axis);
-  const glm::dvec3 forward = front_forward(up_axis);
-  const glm::dvec3 right = glm::cross(forward, cam.up);
+  // Tilted down about the right axis; view_up is the picture's up.
+  const double tilt = tilt_deg * std::numbers::pi / 180.0;
+  const glm::dvec3 forward = std::cos(tilt) * front_forward(up_axis) - std::sin(tilt) * cam.up;
+  const glm::dvec3 right = glm::cross(front_forward(up_axis), cam.up);
+  const glm::dvec3 view_up = glm::cross(right, forward);
   const glm::dvec3 centre = 0.5 * (all.min + all.max);
   // Each corner at lateral offsets (a, b) and depth z behind the centre plane
   // is in the picture when |a| <= (d + z)·tan(fov_h/2) and |b| <= (d + z)·tan(fov_v/2),
@@ -103,7 +118,7 @@ Camera framing_camera(const std::vector<WorldBox>& boxes, UpAxis up_axis, double
   for (int c = 0; c < 8; ++c) {
     const glm::dvec3 p((c & 1) ? all.max.x : all.min.x, (c & 2) ? all.max.y : all.min.y, (c & 4) ? all.max.z : all.min.z);
     const glm::dvec3 q = p - centre;
-    const double a = std::abs(glm::dot(q, right)), b = std::abs(glm::dot(q, cam.up)), z = glm::dot(q, forward);
+    const double a = std::abs(glm::dot(q, right)), b = std::abs(glm::dot(q, view_up)), z = glm::dot(q, forward);
     d = std::max({d, a / tan_h - z, b / tan_v - z});
     half_depth = std::max(half_depth, std::abs(z));
   }
@@ -185,7 +200,7 @@ std::string nothing_emits(const Scene& scene) {
          "\"default_lights\" is false), so the image will be black: add lights, background.rgb or an environment";
 }
 
-SceneSetup complete_scene(Scene& scene, int frame, bool film_size_fixed) {
+SceneSetup complete_scene(Scene& scene, bool film_size_fixed) {
   SceneSetup out;
   std::optional<UpAxis> source_up;
   for (size_t i = 0; i < scene.media.size(); ++i) {
@@ -197,10 +212,23 @@ SceneSetup complete_scene(Scene& scene, int frame, bool film_size_fixed) {
       out.boxes.push_back(w);
       continue;
     }
-    const std::string file =
-        has_frame_pattern(m.file.string()) ? expand_frame_pattern(m.file.string(), frame) : m.file.string();
+    // A frame pattern is read as the whole shot: its key frame decides the
+    // source and mapping, every frame's box the framing (docs/render-farm.md).
+    std::string file = m.file.string();
+    std::vector<std::string> shot{file};
+    if (has_frame_pattern(file)) {
+      const std::vector<int> frames = frames_on_disk(m.file);
+      if (frames.empty()) continue;  // no frame at all: the render says which are missing
+      const int middle = frames[(frames.size() - 1) / 2];
+      if (!out.key_frame) out.key_frame = middle;
+      // A medium without the first pattern's key frame reads its own middle one.
+      const int key = std::binary_search(frames.begin(), frames.end(), *out.key_frame) ? *out.key_frame : middle;
+      shot.clear();
+      for (int f : frames) shot.push_back(expand_frame_pattern(file, f));
+      file = expand_frame_pattern(file, key);
+    }
     std::error_code ec;
-    if (!std::filesystem::exists(file, ec)) continue;  // a missing frame: the render says so
+    if (!std::filesystem::exists(file, ec)) continue;  // a missing file: the render says so
     const VolumeFileInfo info = read_volume_file_info(file, false);
     SourceConvention c = source_convention(info, m.source, m.temperature_grid);
     if (!m.given.temperature_scale) fit_temperature_mapping(c, file);
@@ -215,8 +243,15 @@ SceneSetup complete_scene(Scene& scene, int frame, bool film_size_fixed) {
     if (c.guessed && guess_decides)
       out.notes.push_back(file + ": source " + std::string(to_string(c.source)) + " (" + c.why +
                           "; set media[" + std::to_string(i) + "].source to choose): " + c.mapping_text);
-    const Box b = grid_box(info, m, file);
-    if (!b.empty()) out.boxes.push_back({b.min, b.max, at + " (" + std::filesystem::path(file).filename().string() + ")"});
+    Box b;
+    for (const std::string& f : shot) {
+      const Box fb = f == file ? grid_box(info, m, f) : grid_box(read_volume_file_info(f, false), m, f);
+      if (fb.empty()) continue;
+      b.add(fb.min);
+      b.add(fb.max);
+    }
+    const std::string name = std::filesystem::path(shot.size() > 1 ? m.file : std::filesystem::path(file)).filename().string();
+    if (!b.empty()) out.boxes.push_back({b.min, b.max, at + " (" + name + ")"});
   }
   for (size_t i = 0; i < scene.shapes.size(); ++i) {
     const Shape& s = scene.shapes[i];
@@ -239,10 +274,13 @@ SceneSetup complete_scene(Scene& scene, int frame, bool film_size_fixed) {
     Film& film = scene.film;
     if (!film_size_fixed && extent.y > 1.2 * extent.x && film.width > film.height) std::swap(film.width, film.height);
     const double aspect = double(film.width) / double(film.height);
-    const Camera c = framing_camera(out.boxes, *scene.up_axis, scene.camera.fov_deg, aspect);
+    const double tilt = has_ground_plane(scene, *scene.up_axis) ? ground_tilt_deg(scene.camera.fov_deg) : 0.0;
+    const Camera c = framing_camera(out.boxes, *scene.up_axis, scene.camera.fov_deg, aspect, tilt);
     scene.camera.position = c.position;
     scene.camera.look_at = c.look_at;
     if (!scene.camera.up_given) scene.camera.up = c.up;
+  } else if (!scene.camera.up_given) {
+    scene.camera.up = default_camera_up(*scene.up_axis, scene.camera.look_at - scene.camera.position);
   }
   if (const std::string note = add_default_rig(scene); !note.empty()) out.notes.push_back(scene.file.string() + ": " + note);
   return out;

@@ -4,6 +4,7 @@
 // (grids, temperature mapping), the scene's up axis, and a camera that frames
 // the scene when the file places none. Both backends then render the completed
 // Scene as written.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,20 +23,33 @@ struct WorldBox {
 struct SceneSetup {
   std::vector<std::string> notes;  // one stderr line each, for the user (e.g. a guessed source)
   std::vector<WorldBox> boxes;     // the media and bounded shapes (unbounded planes left out)
+  // A scene with frame patterns: the shot's key frame, the middle one of the
+  // first pattern's frames on disk. Its file decides the source convention,
+  // and auto exposure is chosen from its render (docs/render-farm.md).
+  std::optional<int> key_frame;
 };
 
-// Completes `scene` in place. Frame patterns in medium files are read at
-// `frame` (a missing file is skipped here; the render reports it). When the
-// camera is framed automatically and neither the file nor the command line
-// (`film_size_fixed`) sets the film's size, a subject taller than wide turns
-// the film upright (width and height swapped) when it is over 1.2 times taller than wide. Throws InputError for
-// unreadable files.
-SceneSetup complete_scene(Scene& scene, int frame, bool film_size_fixed);
+// Completes `scene` in place. A medium file that is a frame pattern stands
+// for its whole shot, every frame on disk, whatever frames are rendered: the
+// source convention comes from the key frame's file and the framing from the
+// union of every frame's box (file metadata; voxels only where a file stores
+// no box). When the camera is framed automatically and neither the file nor
+// the command line (`film_size_fixed`) sets the film's size, a subject over
+// 1.2 times taller than wide turns the film upright (width and height
+// swapped). An omitted camera.up follows the up axis (default_camera_up).
+// Throws InputError for unreadable files.
+SceneSetup complete_scene(Scene& scene, bool film_size_fixed);
 
 // Where a camera sits to frame `boxes` from the front (looking along +Z for a
-// Y-up scene, along +Y for a Z-up one) with a vertical field of view of
-// fov_deg: every corner inside the picture with a 5 % margin.
-Camera framing_camera(const std::vector<WorldBox>& boxes, UpAxis up, double fov_deg, double aspect);
+// Y-up scene, along +Y for a Z-up one), tilted down by tilt_deg, with a
+// vertical field of view of fov_deg: every corner inside the picture with a
+// 5 % margin.
+Camera framing_camera(const std::vector<WorldBox>& boxes, UpAxis up, double fov_deg, double aspect,
+                      double tilt_deg = 0.0);
+
+// The automatic camera's downward tilt over a ground plane: the horizon then
+// lies a third of the way from the centre to the top of the picture.
+double ground_tilt_deg(double fov_deg);
 
 // The default rig (docs/scene-format.md "default_lights"): a dim grey
 // background and a sun keyed from above and beside the camera.

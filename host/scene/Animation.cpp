@@ -1,7 +1,9 @@
 // Frames of an animated scene: frame patterns in medium files (Blender's and
 // Houdini's conventions) and keyframed parameters evaluated at a frame
 // (docs/animation.md).
+#include <algorithm>
 #include <cstdio>
+#include <regex>
 
 #include "scene/Scene.h"
 #include "util/Error.h"
@@ -58,6 +60,41 @@ std::string expand_frame_pattern(const std::string& pattern, int frame) {
   return out + pattern.substr(at);
 }
 
+std::vector<int> frames_on_disk(const std::filesystem::path& pattern) {
+  const std::string name = pattern.filename().string();
+  if (!has_frame_pattern(name)) return {};
+  // The name as a regex: literal text escaped, each pattern a run of digits.
+  std::string re;
+  size_t at = 0;
+  auto literal = [&](const std::string& text) {
+    for (char c : text) {
+      if (std::string("\\^$.|?*+()[]{}").find(c) != std::string::npos) re += '\\';
+      re += c;
+    }
+  };
+  for (PatternMatch m = find_pattern(name, 0); m.pos != std::string::npos; m = find_pattern(name, at)) {
+    literal(name.substr(at, m.pos - at));
+    re += "([0-9]{1,9})";
+    at = m.pos + m.len;
+  }
+  literal(name.substr(at));
+  const std::regex match(re);
+  const std::filesystem::path folder = pattern.has_parent_path() ? pattern.parent_path() : std::filesystem::path(".");
+  std::vector<int> frames;
+  std::error_code ec;
+  for (std::filesystem::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string entry = it->path().filename().string();
+    std::smatch found;
+    if (!std::regex_match(entry, found, match)) continue;
+    const int frame = std::stoi(found[1].str());
+    // "00007" is not frame 7 of "####": the name must be the pattern's own spelling.
+    if (expand_frame_pattern(name, frame) == entry) frames.push_back(frame);
+  }
+  std::sort(frames.begin(), frames.end());
+  frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
+  return frames;
+}
+
 bool scene_has_file_patterns(const Scene& scene) {
   for (const Medium& m : scene.media)
     if (m.type == Medium::Type::Vdb && has_frame_pattern(m.file.string())) return true;
@@ -86,6 +123,7 @@ Scene scene_at_frame(const Scene& scene, int frame) {
   }
   // What keys can break: the parse-time checks, now at this frame.
   const glm::dvec3 forward = s.camera.look_at - s.camera.position;
+  if (!s.camera.up_given) s.camera.up = default_camera_up(s.up_axis.value_or(UpAxis::Y), forward);
   const std::string at = " at frame " + std::to_string(frame);
   if (glm::length(forward) == 0)
     throw input_error(scene.file.string(), "camera.look_at", "must differ from position" + at);

@@ -37,13 +37,27 @@ struct Keyframes {
   }
 };
 
+// The world's up axis as a vector.
+inline glm::dvec3 up_axis_vector(UpAxis axis) { return axis == UpAxis::Z ? glm::dvec3(0, 0, 1) : glm::dvec3(0, 1, 0); }
+
+// A camera's up when the file gives none: the scene's up axis, unless the view
+// runs (nearly) along it; a view from above or below then has the world's
+// front-to-back axis at the top of the image, as Blender's top view has +Y
+// (Z up) and Maya's and Houdini's have −Z (Y up).
+inline glm::dvec3 default_camera_up(UpAxis axis, const glm::dvec3& view_direction) {
+  const glm::dvec3 up = up_axis_vector(axis);
+  const double len = glm::length(view_direction);
+  if (!(len > 0.0) || glm::length(glm::cross(view_direction / len, up)) > 1e-3) return up;
+  return axis == UpAxis::Z ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, -1);
+}
+
 struct Camera {
   glm::dvec3 position{0, 1, -6};
   glm::dvec3 look_at{0, 1, 0};
   // The file gives neither position nor look_at: the camera frames the scene's
   // media and shapes (host/render/SceneSetup, docs/scene-format.md "camera").
   bool framed_automatically = false;
-  bool up_given = false;
+  bool up_given = false;  // else `up` follows the up axis (default_camera_up)
   Keyframes<glm::dvec3> position_keys, look_at_keys;
   glm::dvec3 up{0, 1, 0};
   double fov_deg = 40.0;  // vertical field of view
@@ -64,6 +78,10 @@ inline constexpr bool spp_in_range(long long spp) { return spp >= kMinSpp && spp
 // A film side is 1..16384 pixels everywhere (film keys, --width/--height,
 // checkpoints): 16384² pixels is also the largest EXR that is read.
 inline constexpr int kMaxFilmSide = 16384;
+
+// Exposure is at most this many stops either way (film.exposure, --exposure,
+// auto exposure): 2^30 already takes the dimmest visible value past white.
+inline constexpr double kMaxExposureStops = 30.0;
 
 struct Film {
   int width = 640;
@@ -304,7 +322,13 @@ std::optional<IntegratorConflict> integrator_conflict(const Integrator& integrat
 // Parse and validate. Throws InputError("FILE: key.path: reason").
 // Keyframed values are also stored evaluated at frame 0 (clamped), the frame
 // a render without --frames shows; medium files keep their frame patterns.
+// A .vdb or .nvdb file (or a frame pattern of them) loads as the shortest
+// scene naming it, shortest_scene_text.
 Scene load_scene(const std::filesystem::path& file);
+// Whether `file` ends in .vdb or .nvdb (any case).
+bool is_volume_file(const std::filesystem::path& file);
+// {"media": [{"type": "vdb", "file": NAME}]}, NAME the volume's file name.
+std::string shortest_scene_text(const std::filesystem::path& volume);
 Scene parse_scene(const std::string& json_text, const std::filesystem::path& file);
 
 // ---- animation (host/scene/Animation.cpp, docs/animation.md) ----
@@ -314,6 +338,10 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
 bool has_frame_pattern(const std::string& pattern);
 // Every pattern in `pattern` replaced by `frame`.
 std::string expand_frame_pattern(const std::string& pattern, int frame);
+// The frames whose files exist for a path whose file name holds a frame
+// pattern, ascending (the folder's names are read, no file is opened). Empty
+// when none exists or the name holds no pattern.
+std::vector<int> frames_on_disk(const std::filesystem::path& pattern);
 // True when any medium file is a pattern or any parameter has keys.
 bool scene_is_animated(const Scene& scene);
 bool scene_has_file_patterns(const Scene& scene);

@@ -2,6 +2,7 @@
 // types and out-of-range values are errors that name the file and key path, so a
 // typo never silently renders something else.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -14,6 +15,7 @@
 #include "util/Error.h"
 #include "util/InputFile.h"
 #include "util/Json.h"
+#include "util/Suggest.h"
 
 namespace pyrolume {
 namespace {
@@ -32,7 +34,11 @@ class Reader {
     throw input_error(file_, key.empty() ? path_ : join(key), reason);
   }
   std::string join(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
-  bool has(const std::string& key) const { return j_.contains(key); }
+  // Every key asked about is one this object may hold: finish() suggests among them.
+  bool has(const std::string& key) const {
+    asked_.insert(key);
+    return j_.contains(key);
+  }
   const json& raw(const std::string& key) {
     seen_.insert(key);
     return j_.at(key);
@@ -150,7 +156,8 @@ class Reader {
   // After reading: any key not consumed is a typo or unsupported.
   void finish() const {
     for (auto it = j_.begin(); it != j_.end(); ++it)
-      if (!seen_.count(it.key())) fail(it.key(), "unknown key");
+      if (!seen_.count(it.key()))
+        fail(it.key(), "unknown key" + did_you_mean(it.key(), std::vector<std::string>(asked_.begin(), asked_.end())));
   }
   const std::string& path() const { return path_; }
 
@@ -184,6 +191,7 @@ class Reader {
   std::string path_;
   const std::string& file_;
   std::set<std::string> seen_;
+  mutable std::set<std::string> asked_;
 };
 
 // d scaled by its largest component: the same direction, of length in [1, √3],
@@ -514,9 +522,13 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
     if (!(s.camera.fov_deg > 0 && s.camera.fov_deg < 180)) c.fail("fov_deg", "must be in (0, 180) degrees");
     glm::dvec3 f = s.camera.look_at - s.camera.position;
     if (glm::length(f) == 0) c.fail("look_at", "must differ from position");
-    if (glm::length(glm::cross(glm::normalize(f), s.camera.up)) < 1e-9) c.fail("up", "must not be parallel to the view direction");
+    if (s.camera.up_given && glm::length(glm::cross(glm::normalize(f), s.camera.up)) < 1e-9)
+      c.fail("up", "must not be parallel to the view direction");
     c.finish();
   }
+  // Settled again once the up axis is known (render/SceneSetup), and per frame.
+  if (!s.camera.up_given)
+    s.camera.up = default_camera_up(s.up_axis.value_or(UpAxis::Y), s.camera.look_at - s.camera.position);
   if (r.has("film")) {
     Reader f = r.child("film");
     s.film.size_given = f.has("width") || f.has("height");
@@ -529,6 +541,12 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
       s.film.exposure_auto = true;
     } else {
       s.film.exposure = f.number_keyed("exposure", s.film.exposure, s.film.exposure_keys);
+      const std::string limit = "must be within ±" + std::to_string(int(kMaxExposureStops)) + " stops";
+      if (std::abs(s.film.exposure) > kMaxExposureStops && !s.film.exposure_keys.animated())
+        f.fail("exposure", limit + ", got " + json(s.film.exposure).dump());
+      for (size_t n = 0; n < s.film.exposure_keys.values.size(); ++n)
+        if (std::abs(s.film.exposure_keys.values[n]) > kMaxExposureStops)
+          f.fail("exposure.keys[" + std::to_string(n) + "]", limit + ", got " + json(s.film.exposure_keys.values[n]).dump());
     }
     s.film.view = f.choice("view", "agx", {"agx", "standard"}) == "agx" ? ViewTransform::AgX : ViewTransform::Standard;
     s.film.seed = static_cast<uint32_t>(f.integer("seed", static_cast<int>(s.film.seed), 0, 2147483647));
@@ -611,8 +629,27 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
   return s;
 }
 
+bool is_volume_file(const std::filesystem::path& file) {
+  std::string e = file.extension().string();
+  for (char& c : e) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return e == ".vdb" || e == ".nvdb";
+}
+
+std::string shortest_scene_text(const std::filesystem::path& volume) {
+  json medium = {{"type", "vdb"}, {"file", volume.filename().string()}};
+  return json{{"media", json::array({medium})}}.dump();
+}
+
 Scene load_scene(const std::filesystem::path& file) {
   std::error_code ec;
+  if (is_volume_file(file)) {
+    if (has_frame_pattern(file.filename().string())) {
+      if (frames_on_disk(file).empty()) throw input_error(file.string(), "", "no file matches this frame pattern");
+    } else if (!std::filesystem::exists(file, ec)) {
+      throw input_error(file.string(), "", "no such file");
+    }
+    return parse_scene(shortest_scene_text(file), file);
+  }
   if (!std::filesystem::exists(file, ec)) throw input_error(file.string(), "", "no such file");
   // nlohmann::json holds about ten times the text's size while parsing.
   return parse_scene(read_input_file(file, kMaxSceneBytes, "scene", 10.0), file);

@@ -47,16 +47,25 @@ std::string transform_text(const glm::dmat4& M) {
   return s.str();
 }
 
+}  // namespace
+
+std::string footprint_text(double bytes) {
+  char b[32];
+  if (bytes >= double(1ull << 30)) std::snprintf(b, sizeof b, "%.1f GiB", bytes / double(1ull << 30));
+  else if (bytes >= double(1 << 20)) std::snprintf(b, sizeof b, "%.1f MiB", bytes / double(1 << 20));
+  else if (bytes >= 1024.0) std::snprintf(b, sizeof b, "%.1f KiB", bytes / 1024.0);
+  else std::snprintf(b, sizeof b, "%.0f B", bytes);
+  return b;
+}
+
+namespace {
+
 // What the grid would take as a dense R16F texture (its active box with one
 // voxel of padding, 2 B a texel) and as a sparse NanoVDB float tree
 // (docs/volumes.md "Sparse grids"; texture_format "auto" chooses between them).
 void print_footprints(const GridReport& g, std::ostream& out) {
   if (!g.bbox_min || !g.bbox_max || (g.active_voxels && *g.active_voxels == 0)) return;
-  auto mib = [](double bytes) {
-    char b[32];
-    std::snprintf(b, sizeof b, "%.1f MiB", bytes / double(1 << 20));
-    return std::string(b);
-  };
+  auto mib = [](double bytes) { return footprint_text(bytes); };
   const glm::dvec3 d = glm::dvec3(*g.bbox_max - *g.bbox_min) + 3.0;
   out << "  memory: dense " << mib(2.0 * d.x * d.y * d.z) << " (R16F over the active box); sparse ";
   if (g.nodes)

@@ -59,6 +59,10 @@ struct VolumeFileInfo {
 VolumeFileInfo read_volume_file_info(const std::filesystem::path& file, bool values,
                                      const std::string& only_grid = "");
 
+// A size for `info`'s memory line: B, KiB, MiB or GiB, one decimal
+// ("0.0 MiB" hid a grid of a few KiB).
+std::string footprint_text(double bytes);
+
 // One block per grid, after a line naming the file, its format and creator,
 // and one line per other file metadata entry.
 void print_volume_file_info(const VolumeFileInfo& info, std::ostream& out);

@@ -189,7 +189,7 @@ TEST_F(RealRender, ThinHotBlenderFireWithTheDefaultEstimator) {
                            R"(", "density_scale": 0.02, "emission": {"scale": 100}}],
                               "film": {"width": 32, "height": 48}})";
   Scene s = parse_scene(text, "thin_fire.json");
-  complete_scene(s, 0, true);
+  complete_scene(s, true);
   s.film.spp = 64;
   const RenderResult g = backend_->render(s, settings_for(s), {});
   EXPECT_EQ(g.emission_estimator, "line");

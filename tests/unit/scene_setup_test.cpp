@@ -133,7 +133,7 @@ TEST_F(SceneSetupTest, ExplicitKeysWinOverTheConvention) {
     {"type": "vdb", "file": "smoke.vdb"},
     {"type": "vdb", "file": "smoke.vdb", "emission": {"rgb": [1, 0.5, 0.2]}}]})");
   Scene s = load_scene(dir / "s.json");
-  complete_scene(s, 0, false);
+  complete_scene(s, false);
   EXPECT_EQ(s.media[0].temperature_grid, "heat");
   EXPECT_EQ(s.media[0].temperature.scale, 1000.0);   // the convention's
   EXPECT_EQ(s.media[0].temperature.offset, 0.5);     // the file's
@@ -187,19 +187,19 @@ TEST_F(SceneSetupTest, ATallSubjectTurnsTheDefaultFilmUpright) {
             {{"creator", "Houdini/SOP_OpenVDB_Write"}});
   write_file(dir / "s.json", R"({"media": [{"type": "vdb", "file": "tall.vdb"}]})");
   Scene s = load_scene(dir / "s.json");
-  complete_scene(s, 0, false);
+  complete_scene(s, false);
   EXPECT_EQ(s.film.width, 360);
   EXPECT_EQ(s.film.height, 640);
   EXPECT_EQ(s.up_axis, UpAxis::Y);
   EXPECT_EQ(s.camera.up, glm::dvec3(0, 1, 0));
   Scene fixed = load_scene(dir / "s.json");
-  complete_scene(fixed, 0, true);  // --width/--height given
+  complete_scene(fixed, true);  // --width/--height given
   EXPECT_EQ(fixed.film.width, 640);
   // A camera the file places stays; its up decides the axis.
   write_file(dir / "c.json", R"({"camera": {"position": [0, -5, 1], "look_at": [0, 0, 1], "up": [0, 0, 1]},
     "media": [{"type": "vdb", "file": "tall.vdb"}]})");
   Scene c = load_scene(dir / "c.json");
-  complete_scene(c, 0, false);
+  complete_scene(c, false);
   EXPECT_EQ(c.camera.position, glm::dvec3(0, -5, 1));
   EXPECT_EQ(c.up_axis, UpAxis::Z);
   EXPECT_EQ(c.film.width, 640);

@@ -5,6 +5,8 @@
 
 #include <map>
 
+#include "render/vulkan/Spirv.h"
+
 namespace pyrolume::vk {
 
 ComputePipeline::ComputePipeline(Context& ctx, const std::vector<uint32_t>& spirv,
@@ -36,10 +38,13 @@ ComputePipeline::ComputePipeline(Context& ctx, const std::vector<uint32_t>& spir
   layout_ = UniquePipelineLayout(pl, {dev});
   ctx.set_name(pl, (name_ + " layout").c_str());
 
-  // The module is only needed while the pipeline is created.
+  // The module is only needed while the pipeline is created. Specialised
+  // here rather than by the driver: lavapipe creates it ~3x faster (Spirv.h).
+  const std::vector<uint32_t> code = specialize_spirv(spirv, specialization);
+  const bool specialized = code != spirv;
   VkShaderModuleCreateInfo smi{.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  smi.codeSize = spirv.size() * sizeof(uint32_t);
-  smi.pCode = spirv.data();
+  smi.codeSize = code.size() * sizeof(uint32_t);
+  smi.pCode = code.data();
   VkShaderModule sm = VK_NULL_HANDLE;
   VK_CHECK(vkCreateShaderModule(dev, &smi, nullptr, &sm));
   UniqueShaderModule module(sm, {dev});
@@ -59,7 +64,7 @@ ComputePipeline::ComputePipeline(Context& ctx, const std::vector<uint32_t>& spir
   ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   ci.stage.module = sm;
   ci.stage.pName = "main";
-  ci.stage.pSpecializationInfo = entries.empty() ? nullptr : &spec;
+  ci.stage.pSpecializationInfo = (entries.empty() || specialized) ? nullptr : &spec;
   ci.layout = pl;
   VkPipeline p = VK_NULL_HANDLE;
   VK_CHECK(vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &ci, nullptr, &p));

@@ -2,8 +2,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <spirv-tools/optimizer.hpp>
 #include <stdexcept>
 #include <system_error>
+#include <unordered_map>
 
 namespace pyrolume::vk {
 
@@ -34,6 +36,24 @@ std::vector<uint32_t> load_spirv(const std::string& name) {
   std::string where;
   for (const fs::path& d : dirs) where += (where.empty() ? "" : " or ") + d.string();
   throw std::runtime_error("shader " + file + " not found in " + where + " (was the build complete?)");
+}
+
+std::vector<uint32_t> specialize_spirv(const std::vector<uint32_t>& spirv,
+                                       const std::vector<std::pair<uint32_t, uint32_t>>& specialization) {
+  if (specialization.empty()) return spirv;
+  std::unordered_map<uint32_t, std::vector<uint32_t>> values;
+  for (auto [id, value] : specialization) values[id] = {value};
+  spvtools::Optimizer opt(SPV_ENV_VULKAN_1_2);
+  opt.SetMessageConsumer([](spv_message_level_t, const char*, const spv_position_t&, const char*) {});
+  opt.RegisterPass(spvtools::CreateSetSpecConstantDefaultValuePass(values))
+      .RegisterPass(spvtools::CreateFreezeSpecConstantValuePass())
+      .RegisterPass(spvtools::CreateFoldSpecConstantOpAndCompositePass())
+      .RegisterPass(spvtools::CreateDeadBranchElimPass())
+      .RegisterPass(spvtools::CreateAggressiveDCEPass())
+      .RegisterPass(spvtools::CreateEliminateDeadFunctionsPass());
+  std::vector<uint32_t> out;
+  if (!opt.Run(spirv.data(), spirv.size(), &out) || out.empty()) return spirv;
+  return out;
 }
 
 }  // namespace pyrolume::vk
