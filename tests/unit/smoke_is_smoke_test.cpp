@@ -67,7 +67,7 @@ class SmokeIsSmoke : public ::testing::Test {
     write_vdb(dir / "s.vdb", grids, meta);
     write_file(dir / "s.json", "{" + top + R"("media": [{"type": "vdb", "file": "s.vdb")" + keys + "}]}");
     Scene s = load_scene(dir / "s.json");
-    const SceneSetup out = complete_scene(s, 0, false);
+    const SceneSetup out = complete_scene(s, false);
     if (setup) *setup = out;
     return s;
   }
@@ -304,4 +304,31 @@ TEST_F(SmokeIsSmoke, TheSmokeCheckCanFail) {
   EXPECT_EQ(r.err.find("emission.scale"), std::string::npos) << "nothing emits: " << r.err;
   const SmokeLook unlit = smoke_look(read_image(dir / "unlit.exr"));
   EXPECT_FALSE(unlit.shaded_ok()) << unlit.summary();
+}
+
+// `pyrolume info` says what the shortest scene will do with a smoke cache.
+TEST_F(SmokeIsSmoke, InfoSaysTheFileIsSmokeAndWhereItsVoxelsSit) {
+  write_vdb(dir / "fluid_data_0001.vdb", blender_smoke());
+  const CliResult r = run_cli("info '" + (dir / "fluid_data_0001.vdb").string() + "'");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("grid \"flame\" is zero everywhere: smoke, no emission (write an \"emission\" block to make it glow)"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("smoke scatters: albedo 0.5 (sigma_s 0.5, sigma_a 0.5), density_scale 5"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("voxel ijk placed at ijk + 0.5 (Mantaflow's cell corner)"), std::string::npos) << r.out;
+}
+
+// Lights with nothing to light (no scattering, no surface): the black image's
+// warning says so, not "raise emission.scale".
+TEST_F(SmokeIsSmoke, TheBlackImageWarningSaysTheLightsLightNothing) {
+  write_file(dir / "l.json", R"({"film": {"width": 16, "height": 16, "spp": 1},
+    "lights": [{"type": "distant", "direction": [0, 1, 0], "irradiance": [1, 1, 1]}],
+    "media": [{"type": "homogeneous", "bounds": {"sphere": {"center": [0, 1, 0], "radius": 1}}}]})");
+  const CliResult r =
+      run_cli("render '" + (dir / "l.json").string() + "' -o '" + (dir / "l.png").string() + "' --backend cpu");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("EV): the lights light nothing: set the media's sigma_s (or add a surface)"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("emission.scale"), std::string::npos) << r.err;
 }

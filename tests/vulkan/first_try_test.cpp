@@ -140,7 +140,7 @@ class DefaultRig : public BackendFixture {
                                    R"(, "seed": )" + std::to_string(seed) +
                                    R"(}, "media": [{"type": "vdb", "file": "smoke.vdb"}]})");
     Scene s = load_scene(dir / "s.json");
-    complete_scene(s, 0, true);
+    complete_scene(s, true);
     return s;
   }
 };
