@@ -1,6 +1,7 @@
-// The real smoke exports (read in place from ../shared/data/vdb; skipped when
-// that folder is absent) render as smoke from the shortest scene (issue 46;
-// docs/sources.md "Smoke is smoke"): visible, shaded by the default rig, no
+// The real smoke exports (read in place from the shared data folder's vdb/,
+// test::shared_data_dir(); skipped when it is absent) render as smoke from
+// the shortest scene (issue 46; docs/sources.md "Smoke is smoke"): visible,
+// shaded by the default rig, no
 // glow, not clipped (support/SmokeLook.h). The Blender fire keeps glowing.
 #include <gtest/gtest.h>
 
@@ -19,7 +20,7 @@ class RealSmoke : public ::testing::Test {
   void SetUp() override {
     const fs::path data = test::shared_data_dir();
     if (data.empty() || !fs::exists(data / "vdb"))
-      GTEST_SKIP() << "../shared/data/vdb is absent (set PYROLUME_SHARED_DATA to the data folder to run these)";
+      GTEST_SKIP() << "the shared data folder's vdb/ is absent (set PYROLUME_SHARED_DATA to the data folder to run these)";
     dir = data / "vdb";
     out = test::temp_dir("real-smoke");
   }
