@@ -1,8 +1,8 @@
 // The real smoke exports (read in place from the shared data folder's vdb/,
 // test::shared_data_dir(); skipped when it is absent) render as smoke from
 // the shortest scene (issue 46; docs/sources.md "Smoke is smoke"): visible,
-// shaded by the default rig, no
-// glow, not clipped (support/SmokeLook.h). The Blender fire keeps glowing.
+// shaded by the default rig, no glow, not clipped (support/SmokeLook.h).
+// The Blender fire keeps glowing.
 #include <gtest/gtest.h>
 
 #include "support/SmokeLook.h"
