@@ -42,6 +42,18 @@ std::string format_seconds(double s) {
   return buf;
 }
 
+// What a black image's warning names (film_look_warning).
+FilmCause film_cause(const Scene& scene) {
+  FilmCause c;
+  // The pre-render warning (nothing_emits) in short: the cause and its fix.
+  if (!nothing_emits(scene).empty())
+    c.unlit = scene.lights.empty() ? "nothing in the scene gives light: add lights, background.rgb or an environment"
+                                   : "the lights light nothing: set the media's sigma_s (or add a surface)";
+  c.emits = false;
+  for (const Medium& m : scene.media) c.emits = c.emits || m.emission.emits();
+  return c;
+}
+
 }  // namespace
 
 namespace {
@@ -394,7 +406,8 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
       }
     print_warnings(result, tag);
     if (!look_warned)  // once per sequence, at the first frame it concerns
-      if (const std::string w = film_look_warning(image, stops, frame_scene.film.view, ext == ".png"); !w.empty()) {
+      if (const std::string w = film_look_warning(image, stops, frame_scene.film.view, ext == ".png", film_cause(frame_scene));
+          !w.empty()) {
         std::cerr << "pyrolume: warning: " << tag << w << "\n";
         look_warned = true;
       }
@@ -558,7 +571,8 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
     if (args.denoise && result.spp > 0)
       denoise_status = write_denoised_copy(denoised_path(output), output, full, stops, scene.film.view, denoiser, "", true);
     if (result.spp >= settings.spp)  // a finished render: one the user will look at
-      if (const std::string w = film_look_warning(image, stops, scene.film.view, ext == ".png"); !w.empty())
+      if (const std::string w = film_look_warning(image, stops, scene.film.view, ext == ".png", film_cause(scene));
+          !w.empty())
         std::cerr << "pyrolume: warning: " << output.string() << ": " << w << "\n";
     bool checkpointed = false;
     // The beauty's checkpoint also when --denoise accumulated AOVs for its

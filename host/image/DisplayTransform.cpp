@@ -49,7 +49,8 @@ std::vector<unsigned char> display_rgb8(const Image& img, double exposure_stops,
   return bytes;
 }
 
-std::string film_look_warning(const Image& img, double exposure_stops, ViewTransform view, bool clips) {
+std::string film_look_warning(const Image& img, double exposure_stops, ViewTransform view, bool clips,
+                              const FilmCause& cause) {
   const std::vector<unsigned char> bytes = display_rgb8(img, exposure_stops, view);
   size_t black = 0, clipped = 0;
   const size_t pixels = bytes.size() / 3;
@@ -61,11 +62,20 @@ std::string film_look_warning(const Image& img, double exposure_stops, ViewTrans
   if (pixels == 0) return "";
   char line[320];
   if (double(black) >= kBlackFilmFraction * double(pixels)) {
-    std::snprintf(line, sizeof line,
-                  "the image is almost entirely black (%.1f %% of pixels at most 1/255 at exposure %+.2f EV): raise "
-                  "--exposure (or use --exposure auto) or emission.scale, or check that something is in view and lit",
-                  100.0 * double(black) / double(pixels), exposure_stops);
-    return line;
+    const int n = std::snprintf(line, sizeof line, "the image is almost entirely black (%.1f %% of pixels at most 1/255 at exposure %+.2f EV): ",
+                                100.0 * double(black) / double(pixels), exposure_stops);
+    std::string w(line, size_t(std::max(n, 0)));
+    if (!cause.unlit.empty()) return w + cause.unlit;
+    const AutoExposure a = auto_exposure(img, view);
+    if (a.lit_pixels == 0)
+      return w + "no light reaches the camera (every pixel is 0): check that something is in view" +
+             (cause.emits ? " and hot enough to glow" : " and lit");
+    if (!(a.stops > exposure_stops))
+      return w + "what light there is falls on few pixels (" + std::to_string(a.lit_pixels) +
+             " lit): check that the subject is in view";
+    std::snprintf(line, sizeof line, "its light is too dim for this exposure; --exposure %+.1f (or --exposure auto) shows it%s",
+                  a.stops, cause.emits ? ", as does a larger emission.scale" : ", as do brighter lights");
+    return w + line;
   }
   if (clips && double(clipped) >= kClippedFilmFraction * double(pixels)) {
     std::snprintf(line, sizeof line,

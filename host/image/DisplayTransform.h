@@ -72,10 +72,19 @@ class DisplayExposure {
 // (at least kBlackFilmFraction of the pixels have every channel <= 1/255) or,
 // for display output (`clips`: PNG), almost entirely clipped (at least
 // kClippedFilmFraction of the pixels have a channel at 255). Otherwise one line
-// saying so and what to change.
+// saying so, naming the cause that holds and a change that would show more:
+// `unlit` (nothing in the scene gives light: render/SceneSetup's
+// nothing_emits), else light too dim for the exposure (the exposure that
+// shows it; emission.scale only when `emits`), else no light at all reaching
+// the camera.
 inline constexpr double kBlackFilmFraction = 0.995;
 inline constexpr double kClippedFilmFraction = 0.95;
-std::string film_look_warning(const Image& img, double exposure_stops, ViewTransform view, bool clips);
+struct FilmCause {
+  std::string unlit;  // non-empty: why nothing gives light
+  bool emits = true;  // some medium emits
+};
+std::string film_look_warning(const Image& img, double exposure_stops, ViewTransform view, bool clips,
+                              const FilmCause& cause = {});
 
 // "pyrolume: auto exposure: +N.NN EV (...)": what was chosen and from what.
 std::string auto_exposure_line(const AutoExposure& a);

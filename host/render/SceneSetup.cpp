@@ -47,7 +47,9 @@ Box grid_box(const VolumeFileInfo& info, const Medium& m, const std::string& fil
       if (const GridInfo* f = full.grid(name)) wb = f->world_bbox();
     }
     if (!wb) continue;
-    const Box t = mapped(wb->first, wb->second, medium_transform_matrix(m.transform));
+    // The source's voxel placement moves every voxel by the same world vector.
+    const glm::dvec3 shift(g->index_to_world * glm::dvec4(glm::dvec3(m.index_offset), 0.0));
+    const Box t = mapped(wb->first + shift, wb->second + shift, medium_transform_matrix(m.transform));
     b.add(t.min);
     b.add(t.max);
   }
@@ -158,6 +160,34 @@ std::string nothing_in_view(const Camera& camera, const std::vector<WorldBox>& b
          " lie outside it); leave out camera.position and camera.look_at to frame the scene automatically";
 }
 
+std::string add_default_rig(Scene& scene) {
+  if (!scene.default_lights || !scene.lights.empty() || scene.environment || scene.background != glm::dvec3(0.0))
+    return "";
+  for (const Medium& m : scene.media)
+    if (m.emission.emits()) return "";
+  scene.background = glm::dvec3(kDefaultRigBackground);
+  std::string sun = "";
+  // The sun only where light sampling may run (it is a light no ray hits
+  // often enough otherwise; "mis": false or the absorption estimator).
+  if (scene.integrator.allows_light_sampling()) {
+    const glm::dvec3 forward = glm::normalize(scene.camera.look_at - scene.camera.position);
+    const glm::dvec3 right = glm::normalize(glm::cross(forward, scene.camera.up));
+    const glm::dvec3 up = glm::cross(right, forward);
+    // A modelling key from the side and above: toward the light is the
+    // camera's right turned 45° up, so the smoke shows a lit and a shadowed half.
+    Light l;
+    l.type = Light::Type::Distant;
+    l.direction = glm::normalize(right + up);
+    l.angle_deg = kDefaultRigSunAngleDeg;
+    l.temperature_k = kDefaultRigSunK;
+    l.scale = kDefaultRigSunIrradiance;
+    scene.lights.push_back(l);
+    sun = " and a 5500 K sun (irradiance 10) from the camera's right, 45° up";
+  }
+  return "nothing in the scene emits or gives light, so it is lit by the default rig: a grey background (0.05)" + sun +
+         "; write \"default_lights\": false to turn it off";
+}
+
 std::string nothing_emits(const Scene& scene) {
   if (!scene.lights.empty() && !scene_scatters(scene) && scene.integrator.max_depth > 0)
     return "the scene's lights light nothing: no medium scatters (sigma_s is 0 unless set) and there are no "
@@ -166,8 +196,8 @@ std::string nothing_emits(const Scene& scene) {
   if (scene.environment || scene.background != glm::dvec3(0.0)) return "";
   for (const Medium& m : scene.media)
     if (m.emission.emits()) return "";
-  return "nothing in the scene gives light (no medium emits, the background is black and there is no environment), "
-         "so the image will be black: add background.rgb or an environment to light smoke";
+  return "nothing in the scene gives light (no medium emits, no lights, the background is black, no environment, and "
+         "\"default_lights\" is false), so the image will be black: add lights, background.rgb or an environment";
 }
 
 SceneSetup complete_scene(Scene& scene, bool film_size_fixed) {
@@ -202,6 +232,7 @@ SceneSetup complete_scene(Scene& scene, bool film_size_fixed) {
     const VolumeFileInfo info = read_volume_file_info(file, false);
     SourceConvention c = source_convention(info, m.source, m.temperature_grid);
     if (!m.given.temperature_scale) fit_temperature_mapping(c, file);
+    settle_emission(c, file);
     apply_source_convention(m, c);
     if (!source_up) source_up = c.up_axis;
     // A guess is worth a line where it decides something: the mapping of a
@@ -251,6 +282,7 @@ SceneSetup complete_scene(Scene& scene, bool film_size_fixed) {
   } else if (!scene.camera.up_given) {
     scene.camera.up = default_camera_up(*scene.up_axis, scene.camera.look_at - scene.camera.position);
   }
+  if (const std::string note = add_default_rig(scene); !note.empty()) out.notes.push_back(scene.file.string() + ": " + note);
   return out;
 }
 

@@ -51,6 +51,18 @@ Camera framing_camera(const std::vector<WorldBox>& boxes, UpAxis up, double fov_
 // lies a third of the way from the centre to the top of the picture.
 double ground_tilt_deg(double fov_deg);
 
+// The default rig (docs/scene-format.md "default_lights"): a dim grey
+// background and a sun keyed from above and beside the camera.
+inline constexpr double kDefaultRigBackground = 0.05;
+inline constexpr double kDefaultRigSunIrradiance = 10.0;
+inline constexpr double kDefaultRigSunK = 5500.0;
+inline constexpr double kDefaultRigSunAngleDeg = 0.53;  // the Sun's angular diameter
+
+// Adds the default rig to a scene in which nothing emits or gives light
+// (nothing_emits would say so) when its default_lights allows; after the
+// camera is settled. The note line to print, or "" when nothing was added.
+std::string add_default_rig(Scene& scene);
+
 // "" when something in the scene gives light (an emitting medium, a
 // background, an environment, or `lights` with something to light: a
 // surface or a scattering medium); otherwise a one-line reason.

@@ -33,6 +33,7 @@ VolumeOptions volume_options(const Medium& m, bool need_temperature) {
   o.temperature_grid = m.temperature_grid;
   o.need_temperature = need_temperature;
   o.transform = medium_transform_matrix(m.transform);
+  o.index_offset = m.index_offset;
   o.downsample = m.downsample;
   o.texture_format = m.texture_format;
   o.temperature = m.temperature;
@@ -53,7 +54,22 @@ void apply_source_convention(Medium& m, const SourceConvention& c) {
   if (!m.given.temperature_scale) m.temperature.scale = c.mapping.scale;
   if (!m.given.temperature_offset) m.temperature.offset = c.mapping.offset;
   if (!m.given.temperature_cutoff) m.temperature.cutoff_k = c.mapping.cutoff_k;
+  m.index_offset = c.index_offset;
+  // The scene asks for emission by writing an emission block or any key of
+  // the temperature (docs/sources.md "Smoke is smoke").
+  const bool asked = m.given.emission || m.given.temperature_grid || m.given.temperature_scale ||
+                     m.given.temperature_offset || m.given.temperature_cutoff;
   if (c.temperature_grid.empty() && !m.given.emission) m.emission.is_grid = false;
+  else if (!c.emits && !asked) m.emission.is_grid = false;
+  // Smoke that does not glow is shaded as the tool's default volume material:
+  // its albedo splits σt = density_scale · density (docs/sources.md).
+  if (!m.emission.emits()) {
+    if (!m.given.sigma) {
+      m.sigma_s = glm::dvec3(c.smoke_albedo);
+      m.sigma_a = glm::dvec3(1.0 - c.smoke_albedo);
+    }
+    if (!m.given.density_scale) m.density_scale = c.smoke_density_scale;
+  }
 }
 
 }  // namespace pyrolume

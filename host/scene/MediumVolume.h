@@ -32,8 +32,10 @@ StoredVolume load_stored_volume(const Medium& m, const DenseLimits& limits = {})
 
 // Sets what the scene file left unset on a vdb medium: the grids, the
 // temperature mapping (each of scale, offset, cutoff_k only when not written),
-// and, when the convention finds no temperature grid and the file wrote no
-// emission block, no emission.
+// the voxel placement, and no emission where the convention finds no
+// temperature grid, or finds the file is smoke (c.emits) and the scene asks
+// for none; a medium left not emitting, with no sigma keys, scatters with the
+// convention's albedo.
 void apply_source_convention(Medium& m, const SourceConvention& c);
 
 }  // namespace pyrolume

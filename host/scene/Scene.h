@@ -190,6 +190,9 @@ struct Emission {
 struct ExplicitKeys {
   bool temperature_scale = false, temperature_offset = false, temperature_cutoff = false;
   bool emission = false;  // an "emission" block
+  bool temperature_grid = false;
+  bool sigma = false;  // sigma_a or sigma_s
+  bool density_scale = false;
 };
 
 struct Transform {
@@ -217,6 +220,7 @@ struct Medium {
   Transform transform;
   int downsample = 1;
   TextureFormat texture_format = TextureFormat::Auto;  // R32F is also used when values exceed R16F
+  double index_offset = 0.0;  // set by the source convention: voxel ijk sits at ijk + this (docs/sources.md)
 };
 
 // A surface: a triangle mesh (OBJ), an analytic sphere, or a plane (a
@@ -288,6 +292,9 @@ struct Scene {
   std::vector<Medium> media;
   std::vector<Shape> shapes;
   std::vector<Light> lights;
+  // "default_lights": a scene where nothing emits or gives light gets the
+  // default rig (host/render/SceneSetup, docs/scene-format.md); false: never.
+  bool default_lights = true;
 };
 
 // Whether anything in the scene can be lit by another light: a surface, or a

@@ -293,6 +293,7 @@ Medium read_medium(Reader r, const std::filesystem::path& base, int index) {
   m.name = r.string("name", "medium" + std::to_string(index));
   std::string type = r.choice("type", "", {"homogeneous", "vdb"});
   m.type = type == "vdb" ? Medium::Type::Vdb : Medium::Type::Homogeneous;
+  m.given.sigma = r.has("sigma_a") || r.has("sigma_s");
   m.sigma_a = r.nonnegative_rgb("sigma_a", m.sigma_a);
   m.sigma_s = r.nonnegative_rgb("sigma_s", m.sigma_s);
   m.g = r.number("g", 0.0);
@@ -307,6 +308,8 @@ Medium read_medium(Reader r, const std::filesystem::path& base, int index) {
     m.source = read_source(r);
     m.density_grid = r.string("density_grid", "");
     m.temperature_grid = r.string("temperature_grid", "");
+    m.given.temperature_grid = !m.temperature_grid.empty();
+    m.given.density_scale = r.has("density_scale");
     m.density_scale = r.number("density_scale", 1.0);
     if (m.density_scale < 0) r.fail("density_scale", "must be >= 0");
     m.downsample = r.integer("downsample", 1, 1, 64);
@@ -505,6 +508,7 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
   s.file = file;
   Reader r(root, "", fname);
 
+  s.default_lights = r.boolean("default_lights", true);
   if (r.has("up_axis")) s.up_axis = r.choice("up_axis", "y", {"y", "z"}) == "z" ? UpAxis::Z : UpAxis::Y;
   s.camera.framed_automatically = true;
   if (r.has("camera")) {

@@ -79,6 +79,33 @@ VolumeSource detect(const VolumeFileInfo& info, std::string& why, bool& guessed)
   return VolumeSource::Houdini;
 }
 
+// A Blender fluid cache written by Mantaflow (Blender 2.82+), not by 2.7x's
+// smoke point cache: 2.7x writes creator "Blender/Smoke" and a "heat" grid.
+bool is_mantaflow(const VolumeFileInfo& info) {
+  return !starts_with(info.metadata_value("creator"), "Blender/Smoke") && !info.grid("heat");
+}
+
+// The tool's fire shading reads a flame grid (Blender's Quick Smoke material
+// turns on Blackbody Intensity only for its Fire styles; Houdini's Pyro
+// shader takes fire intensity from "flame", "heat" before 17.5). Without one
+// that holds voxels the file is smoke; one whose values are known to be all
+// zero is smoke too (settle_emission reads them when the metadata does not).
+void decide_emission(SourceConvention& c, const VolumeFileInfo& info, std::initializer_list<const char*> flames) {
+  c.flame_grid = first_present(info, flames);
+  if (c.flame_grid.empty()) {
+    c.emits = false;
+    c.emission_text = "no flame grid with voxels: smoke, no emission";
+    return;
+  }
+  const GridInfo* g = info.grid(c.flame_grid);
+  if (g->min_value && g->max_value && *g->min_value == 0.0 && *g->max_value == 0.0) {
+    c.emits = false;
+    c.emission_text = "grid \"" + c.flame_grid + "\" is zero everywhere: smoke, no emission";
+    return;
+  }
+  c.emission_text = "emits: grid \"" + c.flame_grid + "\" holds flame";
+}
+
 }  // namespace
 
 SourceConvention source_convention(const VolumeFileInfo& info, VolumeSource requested,
@@ -111,6 +138,15 @@ SourceConvention source_convention(const VolumeFileInfo& info, VolumeSource requ
       } else {
         c.mapping_text = "no temperature or heat grid with voxels: smoke only, no emission";
       }
+      decide_emission(c, info, {"flame"});
+      // Cycles reads a VDB's voxel ijk as the cell [ijk, ijk+1] (its value at
+      // ijk + 0.5), and Mantaflow writes the cell's corner as ijk: the cache
+      // sits half a voxel higher on every axis than OpenVDB's cell-centred rule
+      // puts it. 2.7x caches add that half voxel to their transform already.
+      if (is_mantaflow(info)) c.index_offset = 0.5;
+      // Quick Smoke's material: a Principled Volume of Density 5, Color 0.5
+      // (σs = Color·Density, σa = (1 − Color)·Density per unit of the grid).
+      c.smoke_density_scale = kBlenderSmokeDensity;
       break;
     }
     case VolumeSource::Houdini:
@@ -126,6 +162,8 @@ SourceConvention source_convention(const VolumeFileInfo& info, VolumeSource requ
                            ? "no temperature grid with voxels: smoke only, no emission"
                            : "T = " + c.temperature_grid + " · " + std::to_string(int(kFittedHottestK)) +
                                  " K / its largest value (fitted: the file's temperature has no unit)";
+      // A guess keeps glowing from its temperature (what it did before).
+      if (!c.guessed) decide_emission(c, info, {"flame", "flames", "heat"});
       break;
     }
     case VolumeSource::Kelvin:
@@ -141,6 +179,16 @@ SourceConvention source_convention(const VolumeFileInfo& info, VolumeSource requ
     }
   }
   return c;
+}
+
+void settle_emission(SourceConvention& c, const std::string& file) {
+  if (!c.emits || c.flame_grid.empty()) return;
+  const VolumeFileInfo info = read_volume_file_info(file, true, c.flame_grid);
+  const GridInfo* g = info.grid(c.flame_grid);
+  if (g && g->min_value && g->max_value && *g->min_value == 0.0 && *g->max_value == 0.0) {
+    c.emits = false;
+    c.emission_text = "grid \"" + c.flame_grid + "\" is zero everywhere: smoke, no emission";
+  }
 }
 
 void fit_temperature_mapping(SourceConvention& c, const std::string& file) {
@@ -175,6 +223,12 @@ std::string scene_snippet(const std::string& file, const SourceConvention& c) {
     << "  density from grid \"" << c.density_grid << "\"; "
     << (c.temperature_grid.empty() ? "" : "temperature from grid \"" + c.temperature_grid + "\": ") << c.mapping_text
     << "\n";
+  if (!c.temperature_grid.empty() && !c.emits)
+    s << "  " << c.emission_text << " (write an \"emission\" block to make it glow)\n";
+  if (c.temperature_grid.empty() || !c.emits)
+    s << "  smoke scatters: albedo " << c.smoke_albedo << " (sigma_s " << c.smoke_albedo << ", sigma_a "
+      << 1.0 - c.smoke_albedo << "), density_scale " << c.smoke_density_scale << "\n";
+  if (c.index_offset != 0.0) s << "  voxel ijk placed at ijk + " << c.index_offset << " (Mantaflow's cell corner)\n";
   return s.str();
 }
 

@@ -20,6 +20,10 @@ const char* to_string(VolumeSource source);
 inline constexpr double kFittedHottestK = 2500.0;
 // A guessed source whose temperatures exceed this reads them as kelvin.
 inline constexpr double kKelvinLookingAbove = 200.0;
+// Blender's Principled Volume default Color (also Quick Smoke's): albedo 0.5.
+inline constexpr double kDefaultSmokeAlbedo = 0.5;
+// Blender's Quick Smoke material sets the Principled Volume's Density to 5.
+inline constexpr double kBlenderSmokeDensity = 5.0;
 
 struct SourceConvention {
   VolumeSource source = VolumeSource::Kelvin;  // never Auto
@@ -33,6 +37,23 @@ struct SourceConvention {
   bool fit_to_range = false;
   std::string mapping_text;  // the mapping in words, for `info` and notes
   UpAxis up_axis = UpAxis::Y;
+  // Whether the file glows by its tool's own rule (docs/sources.md "Smoke is
+  // smoke"): Blender's, Houdini's and EmberGen's fire shading is driven by a
+  // flame grid, so none, or one zero everywhere, is smoke. Settled by
+  // settle_emission; a guessed source and kelvin files glow from temperature.
+  bool emits = true;
+  std::string flame_grid;     // the grid that decides it ("": none with voxels)
+  std::string emission_text;  // why, for `info` and notes
+  // σs / (σa + σs) of the tool's default volume material, for media that do
+  // not emit (Blender's Principled Volume: Color 0.5).
+  double smoke_albedo = kDefaultSmokeAlbedo;
+  // The density_scale such media get: the material's Density (Blender's
+  // Quick Smoke material: 5; 1 elsewhere).
+  double smoke_density_scale = 1.0;
+  // Added to voxel indices before the grid's index->world map: where the tool
+  // puts voxel ijk's value (0: at ijk, OpenVDB's cell-centred rule; 0.5:
+  // Mantaflow's cell ijk spans [ijk, ijk+1], as Cycles reads it).
+  double index_offset = 0.0;
 };
 
 // The convention for a file, from `requested` (Auto: detected from metadata and
@@ -46,6 +67,10 @@ SourceConvention source_convention(const VolumeFileInfo& info, VolumeSource requ
 // A grid whose values are all <= 0 keeps scale 1 (nothing glows; the loader's
 // warning says so).
 void fit_temperature_mapping(SourceConvention& c, const std::string& file);
+
+// Whether the file emits (c.emits, c.emission_text): reads the flame grid's
+// values when the metadata leaves open whether it is zero everywhere.
+void settle_emission(SourceConvention& c, const std::string& file);
 
 // A scene that renders the file with its defaults (for `pyrolume info`).
 std::string scene_snippet(const std::string& file, const SourceConvention& c);

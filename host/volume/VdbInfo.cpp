@@ -354,6 +354,7 @@ int run_info_command(const std::filesystem::path& file, bool values, std::ostrea
   print_volume_file_info(info, out);
   SourceConvention c = source_convention(info, VolumeSource::Auto);
   fit_temperature_mapping(c, file.string());
+  settle_emission(c, file.string());
   out << "scene:\n  " << scene_snippet(file.string(), c);
   return 0;
 }

@@ -323,6 +323,12 @@ void report_counts(const ValueRules& r, const std::string& file, Role role, cons
                        " negative density voxels clamped to 0");
 }
 
+// The medium's transform on top of the grid's map, after the source's voxel
+// placement (VolumeOptions::index_offset).
+glm::dmat4 placed(const VolumeOptions& m, const glm::dmat4& grid_to_world) {
+  return m.transform * grid_to_world * glm::translate(glm::dmat4(1.0), glm::dvec3(m.index_offset));
+}
+
 void set_index_maps(DenseGrid& out, const glm::dmat4& index_to_world, const std::string& file, Role role) {
   out.index_to_world = index_to_world;
   out.world_to_index = glm::inverse(out.index_to_world);
@@ -334,7 +340,7 @@ DenseGrid finish_grid(DenseBuilder& b, DenseGrid& out, const glm::dmat4& grid_to
                       Role role, const std::string& file, std::vector<std::string>& warnings) {
   b.finish();
   report_counts(b.rules, file, role, out.name, warnings);
-  set_index_maps(out, m.transform * grid_to_world * b.index_map(), file, role);
+  set_index_maps(out, placed(m, grid_to_world) * b.index_map(), file, role);
   return std::move(out);
 }
 
@@ -348,7 +354,7 @@ DenseGrid finish_sparse(DenseGrid& out, std::shared_ptr<SparseGrid> sparse, cons
   out.origin = glm::ivec3(lo - int64_t(1));
   out.dims = glm::ivec3(hi - lo + int64_t(3));
   rules.set_range(out);
-  set_index_maps(out, m.transform * grid_to_world, file, role);
+  set_index_maps(out, placed(m, grid_to_world), file, role);
   return std::move(out);
 }
 
@@ -357,7 +363,7 @@ DenseGrid empty_grid(std::string name, const glm::dmat4& grid_to_world, const Vo
                      const std::string& file, std::vector<std::string>& warnings) {
   DenseGrid out;
   out.name = std::move(name);
-  set_index_maps(out, m.transform * grid_to_world, file, role);
+  set_index_maps(out, placed(m, grid_to_world), file, role);
   warnings.push_back(file + ": " + role_key(role, out.name) + ": empty grid (no active voxels): " +
                      (role == Role::Density ? "renders as no medium" : "the medium does not emit"));
   return out;
@@ -734,10 +740,23 @@ std::string cold_temperature_warning(const DenseGrid& t, const TemperatureMappin
                 "nothing glows",
                 t.name.c_str(), hottest_k, map.cutoff_k);
   std::string w = line;
-  // The scale that would put the hottest voxel at 1500 K, a visible fire.
+  // A constant grid (an all-zero flame grid) has no temperature to map: no
+  // scale or offset shows a fire that is not there.
+  if (t.min_value == t.max_value) {
+    std::snprintf(line, sizeof line, "; every voxel holds %.4g, so the file has no fire here (leave out the emission and "
+                  "temperature keys to render it as smoke)", double(t.max_value));
+    return w + line;
+  }
+  // The scale that puts the hottest voxel above the cutoff (1500 K, a visible
+  // fire, or 1.5 × a higher cutoff): never the scale already in use.
+  const double target_k = std::max(1500.0, 1.5 * map.cutoff_k);
   if (hottest_value - map.offset > 0.0) {
-    std::snprintf(line, sizeof line, "; temperature.scale %.4g would put it at 1500 K",
-                  1500.0 / (hottest_value - map.offset));
+    std::snprintf(line, sizeof line, "; temperature.scale %.4g would put it at %.4g K",
+                  target_k / (hottest_value - map.offset), target_k);
+    w += line;
+  } else {
+    std::snprintf(line, sizeof line, "; its values are at or below temperature.offset %.4g: lower the offset",
+                  map.offset);
     w += line;
   }
   return w;

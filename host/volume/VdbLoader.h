@@ -26,8 +26,9 @@ inline constexpr const char* kDefaultDensityGrid = "density";
 VolumeGrids load_volume(const VolumeOptions& options, const DenseLimits& limits = {});
 
 // "" when the temperature grid's hottest value maps above the cutoff;
-// otherwise the warning (naming the grid, the hottest temperature and a
-// temperature.scale that would make it glow) that load_stored_volume adds.
+// otherwise the warning (naming the grid, the hottest temperature and a fix
+// that changes the image: a temperature.scale other than the one in use, or,
+// for a constant grid, that there is no fire to show) that load_stored_volume adds.
 std::string cold_temperature_warning(const DenseGrid& temperature, const TemperatureMapping& mapping);
 
 // The most texels one dense grid may have (default 2^32, 16 GiB as float:

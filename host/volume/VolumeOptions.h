@@ -42,6 +42,7 @@ struct VolumeOptions {
   std::string temperature_grid;  // empty: first of temperature, heat, flame
   bool need_temperature = false; // read the temperature grid too
   glm::dmat4 transform{1.0};     // composed on top of each grid's index->world map
+  double index_offset = 0.0;     // added to every voxel index first (a tool's voxel placement)
   int downsample = 1;
   TextureFormat texture_format = TextureFormat::Auto;  // R32F is also used when values exceed R16F
   TemperatureMapping temperature;  // for the warning when nothing glows

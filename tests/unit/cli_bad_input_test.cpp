@@ -77,6 +77,8 @@ INSTANTIATE_TEST_SUITE_P(
                 R"({"integrator": {"light_only": true, "emission_estimator": "absorption"}})", "",
                 "bad.json: integrator.light_only: true asks for light sampling, which needs the collision estimator"},
         CliCase{"wrong_type", R"({"film": {"height": [3]}})", "", "film.height: expected an integer"},
+        CliCase{"default_lights_not_boolean", R"({"default_lights": "no"})", "",
+                "bad.json: default_lights: expected true or false"},
         CliCase{"not_json", "this is not json", "", "invalid JSON"},
         // Checkpoints carry no AOVs (docs/compositing.md "AOVs").
         CliCase{"aovs_with_resume", kSphere, "--aovs --resume", "--resume: checkpoints do not carry AOVs (--aovs)"},

@@ -1,12 +1,20 @@
 // A scene that names only a VDB file renders a visible, unclipped fire
 // coloured by temperature (issue 22; docs/sources.md), for exports laid out as
 // Houdini and Blender's Mantaflow write them; the real files are checked in
-// tests/realdata. Also: the warnings a disappointing render gets.
+// tests/realdata. Also: the warnings a disappointing render gets, and the
+// default rig (docs/scene-format.md "default_lights"), which is part of the
+// completed scene, so both backends render it: a density-only smoke export
+// from the shortest scene, Vulkan against the CPU reference, per pixel
+// (z-test, 3×3-pooled variance) and in the image mean. That comparison can
+// fail: the same smoke with the sun mirrored to the camera's left is rejected.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "render/SceneSetup.h"
+#include "support/BackendSuite.h"
 #include "support/FirstTry.h"
+#include "support/Stats.h"
 #include "support/TestSupport.h"
 #include "support/VdbScenes.h"
 
@@ -43,9 +51,10 @@ struct FirstTry : ::testing::Test {
 }  // namespace
 
 TEST_F(FirstTry, HoudiniPyroExport) {
-  // Y up, unitless temperature (burning ~1.3), creator metadata.
+  // Y up, unitless temperature (burning ~1.3), a flame grid (what makes a
+  // Pyro export a fire, docs/sources.md "Smoke is smoke"), creator metadata.
   write_vdb(dir / "pyro.vdb", {plume("density", 3.0f, false), plume("temperature", 1.3f, false),
-                               plume("vel", 0.5f, false)},
+                               plume("flame", 1.0f, false), plume("vel", 0.5f, false)},
             {{"creator", "Houdini/SOP_OpenVDB_Write"}});
   std::string err;
   const FirstTryLook look = render_shortest(dir / "pyro.vdb", &err);
@@ -104,3 +113,57 @@ TEST_F(FirstTry, ACameraThatSeesNothingIsSaid) {
             std::string::npos)
       << r.err;
 }
+
+namespace pyrolume::test {
+namespace {
+
+class DefaultRig : public BackendFixture {
+ protected:
+  DefaultRig() : BackendFixture("vulkan") {}
+  fs::path dir = temp_dir("default-rig");
+  void TearDown() override {
+    BackendFixture::TearDown();
+    fs::remove_all(dir);
+  }
+  // A 5-unit puff of density up to 3 (as thick as Pyro smoke), Houdini's
+  // creator, no temperature: smoke lit only by the rig.
+  Scene smoke_scene(int spp, uint32_t seed) {
+    const VoxelBox box{{0, 0, 0}, {9, 13, 9}};
+    write_vdb(dir / "smoke.vdb",
+              {make_float_grid("density", Lattice{0.5, glm::dvec3(0.0)}, box,
+                               [](int i, int j, int k) {
+                                 const double a = (i - 4.5) / 5.0, b = (k - 4.5) / 5.0, h = (j - 6.5) / 7.0;
+                                 return 3.0f * float(std::max(0.0, 1.0 - (a * a + b * b + h * h)));
+                               })},
+              {{"creator", "Houdini/SOP_OpenVDB_Write"}});
+    write_file(dir / "s.json", R"({"film": {"width": 24, "height": 24, "spp": )" + std::to_string(spp) +
+                                   R"(, "seed": )" + std::to_string(seed) +
+                                   R"(}, "media": [{"type": "vdb", "file": "smoke.vdb"}]})");
+    Scene s = load_scene(dir / "s.json");
+    complete_scene(s, true);
+    return s;
+  }
+};
+
+TEST_F(DefaultRig, BothBackendsRenderItAlike) {
+  const Scene s = smoke_scene(128, 1);
+  ASSERT_EQ(s.lights.size(), 1u) << "the rig's sun";
+  const RenderResult gpu = render(s);
+  const Scene c = smoke_scene(128, 2);
+  const RenderResult cpu = cpu_renderer().render(c, settings_for(c), {});
+  const ZTestReport rep = ztest_images(gpu, cpu, pooled(0.02));
+  std::printf("default rig, vulkan vs cpu: %s\n", rep.summary().c_str());
+  EXPECT_TRUE(rep.ok) << rep.summary();
+  // Mirrored sun: a different image, which the same test must reject.
+  Scene mirrored = c;
+  const glm::dvec3 forward = glm::normalize(c.camera.look_at - c.camera.position);
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, c.camera.up));
+  mirrored.lights[0].direction -= 2.0 * glm::dot(mirrored.lights[0].direction, right) * right;
+  const RenderResult other = cpu_renderer().render(mirrored, settings_for(mirrored), {});
+  const ZTestReport bad = ztest_images(gpu, other, pooled(0.02));
+  std::printf("deliberately wrong (sun on the left): %s\n", bad.summary().c_str());
+  EXPECT_FALSE(bad.fraction_ok) << bad.summary();
+}
+
+}  // namespace
+}  // namespace pyrolume::test
