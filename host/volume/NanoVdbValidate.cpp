@@ -10,7 +10,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <iomanip>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -143,6 +145,19 @@ class GridChecker {
     for (int i = 0; i < 3; ++i) finite = finite && std::isfinite(g.mMap.mVecD[i]);
     if (!finite || std::abs(det) < 3e-15)
       fail("its index-to-world map is singular or not finite (determinant " + std::to_string(det) + ")");
+    // Its translation within 1e15 voxels of the origin: further out, double
+    // arithmetic loses the voxel (2^53 ≈ 9e15), and OpenVDB, recovering the
+    // scale as (1 + t) − t, throws "Non-zero scale values required" out of
+    // nanoToOpenVDB (a translation of 4e304: found by fuzz_nvdb).
+    double voxel = INFINITY, offset = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      voxel = std::min(voxel, std::sqrt(a[c] * a[c] + a[3 + c] * a[3 + c] + a[6 + c] * a[6 + c]));
+      offset = std::max(offset, std::abs(g.mMap.mVecD[c]));
+    }
+    if (!(offset <= 1e15 * voxel))
+      fail("its index-to-world map puts the grid " +
+           (std::ostringstream() << std::setprecision(3) << offset / voxel).str() +
+           " voxels from the origin (at most 1e15)");
     uint64_t nodes_end = size_;
     uint64_t table = 0;
     const uint64_t count = g.mBlindMetadataCount;

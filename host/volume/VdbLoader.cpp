@@ -705,7 +705,14 @@ VolumeGrids load_nanovdb(const VolumeOptions& m, bool need_temperature, const De
     auto read = [&](const auto& g) {
       if (!sparse) return dense_from_nanovdb(g, m, role, file, out.warnings, limits);
       ensure_openvdb_initialized();
-      return sparse_from_openvdb(*nanovdb::nanoToOpenVDB(g), m, role, file, out.warnings);
+      const auto converted = [&] {
+        try {
+          return nanovdb::nanoToOpenVDB(g);
+        } catch (const openvdb::Exception& ex) {  // what validate_nanovdb_grid could not foresee
+          throw input_error(file, role_key(role, e.name), std::string("cannot convert it to an OpenVDB tree: ") + ex.what());
+        }
+      }();
+      return sparse_from_openvdb(*converted, m, role, file, out.warnings);
     };
     if (std::optional<DenseGrid> g = with_scalar_grid(h, read)) return std::move(*g);
     if (sparse) throw input_error(file, role_key(role, e.name), "NanoVDB grid type " + e.type + " cannot be kept sparse");

@@ -40,6 +40,7 @@ using Bytes = std::vector<char>;
 static_assert(sizeof(nanovdb::GridData) == 672 && sizeof(nanovdb::TreeData<3>) == 64, "NanoVDB 32 layout");
 constexpr size_t kGridSize = 32, kGridType = 636, kTree = 672;
 constexpr size_t kMapD = 296 + 88;  // GridData::mMap.mMatD[0] (after the float matrices, translation and taper)
+constexpr size_t kVecD = kMapD + 2 * 72;  // GridData::mMap.mVecD[0] (after mMatD and mInvMatD)
 constexpr size_t kNodeOffset = kTree, kNodeCount = kTree + 32, kVoxelCount = kTree + 56;
 constexpr size_t kRootBBox = 0, kRootTableSize = 24;
 
@@ -161,6 +162,10 @@ TEST(NanoVdbValidate, EachForgedFieldIsRefusedByEveryReaderInOneLine) {
       // and of quantised grids) threw OpenVDB's ArithmeticError out of the loader.
       {"index-to-world map", [](Bytes& b, size_t g) { put<double>(b, g + kMapD, 0.0); },
        "index-to-world map is singular or not finite"},
+      // Found by fuzz_nvdb: a translation of 4e304 made OpenVDB's scale
+      // (1 + t) − t zero, and nanoToOpenVDB threw past the fuzzer's handler.
+      {"index-to-world translation", [](Bytes& b, size_t g) { put<double>(b, g + kVecD, 4.46e304); },
+       "voxels from the origin (at most 1e15)"},
       // A node's origin is its bounding box's min, unchecked where the box
       // is empty (a node without active values): this one has some.
       {"lower node bounding box (emptied)",
