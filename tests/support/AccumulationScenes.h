@@ -41,11 +41,9 @@ inline Scene constant_background_scene(int width, int height, int spp, glm::dvec
 // samples are non-finite. (A NaN albedo would not do: the walks end a path
 // whose throughput is not > 0.)
 //
-// Texture::load refuses non-finite texels; the test hook
-// PYROLUME_TEST_NONFINITE_TEXTURES (set here, for this process and the CLI
-// runs it starts) lets this one through.
+// Texture::load refuses non-finite texels: render it while a
+// NonfiniteTexturesAllowed (below) lives.
 inline Scene inf_texture_scene(const std::filesystem::path& dir, int width, int height, int spp) {
-  setenv("PYROLUME_TEST_NONFINITE_TEXTURES", "1", 1);
   Image inf_img = make_image(2, 2);
   for (float& v : inf_img.rgb) v = std::numeric_limits<float>::infinity();
   write_image(dir / "inf.exr", inf_img);
@@ -58,6 +56,17 @@ inline Scene inf_texture_scene(const std::filesystem::path& dir, int width, int 
   s.shapes.push_back(plane);
   return s;
 }
+
+// While one lives, the test hook PYROLUME_TEST_NONFINITE_TEXTURES lets
+// non-finite texels through Texture::load, in this process and the CLI runs
+// it starts. Scoped: set for the whole process, it made a later test of the
+// refusal fail when gtest ran both in one process.
+struct NonfiniteTexturesAllowed {
+  NonfiniteTexturesAllowed() { setenv("PYROLUME_TEST_NONFINITE_TEXTURES", "1", 1); }
+  ~NonfiniteTexturesAllowed() { unsetenv("PYROLUME_TEST_NONFINITE_TEXTURES"); }
+  NonfiniteTexturesAllowed(const NonfiniteTexturesAllowed&) = delete;
+  NonfiniteTexturesAllowed& operator=(const NonfiniteTexturesAllowed&) = delete;
+};
 
 // The same scene as JSON, for CLI runs (the texture path relative to the scene).
 inline std::string inf_texture_scene_json(int width, int height, int spp) {

@@ -60,6 +60,7 @@ TEST(CliCheckpointCpu, MismatchedResumeIsRefused) {
 
 TEST(CliCheckpointCpu, NonFiniteSamplesAreReportedInStats) {
   auto dir = temp_dir("cli-inf");
+  const NonfiniteTexturesAllowed allow_inf;
   inf_texture_scene(dir, 8, 4, 16);  // writes inf.exr
   write_file(dir / "s.json", inf_texture_scene_json(8, 4, 16));
   CliResult r = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --backend cpu --stats " +

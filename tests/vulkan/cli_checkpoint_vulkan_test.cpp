@@ -141,6 +141,7 @@ TEST(CliLimitsVulkan, GridPastTheDevicesTextureLimitIsBadInput) {
 
 TEST(CliCheckpointVulkan, NonFiniteSamplesAreReportedInStats) {
   auto dir = temp_dir("cli-inf-gpu");
+  const NonfiniteTexturesAllowed allow_inf;
   inf_texture_scene(dir, 8, 4, 16);  // writes inf.exr
   write_file(dir / "s.json", inf_texture_scene_json(8, 4, 16));
   CliResult r = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --stats " + q(dir / "st.json"));
