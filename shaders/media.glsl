@@ -42,7 +42,9 @@ float stochastic_density(uint slot, vec3 u, inout uint rng) {
     default: return texelFetch(density_texels[3], index).r;
   }
 }
-float temperature_at(uint slot, vec3 u) {
+// The temperature grid's stored value at index-space u, before the mapping
+// T = (value - offset) * scale turns it into kelvin (emission_at below).
+float temperature_value_at(uint slot, vec3 u) {
   if (GRID_COUNT <= 1u) slot = 0u;
   if (SPARSE_GRIDS && grids[slot].temperature_tree != 0u)
     return sparse_trilinear(grids[slot].temperature_leaf_table, grids[slot].temperature_leaf_origin,
@@ -103,7 +105,7 @@ vec3 grid_le(GpuMedium m, uint slot, vec3 x, float value_read) {
     vec4 p1 = vec4(x, 1.0);
     vec3 u = vec3(dot(grids[slot].temperature_row0, p1), dot(grids[slot].temperature_row1, p1),
                   dot(grids[slot].temperature_row2, p1));
-    value = temperature_at(slot, u);
+    value = temperature_value_at(slot, u);
   }
   float T = (value - grids[slot].temperature_offset) * grids[slot].temperature_scale;
   if (!(T > grids[slot].cutoff_k) || !(T >= grids[slot].t_min_k)) return vec3(0.0);
@@ -178,8 +180,8 @@ bool cell_step(inout CellWalk w) {
 // collects emission, come at least as often as the emission asks for.
 float cell_majorant(uint slot, CellWalk w, bool line) {
   const uint local = cell_local(w), rates = grids[slot].line_rate_offset;
-  const float sigma_bar = majorant_value(w.offset + local) * grids[slot].majorant_scale;
-  return line && rates != 0u ? max(sigma_bar, majorant_value(rates + local)) : sigma_bar;
+  const float sigma_maj = majorant_value(w.offset + local) * grids[slot].majorant_scale;
+  return line && rates != 0u ? max(sigma_maj, majorant_value(rates + local)) : sigma_maj;
 }
 
 // Majorant of grid medium m over the DDA cell the ray is in at t, and the t at
@@ -214,7 +216,7 @@ float grid_majorant(GpuMedium m, vec3 o, vec3 d, float t, float t_span_end, bool
 // One free flight of delta tracking through grid medium m's majorant cells,
 // for scenes whose only medium is that grid (path_track): one exponential
 // optical depth tau = −ln(1 − u) for the whole flight, spent cell by cell
-// along the DDA (tau = Σ_j sigma_bar_j·Δt_j), so crossing a cell costs one DDA
+// along the DDA (tau = Σ_j sigma_maj_j·Δt_j), so crossing a cell costs one DDA
 // step instead of a pass of the tracking loop and its density lookup. The
 // same distribution as restarting the flight at every face (the exponential
 // is memoryless). Returns the majorant of the cell the flight collides in,
@@ -225,12 +227,12 @@ float grid_free_flight(GpuMedium m, vec3 o, vec3 d, inout float t, float t_end, 
   float nudge;
   CellWalk w = cell_walk(slot, o, d, t, nudge);
   for (uint n = 0u; n < 256u; ++n) {
-    const float sigma_bar = cell_majorant(slot, w, line);
+    const float sigma_maj = cell_majorant(slot, w, line);
     const float t_exit = min(min3(w.t_axis), t_end);
-    const float depth = sigma_bar * max(t_exit - t, 0.0);
+    const float depth = sigma_maj * max(t_exit - t, 0.0);
     if (depth > tau) {
-      t += tau / sigma_bar;
-      return sigma_bar;
+      t += tau / sigma_maj;
+      return sigma_maj;
     }
     tau -= depth;
     t = max(t, t_exit);
@@ -305,7 +307,7 @@ vec3 emission_at(vec3 x, float t, vec2 span[MEDIA_N], float rho[MEDIA_N], float 
 // Local majorant over [t, t_next): sum over the media present of their bound
 // (with `line`, grids' line rates included: grid_majorant).
 float majorant_at(vec3 o, vec3 d, float t, vec2 span[MEDIA_N], bool line, out float t_next, out bool any_ahead) {
-  float sigma_bar = 0.0;
+  float sigma_maj = 0.0;
   t_next = INF;
   any_ahead = false;
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
@@ -318,13 +320,13 @@ float majorant_at(vec3 o, vec3 d, float t, vec2 span[MEDIA_N], bool line, out fl
     }
     t_next = min(t_next, s.y);
     GpuMedium m = media[i];
-    if (is_grid(m)) sigma_bar += grid_majorant(m, o, d, t, s.y, line, t_next);
+    if (is_grid(m)) sigma_maj += grid_majorant(m, o, d, t, s.y, line, t_next);
     else {
       // A homogeneous medium's line rate: line_points along the ray's chord through it.
       const float chord = s.y - max(s.x, 0.0);
       const float sigma_t = max3(m.sigma_a + m.sigma_s);
-      sigma_bar += line && m.line_points > 0.0 && chord > 0.0 ? max(sigma_t, m.line_points / chord) : sigma_t;
+      sigma_maj += line && m.line_points > 0.0 && chord > 0.0 ? max(sigma_t, m.line_points / chord) : sigma_t;
     }
   }
-  return sigma_bar;
+  return sigma_maj;
 }

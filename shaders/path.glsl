@@ -65,7 +65,7 @@ int path_begin(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng) {
 bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, float rho[MEDIA_N],
                 float temperature_value[MEDIA_N], inout uint rng, inout PathStats stats) {
   const vec3 x = c.x, sigma_s = c.sigma_s;
-  const float sigma_bar = c.sigma_bar, p_a = c.p_a, p_s = c.p_s;
+  const float sigma_maj = c.sigma_maj, p_a = c.p_a, p_s = c.p_s;
   if (event == EVENT_ESCAPE) {
     escape(p);
     return ray_ends(p);
@@ -92,10 +92,10 @@ bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, 
   if (!surface) {
     stats.events += 1.0;
     set_features(p, collision_albedo(c.sigma_a, sigma_s), vec3(0.0), x);
-    // The absorption estimator collects sigma_a·Le / (sigma_bar·P_a) where the
+    // The absorption estimator collects sigma_a·Le / (sigma_maj·P_a) where the
     // path is absorbed. A medium's real collision scatters whenever it can
     // (implicit capture, path_track): there it collects what an absorption
-    // would have, as its expected value sigma_a·Le / (sigma_bar·(P_a + P_s)),
+    // would have, as its expected value sigma_a·Le / (sigma_maj·(P_a + P_s)),
     // p_s being P_a + P_s. Every real collision of the path adds its share,
     // each weighted by the scattering that led to it, instead of one
     // all-or-nothing sample where the path happens to be absorbed. One copy
@@ -103,15 +103,15 @@ bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, 
     // workarounds": every branch runs).
     if (HAS_EMISSION && !COLLISION_ESTIMATOR) {
       // rho is the free flight's (stochastic) estimate, as in P_a and P_s:
-      // sigma_a(rho)/(sigma_bar·P) keeps its expectation; the temperature is
+      // sigma_a(rho)/(sigma_maj·P) keeps its expectation; the temperature is
       // the trilinear value (media.glsl event_temperatures).
       event_temperatures(x, p.t, span, temperature_value);
       p.L += p.w * emission_at(x, p.t, span, rho, temperature_value) /
-             (sigma_bar * (event == EVENT_ABSORB ? p_a : p_s));
+             (sigma_maj * (event == EVENT_ABSORB ? p_a : p_s));
     }
     if (event == EVENT_ABSORB) return ray_ends(p);
   }
-  return scatter_vertex(p, surface, x, sigma_s, sigma_bar, p_s, rho, rng, stats);
+  return scatter_vertex(p, surface, x, sigma_s, sigma_maj, p_s, rho, rng, stats);
 }
 
 // One step of delta tracking along one path: its next ray if needed, free

@@ -5,7 +5,7 @@
 const float RATIO_TRACKING_ROULETTE_BELOW = 0.1;
 
 // Transmittance along a ray to infinity, per channel. Ratio tracking (Novák et
-// al. 2014): multiply by the null fraction sigma_n/sigma_bar at every tentative
+// al. 2014): multiply by the null fraction sigma_n/sigma_maj at every tentative
 // collision, with Russian roulette once the estimate is small. Delta tracking
 // (spectral: Kutz et al. 2017) terminates at real collisions instead.
 vec3 transmittance(vec3 o, vec3 d, bool ratio, inout uint rng, inout PathStats stats) {
@@ -17,27 +17,27 @@ vec3 transmittance(vec3 o, vec3 d, bool ratio, inout uint rng, inout PathStats s
   for (;;) {
     float t_next;
     bool any_ahead;
-    float sigma_bar = majorant_at(o, d, t, span, false, t_next, any_ahead);
+    float sigma_maj = majorant_at(o, d, t, span, false, t_next, any_ahead);
     if (!any_ahead || isinf(t_next)) return T;
-    if (sigma_bar <= 0.0) { t = t_next; continue; }
-    float dt = sample_free_flight(sigma_bar, rng_next(rng));
+    if (sigma_maj <= 0.0) { t = t_next; continue; }
+    float dt = sample_free_flight(sigma_maj, rng_next(rng));
     if (t + dt >= t_next) { t = t_next; continue; }
     t += dt;
     vec3 sigma_a, sigma_s;
     float rho[MEDIA_N], temperature_value[MEDIA_N];
     coefficients_at(o + t * d, t, span, true, sigma_a, sigma_s, rho, temperature_value, stats, rng);
-    vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
+    vec3 sigma_n = max(vec3(sigma_maj) - sigma_a - sigma_s, vec3(0.0));
     if (ratio) {
-      T *= sigma_n / sigma_bar;
+      T *= sigma_n / sigma_maj;
       float q = max3(T);
       if (q < RATIO_TRACKING_ROULETTE_BELOW) {  // Russian roulette: survive with probability q, reweight by 1/q
         if (rng_next(rng) >= q) return vec3(0.0);
         T /= q;
       }
     } else {
-      float p_null = avg3(sigma_n * T) / (sigma_bar * avg3(T));
+      float p_null = avg3(sigma_n * T) / (sigma_maj * avg3(T));
       if (rng_next(rng) >= p_null) return vec3(0.0);
-      T *= sigma_n / (sigma_bar * p_null);
+      T *= sigma_n / (sigma_maj * p_null);
     }
   }
   return T;
@@ -50,7 +50,7 @@ const uint EVENT_NONE = 0u, EVENT_ESCAPE = 1u, EVENT_SURFACE = 2u, EVENT_ABSORB 
 // What path_event needs of the real collision path_track found.
 struct Collision {
   vec3 x, sigma_s;
-  float sigma_bar, p_a, p_s;
+  float sigma_maj, p_a, p_s;
   vec3 sigma_a;  // read only for film.aovs' albedo (the wavefront does not carry it)
 };
 
@@ -66,9 +66,9 @@ const bool ONE_GRID = HAS_GRIDS && !HAS_ANALYTIC_MEDIA && MEDIUM_COUNT == 1u;
 // across the cells instead (grid_free_flight), the same distribution. RGB
 // sigma is handled by spectral tracking (Kutz et al. 2017, "Spectral and
 // Decomposition Tracking", history-aware averaged probabilities):
-// distances are sampled with the grey majorant sigma_bar, and event x (absorb /
-// scatter / null) is chosen with P_x = avg(sigma_x ⊙ w) / (sigma_bar·avg(w)); the
-// path weight w then picks up sigma_x / (sigma_bar·P_x) per channel. For grey
+// distances are sampled with the grey majorant sigma_maj, and event x (absorb /
+// scatter / null) is chosen with P_x = avg(sigma_x ⊙ w) / (sigma_maj·avg(w)); the
+// path weight w then picks up sigma_x / (sigma_maj·P_x) per channel. For grey
 // media every factor is 1 and this is plain delta tracking.
 uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout PathStats stats, out Collision c_out,
                 out float rho[MEDIA_N], out float temperature_value[MEDIA_N]) {
@@ -85,7 +85,7 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
   // flights are memoryless). Each path sees the same random numbers either
   // way, so the image is bit-identical.
   uint event = EVENT_NONE;
-  float sigma_bar = 0.0, p_a = 0.0, p_s = 0.0;
+  float sigma_maj = 0.0, p_a = 0.0, p_s = 0.0;
   vec3 x = vec3(0.0), sigma_a = vec3(0.0), sigma_s = vec3(0.0);
   for (;;) {
     if (event == EVENT_NONE) do {
@@ -100,8 +100,8 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
           break;
         }
         const float t_end = min(s.y, t_surface);
-        sigma_bar = grid_free_flight(media[0], p.o, p.d, p.t, t_end, COLLISION_ESTIMATOR, -log(1.0 - rng_next(rng)));
-        if (sigma_bar <= 0.0) {
+        sigma_maj = grid_free_flight(media[0], p.o, p.d, p.t, t_end, COLLISION_ESTIMATOR, -log(1.0 - rng_next(rng)));
+        if (sigma_maj <= 0.0) {
           // Out of the grid (the surface, or nothing, beyond), or out of walk
           // steps: a fresh flight from p.t.
           if (p.t >= t_end) event = p.has_hit ? EVENT_SURFACE : EVENT_ESCAPE;
@@ -111,14 +111,14 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
         // Restarted at every majorant-cell face and media boundary.
         float t_next;
         bool any_ahead;
-        sigma_bar = majorant_at(p.o, p.d, p.t, span, COLLISION_ESTIMATOR, t_next, any_ahead);
+        sigma_maj = majorant_at(p.o, p.d, p.t, span, COLLISION_ESTIMATOR, t_next, any_ahead);
         if (!any_ahead) t_next = INF;
         if (isinf(t_next) && !p.has_hit) {
           event = EVENT_ESCAPE;
           break;
         }
         const float t_end = min(t_next, t_surface);
-        float dt = sigma_bar > 0.0 ? sample_free_flight(sigma_bar, rng_next(rng)) : INF;
+        float dt = sigma_maj > 0.0 ? sample_free_flight(sigma_maj, rng_next(rng)) : INF;
         if (p.t + dt >= t_end) {
           if (p.has_hit && t_surface <= t_next) {
             event = EVENT_SURFACE;
@@ -134,19 +134,19 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
       // reads the trilinear density and temperature there.
       coefficients_at(x, p.t, span, !COLLISION_ESTIMATOR, sigma_a, sigma_s, rho, temperature_value, stats, rng);
       if (HAS_EMISSION && COLLISION_ESTIMATOR && !p.skip_segment) {
-        // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_bar at every tentative collision;
-        // the line estimator is this one with sigma_bar raised to the line rates (grid_majorant).
+        // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_maj at every tentative collision;
+        // the line estimator is this one with sigma_maj raised to the line rates (grid_majorant).
         // With next-event estimation the ray's own MIS weight (light rays: 1). A skipped
         // segment (ratio-tracked continuation) was already collected: no lookup.
         vec3 e = emission_at(x, p.t, span, rho, temperature_value);
-        if (max3(e) > 0.0) p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_bar) * p.w * e;
+        if (max3(e) > 0.0) p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_maj) * p.w * e;
       }
-      vec3 sigma_n = max(vec3(sigma_bar) - sigma_a - sigma_s, vec3(0.0));
+      vec3 sigma_n = max(vec3(sigma_maj) - sigma_a - sigma_s, vec3(0.0));
       if (NEE && p.light_ray) {
         // Light rays: ratio tracking (docs/mis.md "Light rays"): no event is
         // chosen, the weight takes the null fraction, Russian roulette once the
         // ray's transmittance estimate is below RATIO_TRACKING_ROULETTE_BELOW.
-        const vec3 null_fraction = sigma_n / sigma_bar;
+        const vec3 null_fraction = sigma_n / sigma_maj;
         p.w *= null_fraction;
         p.light_T *= max3(null_fraction);
         if (p.light_T < RATIO_TRACKING_ROULETTE_BELOW) {
@@ -159,12 +159,12 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
         }
         continue;
       }
-      float c = sigma_bar * avg3(p.w);
+      float c = sigma_maj * avg3(p.w);
       p_a = avg3(sigma_a * p.w) / c;
       p_s = HAS_SCATTERING ? avg3(sigma_s * p.w) / c : 0.0;
       // A real collision scatters whenever it can (implicit capture,
       // docs/mis.md "No absorption events"): the scattering's weight
-      // sigma_s / (sigma_bar·(P_a + P_s)) keeps the expectation, and the
+      // sigma_s / (sigma_maj·(P_a + P_s)) keeps the expectation, and the
       // emission an absorption here would have collected is collected as its
       // expected value, by the collision estimator already or by path_event.
       if (p_s > 0.0) {
@@ -180,7 +180,7 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
         event = EVENT_SCATTER;
         break;
       }
-      p.w *= sigma_n / (sigma_bar * (1.0 - p_a - p_s));
+      p.w *= sigma_n / (sigma_maj * (1.0 - p_a - p_s));
       if (max3(p.w) <= 0.0) event = EVENT_END;
     } while (false);
     if (!EARLY_EVENT_EXIT) {
@@ -192,6 +192,6 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
       if (2u * tracking <= lanes) break;
     }
   }
-  c_out = Collision(x, sigma_s, sigma_bar, p_a, p_s, sigma_a);
+  c_out = Collision(x, sigma_s, sigma_maj, p_a, p_s, sigma_a);
   return event;
 }

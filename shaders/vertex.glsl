@@ -96,7 +96,7 @@ bool leave_vertex(inout PathState p, vec3 o, vec3 d, vec3 f, float pdf_own, uint
 // ends. Both kinds share one copy of the light code (the receiver
 // normalisers, leave_vertex's light pdf; their light rays are drawn by
 // next_light_ray; docs/rendering.md "llvmpipe workarounds": one copy of the light code).
-bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float sigma_bar, float p_s,
+bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float sigma_maj, float p_s,
                     float rho[MEDIA_N], inout uint rng, inout PathStats stats) {
   vec3 o = x, n = vec3(0.0), albedo = vec3(0.0);
   vec3 share[MEDIA_N];
@@ -121,7 +121,7 @@ bool scatter_vertex(inout PathState p, bool surface, vec3 x, vec3 sigma_s, float
     if (p.depth >= frame.max_depth) return true;  // max_depth reached
     ++p.depth;
     const float w_before = max3(p.w);
-    p.w *= sigma_s / (sigma_bar * p_s);
+    p.w *= sigma_s / (sigma_maj * p_s);
     // Russian roulette for what absorption no longer ends: once the factors
     // that kept this path alive have lowered its weight below
     // SCATTER_ROULETTE_BELOW of what it was, survive with probability

@@ -96,7 +96,7 @@ void path_io(bool store, bool everything, uint slot, inout PathState p, inout Sl
   s.stats = PathStats(uintBitsToFloat(u.y), uintBitsToFloat(u.z));
   s.pending = u.w;
   io_v3u(store, base + 6u, s.c.x, s.event);
-  io_v3f(store, base + 7u, s.c.sigma_s, s.c.sigma_bar);
+  io_v3f(store, base + 7u, s.c.sigma_s, s.c.sigma_maj);
   u = uvec4(floatBitsToUint(s.c.p_a), floatBitsToUint(s.c.p_s), floatBitsToUint(p.alpha), 0u);
   io(store, base + 8u, u);
   s.c.p_a = uintBitsToFloat(u.x);

@@ -123,14 +123,14 @@ void check_majorant_depth(const Scene& scene, size_t medium, const DenseGrid& de
   if (density.empty()) return;
   const Medium& m = scene.media[medium];
   const double max_rho = density.max_texel();
-  const double sigma_bar = max3(m.sigma_a + m.sigma_s) * m.density_scale * max_rho;
+  const double sigma_maj = max3(m.sigma_a + m.sigma_s) * m.density_scale * max_rho;
   glm::dvec3 lo, hi;
   density.world_bounds(lo, hi);
   const double diagonal = glm::length(hi - lo);
-  const double depth = sigma_bar * diagonal;
+  const double depth = sigma_maj * diagonal;
   if (!(depth <= kMaxMajorantDepth))
     throw input_error(scene.file.string(), "media[" + std::to_string(medium) + "].density_scale",
-                      "the grid's majorant optical depth is " + sci(depth) + " (σt up to " + sci(sigma_bar) +
+                      "the grid's majorant optical depth is " + sci(depth) + " (σt up to " + sci(sigma_maj) +
                           " per unit across " + sci(diagonal) + " units): a ray through it would take that many "
                           "tracking steps, more than " + sci(kMaxMajorantDepth) +
                           "; lower density_scale (or sigma_a, sigma_s)");

@@ -141,15 +141,15 @@ double tracking_cost(const DenseGrid& g, const MajorantGrid& m, double sigma_t_p
           const double ta = (face - p[a]) / v[a];
           if (ta < t_exit) t_exit = ta, axis = a;
         }
-        const double sigma_bar = m.at(cell.x, cell.y, cell.z) * sigma_t_per_density;
-        cost += sigma_bar > 0.0 ? costs.cell : costs.empty;
-        while (sigma_bar > 0.0) {
-          t -= std::log(1.0 - rng.next()) / sigma_bar;
+        const double sigma_maj = m.at(cell.x, cell.y, cell.z) * sigma_t_per_density;
+        cost += sigma_maj > 0.0 ? costs.cell : costs.empty;
+        while (sigma_maj > 0.0) {
+          t -= std::log(1.0 - rng.next()) / sigma_maj;
           if (t >= t_exit) break;
           cost += 1.0;  // a density lookup
           if (cost - ray_start >= kCostCapPerRay) break;
           const double sigma = g.sample_index(p + t * v + to_index) * sigma_t_per_density;
-          if (rng.next() * sigma_bar < sigma) {
+          if (rng.next() * sigma_maj < sigma) {
             collided = true;
             break;
           }

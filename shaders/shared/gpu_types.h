@@ -48,11 +48,11 @@ PYRO_CONST uint BINDING_EMISSION_CDF = 17;     // readonly buffer float[]: every
 PYRO_CONST uint BINDING_EMISSION_CELLS = 18;   // readonly buffer uint[]: the cells of its entries
 PYRO_CONST uint BINDING_EMISSION_PMF = 19;     // readonly buffer float[]: per-cell probabilities
 PYRO_CONST uint BINDING_EMISSION_HEADERS = 20; // uniform GpuEmissionCdf[MAX_GRIDS], by grid slot
-PYRO_CONST uint BINDING_EMISSION_CLUSTERS = 22; // readonly buffer GpuEmissionCluster[]: their clusters
 PYRO_CONST uint BINDING_PASS_STATUS = 21;      // buffer PassStatus: what the pass could not finish
+PYRO_CONST uint BINDING_EMISSION_CLUSTERS = 22; // readonly buffer GpuEmissionCluster[]: their clusters
 PYRO_CONST uint BINDING_PATHS = 23;    // uimageBuffer (rgba32ui): the wavefront's path states (shaders/wavefront.glsl path_io)
-PYRO_CONST uint BINDING_LIGHTS = 25;    // readonly buffer GpuLight[]: the scene's analytic lights (shared/light_types.h)
 PYRO_CONST uint BINDING_QUEUES = 24;   // buffer WavefrontQueues, then its queues of path slots
+PYRO_CONST uint BINDING_LIGHTS = 25;    // readonly buffer GpuLight[]: the scene's analytic lights (shared/light_types.h)
 PYRO_CONST uint BINDING_ALPHA = 26;    // buffer AlphaTexel[] (one per pixel)
 PYRO_CONST uint BINDING_AOV_LIGHTS = 27;    // buffer AovLightTexel[] (one per pixel; film.aovs)
 PYRO_CONST uint BINDING_AOV_FEATURES = 28;  // buffer AovFeatureTexel[] (one per pixel; film.aovs)
@@ -75,9 +75,9 @@ PYRO_CONST uint SPEC_SURFACE_HAS_TRIANGLES = 9;
 PYRO_CONST uint SPEC_HAS_ENVIRONMENT = 10;
 PYRO_CONST uint SPEC_LIGHT_STRATEGY = 11;  // LIGHT_STRATEGY_*: next-event estimation and MIS (docs/mis.md)
 PYRO_CONST uint SPEC_GUIDED_CONTINUATION = 12;  // some continuations are drawn from the lights (LightSelection::p_continue_own < 1)
+PYRO_CONST uint SPEC_EARLY_EVENT_EXIT = 13;  // free flights leave once half the SIMD group has its event (render.comp path_track)
 PYRO_CONST uint SPEC_HAS_ANALYTIC_MEDIA = 14;  // a sphere or box medium (else every medium is a grid)
 PYRO_CONST uint SPEC_ALBEDO_TEXTURE_COUNT = 15;  // albedo textures the surfaces use (0..MAX_TEXTURES)
-PYRO_CONST uint SPEC_EARLY_EVENT_EXIT = 13;  // free flights leave once half the SIMD group has its event (render.comp path_track)
 PYRO_CONST uint SPEC_WAVEFRONT_STAGE = 16;  // WAVEFRONT_*: the megakernel, or one stage of the wavefront integrator
 PYRO_CONST uint WAVEFRONT_NONE = 0;        // the megakernel: each lane runs its paths to the end
 PYRO_CONST uint WAVEFRONT_START = 1;       // one lane per pixel: its first camera ray
@@ -91,8 +91,8 @@ PYRO_CONST uint SPEC_WAVEFRONT_SPLIT = 17;  // the event stage leaves the next r
 // Every emitting grid's temperature is the second channel of its density
 // texture (GpuScene::temperature_in_density): one lookup reads both.
 PYRO_CONST uint SPEC_TEMPERATURE_IN_DENSITY = 18;
-PYRO_CONST uint SPEC_AOVS = 20;  // film.aovs: the light layers and first-hit features (docs/compositing.md "AOVs")
 PYRO_CONST uint SPEC_LIGHT_COUNT = 19;  // analytic lights (the scene's `lights`); 0 compiles their code out
+PYRO_CONST uint SPEC_AOVS = 20;  // film.aovs: the light layers and first-hit features (docs/compositing.md "AOVs")
 PYRO_CONST uint SPEC_SPARSE_GRIDS = 21;  // some grid is a NanoVDB tree (texture_format "sparse"); false compiles that code out
 PYRO_CONST uint SPEC_STOCHASTIC_DENSITY = 22;  // free flights read one texel of the density's trilinear footprint (docs/rendering.md "Stochastic density lookups")
 PYRO_CONST uint WAVEFRONT_GROUP = 64;      // lanes per workgroup of the queue stages
@@ -276,13 +276,13 @@ struct AlphaTexel {
 // 128 MiB range at 1920×1080). Its own binding after the AlphaTexels.
 struct AovLightTexel {
   vec3 emission;    // media emission reaching the camera unscattered
-  float pad0;
+  float unused0;
   vec3 scatter;     // paths whose first vertex scatters in a medium
-  float pad1;
+  float unused1;
   vec3 surface;     // paths whose first vertex is on a surface
-  float pad2;
+  float unused2;
   vec3 background;  // background, environment, sun discs, sphere lights seen directly
-  float pad3;
+  float unused3;
 };
 
 // film.aovs: sums of the camera ray's first-event features over the samples

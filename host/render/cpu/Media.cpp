@@ -127,7 +127,7 @@ double sigma_t_at(const MediaData& md, const std::vector<int>& present, int c, c
 
 double grid_density(const MediumData& m, const glm::dvec3& p) { return m.volume->density.grid.sample_world(p); }
 
-double grid_temperature(const MediumData& m, const glm::dvec3& p) {
+double grid_temperature_k(const MediumData& m, const glm::dvec3& p) {
   const double v = m.volume->temperature ? m.volume->temperature->grid.sample_world(p) : 0.0;
   return (v - m.temperature.offset) * m.temperature.scale;
 }
@@ -153,7 +153,7 @@ double grid_sigma_a_Le(const MediumData& m, int medium, int c, const glm::dvec3&
   const double sigma_a = m.sigma_a[c] * rho;
   if (!(sigma_a > 0.0)) return 0.0;
   if (m.emits_rgb) return sigma_a * m.Le_rgb[c];
-  if (m.emits_temperature) return sigma_a * cache.get(m, medium, grid_temperature(m, p))[c];
+  if (m.emits_temperature) return sigma_a * cache.get(m, medium, grid_temperature_k(m, p))[c];
   return 0.0;
 }
 

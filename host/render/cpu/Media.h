@@ -100,7 +100,7 @@ inline bool exceeds_majorant(double sigma_t, double sigma_maj) { return sigma_t 
 double grid_density(const MediumData& m, const glm::dvec3& p);
 
 // Temperature in kelvin at p: (value − offset) · scale (value 0 outside the grid).
-double grid_temperature(const MediumData& m, const glm::dvec3& p);
+double grid_temperature_k(const MediumData& m, const glm::dvec3& p);
 
 // Le of a vdb medium at temperature T, what the GPU LUT returns: the emission
 // rule of color/EmissionModel.h (temperature_Le), Planck evaluated directly.
