@@ -608,8 +608,15 @@ int run_preview_command(const PreviewArgs& args) {
   parse_exposure(args.exposure);         // InputError (a bad --exposure): exit 2
   Scene scene = load_scene(args.scene);  // InputError: the CLI prints it, exit 2
   // Source conventions, up axis and framing, as `render` settles them.
-  for (const std::string& note : complete_scene(scene, args.width || args.height || scene.film.size_given).notes)
-    std::cerr << "pyrolume: note: " << note << "\n";
+  const SceneSetup setup = complete_scene(scene, args.width || args.height || scene.film.size_given);
+  for (const std::string& note : setup.notes) std::cerr << "pyrolume: note: " << note << "\n";
+  // A frame pattern stands for its shot: the window shows the key frame, the
+  // one whose file set the source convention, framing and exposure.
+  if (setup.key_frame) {
+    scene = scene_at_frame(scene, *setup.key_frame);
+    std::cerr << "pyrolume: note: preview shows the shot's key frame " << *setup.key_frame
+              << " (the middle of its frames on disk)\n";
+  }
 
   g_signal = 0;
   auto old_int = std::signal(SIGINT, on_preview_signal);

@@ -109,6 +109,11 @@ TEST_F(Shot, ABareVdbRendersAsTheShortestSceneNamingIt) {
   r = run_cli("preview " + shot_q(dir / "blob_0002.vdb") + " --frames 1 --width 16 --height 16");
   EXPECT_TRUE(r.status == 0 || r.err.find("pyrolume render") != std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("JSON"), std::string::npos) << r.err;
+  // A pattern: the window shows the shot's key frame (the middle of 1..4).
+  r = run_cli("preview " + shot_q(dir / "blob_####.vdb") + " --frames 1 --width 16 --height 16");
+  EXPECT_TRUE(r.status == 0 || r.err.find("pyrolume render") != std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("preview shows the shot's key frame 2"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("not found"), std::string::npos) << r.err;
 
   write_file(dir / "junk.vdb", "this is not a vdb");
   r = run_cli("preview " + shot_q(dir / "junk.vdb") + " --frames 1");
