@@ -33,6 +33,21 @@
 
 namespace pyrolume::test {
 
+// Sets a Vulkan backend's test switches (render/vulkan/VulkanHooks.h) for
+// its lifetime, and puts the defaults back after.
+class HooksSet {
+ public:
+  HooksSet(Backend& vulkan, const VulkanHooks& hooks) : vulkan_(dynamic_cast<VulkanRenderer&>(vulkan)) {
+    vulkan_.set_hooks(hooks);
+  }
+  ~HooksSet() { vulkan_.set_hooks({}); }
+  HooksSet(const HooksSet&) = delete;
+  HooksSet& operator=(const HooksSet&) = delete;
+
+ private:
+  VulkanRenderer& vulkan_;
+};
+
 // A fixture for one named backend ("cpu" or "vulkan"); suite-wide renderers,
 // made on first use and released at the end of the suite.
 class BackendFixture : public ::testing::Test {
@@ -78,11 +93,8 @@ class BackendFixture : public ::testing::Test {
   // A Vulkan render with the test switches of render/vulkan/VulkanHooks.h,
   // which are back at their defaults afterwards.
   RenderResult render_with(const Scene& s, const VulkanHooks& hooks) {
-    auto& v = dynamic_cast<VulkanRenderer&>(vulkan_backend());
-    v.set_hooks(hooks);
-    RenderResult r = render(s);
-    v.set_hooks({});
-    return r;
+    const HooksSet set(vulkan_backend(), hooks);
+    return render(s);
   }
   RenderResult render(const Scene& s, const RenderSettings& rs) {
     RenderResult r;

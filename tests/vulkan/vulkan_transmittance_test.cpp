@@ -14,9 +14,9 @@
 #include <gtest/gtest.h>
 
 #include "render/Backend.h"
-#include "render/vulkan/VulkanRenderer.h"
 #include "support/VulkanFixture.h"
 #include "support/AnalyticScenes.h"
+#include "support/BackendSuite.h"
 #include "support/Stats.h"
 #include "support/TestSupport.h"
 #include "support/VdbScenes.h"
@@ -48,10 +48,8 @@ class VulkanTransmittance : public test::VulkanFixture {
     rs.seed = s.film.seed + debug_mode;
     VulkanHooks hooks;
     hooks.debug_mode = debug_mode;
-    auto& vulkan = dynamic_cast<VulkanRenderer&>(*backend_);
-    vulkan.set_hooks(hooks);
+    const test::HooksSet set(*backend_, hooks);
     RenderResult r = backend_->render(s, rs, {});
-    vulkan.set_hooks({});
     EXPECT_EQ(r.spp, s.film.spp);
     for (size_t i = 0; i < r.sum.size(); ++i) {
       EXPECT_TRUE(std::isfinite(r.sum[i])) << i;
