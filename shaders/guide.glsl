@@ -15,6 +15,9 @@
 // fire's structure (and the background through the smoke) from the path
 // tracer's noise.
 const uint GUIDE_MAX_STEPS = 4096u;
+// Past this transmittance in every channel the march stops: what lies behind
+// adds at most this fraction of its own light (docs/compositing.md "The guide").
+const float GUIDE_MIN_TRANSMITTANCE = 1e-6;
 
 // The media part of the guide: emission and transmittance from the media
 // entry to t_end (the surface or sphere light, or INF).
@@ -30,7 +33,10 @@ void guide_media(vec3 o, vec3 d, float t_end, vec2 span[MEDIA_N], inout vec3 L, 
   t1 = min(t1, t_end);
   PathStats stats = PathStats(0.0, 0.0);
   float t = t0;
-  for (uint n = 0u; n < GUIDE_MAX_STEPS && t < t1; ++n) {
+  uint n = 0u;  // steps taken
+  while (n < GUIDE_MAX_STEPS && t < t1 && max3(T) >= GUIDE_MIN_TRANSMITTANCE) {
+    // One majorant cell (or run of empty cells) per pass of this loop: the
+    // majorant is looked up once per cell, not once per step.
     float t_next;
     bool ahead;
     const float majorant = majorant_at(o, d, t, span, false, t_next, ahead);
@@ -38,22 +44,27 @@ void guide_media(vec3 o, vec3 d, float t_end, vec2 span[MEDIA_N], inout vec3 L, 
     t_next = min(t_next, t1);
     if (!(majorant > 0.0)) {  // nothing here up to t_next
       t = t_next;
+      ++n;
       continue;
     }
-    const float dt = min(h, t_next - t);
-    const float tm = t + 0.5 * dt;
-    const vec3 x = o + tm * d;
-    vec3 sigma_a, sigma_s;
-    float rho[MEDIA_N], temperature_value[MEDIA_N];
-    uint no_rng = 0u;  // the guide's march reads the trilinear density
-    coefficients_at(x, tm, span, false, sigma_a, sigma_s, rho, temperature_value, stats, no_rng);
-    const vec3 E = emission_at(x, tm, span, rho, temperature_value);
-    const vec3 sigma_t = sigma_a + sigma_s;
-    const vec3 tr = exp(-sigma_t * dt);
-    // E·Δt where σt·Δt is too small for (1 − e^(−σt·Δt))/σt to keep its digits.
-    L += T * mix(E * dt, E * (1.0 - tr) / max(sigma_t, vec3(1e-30)), greaterThan(sigma_t * dt, vec3(1e-4)));
-    T *= tr;
-    t += dt;
+    // Equal steps of at most h through the cell, each at its midpoint.
+    const uint steps = uint(clamp(ceil((t_next - t) / h), 1.0, float(GUIDE_MAX_STEPS)));
+    const float dt = (t_next - t) / float(steps);
+    for (uint j = 0u; j < steps && n < GUIDE_MAX_STEPS; ++j, ++n) {
+      const float tm = t + (float(j) + 0.5) * dt;
+      const vec3 x = o + tm * d;
+      vec3 sigma_a, sigma_s;
+      float rho[MEDIA_N], temperature_value[MEDIA_N];
+      uint no_rng = 0u;  // the guide's march reads the trilinear density
+      coefficients_at(x, tm, span, false, sigma_a, sigma_s, rho, temperature_value, stats, no_rng);
+      const vec3 E = emission_at(x, tm, span, rho, temperature_value);
+      const vec3 sigma_t = sigma_a + sigma_s;
+      const vec3 tr = exp(-sigma_t * dt);
+      // E·Δt where σt·Δt is too small for (1 − e^(−σt·Δt))/σt to keep its digits.
+      L += T * mix(E * dt, E * (1.0 - tr) / max(sigma_t, vec3(1e-30)), greaterThan(sigma_t * dt, vec3(1e-4)));
+      T *= tr;
+    }
+    t = t_next;
   }
 }
 

@@ -68,20 +68,20 @@ void main() {
     // unfinished samples are reported below and the host redoes the pass in
     // smaller ones. (The nested loops are from when the limit was thought to
     // be per loop; they cost nothing.)
+    // The guide, before the paths so that the SIMD group's lanes march
+    // together (inside the regenerating loop below, a lane would march while
+    // the rest of its group waited).
+    if (AOVS && first == 0u) add_pixel_guide(pixel, aovs);
     uint rng;
     PathState p;
     camera_path(pixel, k, rng, p);
-    if (AOVS) add_sample_guide(pixel, k, aovs);
     vec2 span[MEDIA_N];
     while (k < last) {
       for (uint n = 0u; n < 16384u && k < last; ++n) {
         if (!path_step(p, span, rng, stats)) continue;
         add_sample(p.L, p.alpha, pass_sum, pass_sum_c, pass_sq, pass_sq_c, pass_alpha, nonfinite);
         if (AOVS) add_sample_aovs(p, aovs);
-        if (++k < last) {
-          camera_path(pixel, k, rng, p);
-          if (AOVS) add_sample_guide(pixel, k, aovs);
-        }
+        if (++k < last) camera_path(pixel, k, rng, p);
       }
     }
   }

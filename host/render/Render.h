@@ -51,7 +51,8 @@ struct RenderSettings {
 // at these offsets: the light layers (RGB; they sum to RenderResult::sum),
 // then the first-event features (albedo RGB, normal XYZ, depth) summed over
 // the samples that have a first event, and their number (kAovHits); then the
-// denoiser's guide (RGB) and its alpha, summed over all samples.
+// denoiser's guide (RGB) and its alpha: the pixel's own values, not sums (a
+// fixed quadrature of the pixel, computed once; docs/compositing.md "The guide").
 constexpr int kAovEmission = 0, kAovScatter = 3, kAovSurface = 6, kAovBackground = 9;
 constexpr int kAovAlbedo = 12, kAovNormal = 15, kAovDepth = 18, kAovHits = 19;
 constexpr int kAovGuide = 20, kAovGuideAlpha = 23, kAovValues = 24;

@@ -25,7 +25,7 @@ Aovs aovs_from_render(const RenderResult& result) {
         a.scatter[i * 3 + c] = float(s[kAovScatter + c] / n);
         a.surface[i * 3 + c] = float(s[kAovSurface + c] / n);
         a.background[i * 3 + c] = float(s[kAovBackground + c] / n);
-        a.guide[i * 3 + c] = float(s[kAovGuide + c] / n);
+        a.guide[i * 3 + c] = float(s[kAovGuide + c]);  // the pixel's, not a sum
       }
       if (hits > 0.0) {  // the features, over the samples that have a first event
         a.albedo[i * 3 + c] = float(s[kAovAlbedo + c] / hits);
@@ -33,7 +33,7 @@ Aovs aovs_from_render(const RenderResult& result) {
       }
     }
     if (hits > 0.0) a.depth[i] = float(s[kAovDepth] / hits);
-    if (n > 0.0) a.guide_alpha[i] = float(s[kAovGuideAlpha] / n);
+    if (n > 0.0) a.guide_alpha[i] = float(s[kAovGuideAlpha]);
   }
   return a;
 }

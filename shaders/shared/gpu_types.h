@@ -286,9 +286,10 @@ struct AovLightTexel {
 };
 
 // film.aovs: sums of the camera ray's first-event features over the samples
-// that have one (hits counts them), and of the denoiser's guide over all
-// samples (guide.glsl: the media's emission along the camera ray, and its
-// alpha, by a deterministic ray march).
+// that have one (hits counts them), and the pixel's denoiser guide (written
+// once, by the first pass: accumulation.glsl add_pixel_guide; guide.glsl: the
+// media's emission along the camera ray, and its alpha, by a deterministic
+// ray march).
 struct AovFeatureTexel {
   vec3 albedo;
   float depth;

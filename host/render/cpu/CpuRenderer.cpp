@@ -793,6 +793,7 @@ void add_sample_aovs(const glm::dvec3& L, bool recorded, const WalkAov aov[3], d
 
 // The media part of the guide: emission and transmittance along the spans
 // in s (ray_spans) up to t_end.
+constexpr double kGuideMinTransmittance = 1e-6;
 void guide_media(const WalkScene& ws, const glm::dvec3& o, const glm::dvec3& d, double t_end, Scratch& s,
                  glm::dvec3& L, glm::dvec3& T) {
   constexpr double inf = std::numeric_limits<double>::infinity();
@@ -829,6 +830,9 @@ void guide_media(const WalkScene& ws, const glm::dvec3& o, const glm::dvec3& d, 
         L[c] += T[c] * (sigma_t[c] * dt > 1e-4 ? E[c] * (1.0 - tr) / sigma_t[c] : E[c] * dt);
         T[c] *= tr;
       }
+      // Nothing behind this adds more than 1e-6 of its own light (the GPU's
+      // GUIDE_MIN_TRANSMITTANCE).
+      if (std::max({T.x, T.y, T.z}) < kGuideMinTransmittance) return;
     }
   }
 }
@@ -876,6 +880,28 @@ glm::dvec3 camera_ray_direction(const Camera& camera, int width, int height, dou
   double sy = (1.0 - 2.0 * fy / height) * tan_half;
   return glm::normalize(forward + sx * right + sy * up);
 }
+
+namespace {
+
+// The pixel's guide (RenderResult::aov_sum at kAovGuide, kAovGuideAlpha): the
+// mean of four marches through the centres of the pixel's 2×2 quarters, once
+// per render (docs/compositing.md "The guide").
+void pixel_guide(const WalkScene& ws, const Camera& camera, int W, int H, int x, int y, Scratch& s,
+                 double* aov_sum) {
+  glm::dvec3 sum_L(0.0);
+  double sum_alpha = 0.0;
+  for (int j = 0; j < 4; ++j) {
+    const double fx = x + 0.25 + 0.5 * (j & 1), fy = y + 0.25 + 0.5 * (j >> 1);
+    glm::dvec3 L, T;
+    guide_march(ws, camera.position, camera_ray_direction(camera, W, H, fx, fy), s, L, T);
+    sum_L += L;
+    sum_alpha += 1.0 - (T.x + T.y + T.z) / 3.0;
+  }
+  for (int c = 0; c < 3; ++c) aov_sum[kAovGuide + c] = sum_L[c] / 4.0;
+  aov_sum[kAovGuideAlpha] = sum_alpha / 4.0;
+}
+
+}  // namespace
 
 }  // namespace cpu
 
@@ -1063,6 +1089,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
             double alpha_sum = res.alpha_sum[pix], alpha_sq = res.alpha_sum_sq[pix];
             double aov_sum[kAovValues] = {};
             if (settings.aovs) std::copy_n(res.aov_sum.data() + pix * kAovValues, kAovValues, aov_sum);
+            if (settings.aovs && s_begin == 0) pixel_guide(walk_scene, scene.camera, W, H, x, y, scratch, aov_sum);
             for (int si = s_begin; si < s_end; ++si) {
               cnt.step();
               Pcg32 rng = Pcg32::for_sample(settings.seed, settings.frame, pix, uint64_t(si));
@@ -1096,18 +1123,7 @@ RenderResult CpuRenderer::render(const Scene& scene, const RenderSettings& setti
                 sum[c] += L[c];
                 sum_sq[c] += L[c] * L[c];
               }
-              if (settings.aovs) {
-                add_sample_aovs(L, recorded, aov, aov_sum);
-                // The guide's film point: the si-th of the R2 sequence in the
-                // pixel (as the GPU's add_sample_guide), not the sample's own.
-                const double r2x = std::fmod(0.5 + si * 0.7548776662466927, 1.0);
-                const double r2y = std::fmod(0.5 + si * 0.5698402909980532, 1.0);
-                const glm::dvec3 guide_dir = camera_ray_direction(scene.camera, W, H, x + r2x, y + r2y);
-                glm::dvec3 G, T;
-                guide_march(walk_scene, scene.camera.position, guide_dir, scratch, G, T);
-                for (int c = 0; c < 3; ++c) aov_sum[kAovGuide + c] += G[c];
-                aov_sum[kAovGuideAlpha] += 1.0 - (T.x + T.y + T.z) / 3.0;
-              }
+              if (settings.aovs) add_sample_aovs(L, recorded, aov, aov_sum);
             }
             if (settings.aovs) std::copy_n(aov_sum, kAovValues, next_aov.data() + pix * kAovValues);
             for (int c = 0; c < 3; ++c) {
