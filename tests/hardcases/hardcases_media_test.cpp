@@ -262,7 +262,7 @@ double implicit_capture_events(double alpha, int max_depth) {
 // probability 1 − α; the GPU scatters instead, with weight α, and collects
 // the absorption's expected emission (σa/σt)·Le at every collision. The
 // (max_depth + 1)-th collision ends the path with nothing more
-// (CpuRenderer.cpp, render.comp), so both backends and estimators converge to
+// (host/render/cpu/Walk.cpp, render.comp), so both backends and estimators converge to
 //   L = Le · (1 − α^(max_depth + 1)) = 0.6327 · Le,
 // far from the untruncated Le (+58 %) and from any small cap on the depth.
 // Escape is negligible: 1001 flights of mean length 0.1 move a path ~6 units

@@ -157,4 +157,21 @@ double grid_sigma_a_Le(const MediumData& m, int medium, int c, const glm::dvec3&
   return 0.0;
 }
 
+// The line estimator's second process (walk_channel), this reference's own
+// rule, not the GPU's per-cell rates: in a grid medium a point every
+// 1/kLinePointsPerVoxel voxels on average, over the whole medium; in a
+// homogeneous one kLinePointsPerWidth across its smallest extent.
+constexpr double kLinePointsPerVoxel = 0.25, kLinePointsPerWidth = 8.0;
+double line_rate(const MediumData& m) {
+  if (!m.is_vdb()) {
+    const double width = m.bounds.smallest_extent();
+    return width > 0.0 ? kLinePointsPerWidth / width : 0.0;
+  }
+  if (!m.volume || m.volume->density.grid.empty()) return 0.0;
+  const glm::dmat4& to_world = m.volume->density.grid.index_to_world;
+  const double voxel = std::min({glm::length(glm::dvec3(to_world[0])), glm::length(glm::dvec3(to_world[1])),
+                                 glm::length(glm::dvec3(to_world[2]))});
+  return voxel > 0.0 ? kLinePointsPerVoxel / voxel : 0.0;
+}
+
 }  // namespace pyrolume::cpu

@@ -118,4 +118,9 @@ struct LeCache {
 // σa_c(p) · Le_c(p), given the density rho already looked up at p.
 double grid_sigma_a_Le(const MediumData& m, int medium, int c, const glm::dvec3& p, double rho, LeCache& cache);
 
+// The line estimator's rate of collection points in medium m, per unit
+// length (MediumData::line_rate; this reference's own rule, not the GPU's
+// per-cell rates: Media.cpp).
+double line_rate(const MediumData& m);
+
 }  // namespace pyrolume::cpu
