@@ -100,6 +100,14 @@ class RenderSession {
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
+  // Set-up (RenderSession.cpp), in the constructor's order: the accumulation's
+  // size against the device and the machine; the accumulation buffers; the
+  // pipeline with every binding; the descriptors; one empty dispatch.
+  void check_sizes(const Scene& scene) const;
+  void create_accumulation();
+  void create_pipeline(const std::vector<uint32_t>& code);
+  void write_descriptors();
+  void warm_up();
   DenseLimits dense_limits() const;  // this device's 3D texture limits, for the grid loader
   uint64_t shared_texture_bytes() const;
   void upload_constants(const Scene& scene);
