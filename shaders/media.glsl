@@ -93,6 +93,12 @@ vec3 density_texel_dir(uint slot, vec3 d) {
   return vec3(dot(grids[slot].density_row0, d0), dot(grids[slot].density_row1, d0), dot(grids[slot].density_row2, d0));
 }
 
+// A grid's stored temperature value in kelvin, T = (value − offset)·scale: the
+// one GLSL copy of the mapping (the host's is TemperatureMapping::kelvin).
+float temperature_kelvin(uint slot, float value) {
+  return (value - grids[slot].temperature_offset) * grids[slot].temperature_scale;
+}
+
 // Emitted radiance Le of grid medium m at world point x (docs/scene-format.md "media": T = (v − offset)·scale,
 // no emission at or below cutoff_k; the LUT is uniform in ln T). With
 // TEMPERATURE_IN_DENSITY the grid's value v was read with the density at x.
@@ -107,7 +113,7 @@ vec3 grid_le(GpuMedium m, uint slot, vec3 x, float value_read) {
                   dot(grids[slot].temperature_row2, p1));
     value = temperature_value_at(slot, u);
   }
-  float T = (value - grids[slot].temperature_offset) * grids[slot].temperature_scale;
+  const float T = temperature_kelvin(slot, value);
   if (!(T > grids[slot].cutoff_k) || !(T >= grids[slot].t_min_k)) return vec3(0.0);
   return m.emission * blackbody_at(slot, log(T) * grids[slot].lut_scale + grids[slot].lut_offset);
 }

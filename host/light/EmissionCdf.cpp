@@ -71,7 +71,7 @@ EmissionCdf EmissionCdf::build(const DenseGrid& density, const DenseGrid* temper
   // E(T) = Y(σa ⊙ Le(T)) per temperature texel (memoised on the stored value:
   // R16F grids hold at most 65536 distinct values).
   auto E_of_value = [&](float value) -> double {
-    const double T = (double(value) - p.temperature.offset) * p.temperature.scale;
+    const double T = p.temperature.kelvin(value);
     if (!temperature_emits(T, p.temperature.cutoff_k)) return 0.0;  // NaN too
     const glm::dvec3 Le = temperature_Le(T, p.temperature.cutoff_k, p.emission.scale, p.emission.blackbody,
                                          p.emission.observer, p.emission.adapt_to_k);
@@ -235,7 +235,7 @@ EmissionCdf EmissionCdf::build_sparse_blocks(const DenseGrid& density, const Den
   const size_t nblock = e.cell_count();
 
   auto E_of_value = [&](float value) -> double {
-    const double T = (double(value) - p.temperature.offset) * p.temperature.scale;
+    const double T = p.temperature.kelvin(value);
     if (!temperature_emits(T, p.temperature.cutoff_k)) return 0.0;
     const glm::dvec3 Le = temperature_Le(T, p.temperature.cutoff_k, p.emission.scale, p.emission.blackbody,
                                          p.emission.observer, p.emission.adapt_to_k);

@@ -110,7 +110,7 @@ void check_loaded_medium(const Scene& scene, size_t medium, const StoredVolume& 
   if (!e.emits() || !e.is_grid || !volume.temperature || volume.temperature->grid.empty()) return;
   const DenseGrid& t = volume.temperature->grid;
   const TemperatureMapping& map = m.temperature;
-  const double hottest_k = std::max((double(t.min_value) - map.offset) * map.scale, (double(t.max_value) - map.offset) * map.scale);
+  const double hottest_k = map.hottest_kelvin(t.min_value, t.max_value);
   if (!(hottest_k > map.cutoff_k)) return;  // nothing glows (the loader warns)
   char what[160];
   std::snprintf(what, sizeof what, "the brightest %s blackbody colour up to the grid's hottest voxel, %.4g K",

@@ -738,8 +738,8 @@ VolumeGrids load_volume(const VolumeOptions& m, const DenseLimits& limits) {
 }
 
 std::string cold_temperature_warning(const DenseGrid& t, const TemperatureMapping& map) {
-  const double hottest_value = map.scale >= 0.0 ? t.max_value : t.min_value;
-  const double hottest_k = (hottest_value - map.offset) * map.scale;
+  const double hottest_value = map.hottest_value(t.min_value, t.max_value);
+  const double hottest_k = map.kelvin(hottest_value);
   if (!(hottest_k <= map.cutoff_k)) return "";  // something glows (NaN-safe)
   char line[512];
   std::snprintf(line, sizeof line,

@@ -13,6 +13,16 @@ struct TemperatureMapping {
   double scale = 1.0;   // T = (value - offset) * scale, kelvin
   double offset = 0.0;
   double cutoff_k = 100.0;  // no emission at or below
+
+  // A stored temperature value in kelvin: the one C++ copy of the mapping
+  // (the GPU's is media.glsl temperature_kelvin).
+  double kelvin(double value) const { return (value - offset) * scale; }
+  // Of a grid whose values span [min_value, max_value], the value that maps
+  // hottest (the smallest one under a negative scale), and its kelvin.
+  double hottest_value(double min_value, double max_value) const { return scale >= 0.0 ? max_value : min_value; }
+  double hottest_kelvin(double min_value, double max_value) const {
+    return kelvin(hottest_value(min_value, max_value));
+  }
 };
 
 // The simulator that wrote a vdb file (docs/sources.md): it decides the grids

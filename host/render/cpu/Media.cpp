@@ -129,7 +129,7 @@ double grid_density(const MediumData& m, const glm::dvec3& p) { return m.volume-
 
 double grid_temperature_k(const MediumData& m, const glm::dvec3& p) {
   const double v = m.volume->temperature ? m.volume->temperature->grid.sample_world(p) : 0.0;
-  return (v - m.temperature.offset) * m.temperature.scale;
+  return m.temperature.kelvin(v);
 }
 
 glm::dvec3 grid_Le_of_temperature(const MediumData& m, double T) {

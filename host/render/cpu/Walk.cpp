@@ -181,6 +181,11 @@ struct Walk {
   bool skip_segment = false;
   double result = 0.0;  // what the walk returns, once a part says it has ended
 
+  Walk(const WalkScene& ws, int c, Pcg32& rng, ThreadCounters& cnt, Scratch& s, int max_depth, WalkRole role,
+       bool* camera_escaped, WalkAov* aov, const glm::dvec3& o, const glm::dvec3& d)
+      : ws(ws), c(c), rng(rng), cnt(cnt), s(s), max_depth(max_depth), role(role), camera_escaped(camera_escaped),
+        aov(aov), o(o), d(d) {}
+
   // The camera ray's first event (scatters == 0: o is still the camera).
   void feature(double albedo, const glm::dvec3& normal, double depth) {
     if (!aov || aov->has_feature) return;
@@ -451,7 +456,7 @@ bool surface_bounce(Walk& w, const geometry::SurfaceHit& hit) {
 // through next_event.
 double walk_channel(const WalkScene& ws, int c, glm::dvec3 o, glm::dvec3 d, Pcg32& rng, ThreadCounters& cnt,
                     Scratch& s, int max_depth, WalkRole role, bool* camera_escaped, WalkAov* aov) {
-  Walk w{ws, c, rng, cnt, s, max_depth, role, camera_escaped, role == WalkRole::Path ? aov : nullptr, o, d};
+  Walk w(ws, c, rng, cnt, s, max_depth, role, camera_escaped, role == WalkRole::Path ? aov : nullptr, o, d);
   const WalkLights& lights = ws.lights;
   constexpr double inf = std::numeric_limits<double>::infinity();
   for (;;) {
