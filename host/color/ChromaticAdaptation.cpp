@@ -1,4 +1,5 @@
 #include "color/ChromaticAdaptation.h"
+#include "util/Math.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -13,11 +14,6 @@ constexpr double kBradford[3][3] = {
     {-0.7502, 1.7135, 0.0367},
     {0.0389, -0.0685, 1.0296},
 };
-
-glm::dvec3 mul(const double (&m)[3][3], const glm::dvec3& v) {
-  return {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z, m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
-          m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
-}
 
 // The exact inverse (adjugate / determinant) rather than a rounded published
 // table, so that a white maps to exactly the destination white.

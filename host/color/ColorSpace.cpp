@@ -1,4 +1,5 @@
 #include "color/ColorSpace.h"
+#include "util/Math.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,11 +19,6 @@ constexpr double kSrgbToXyz[3][3] = {
     {0.2126729, 0.7151522, 0.0721750},
     {0.0193339, 0.1191920, 0.9503041},
 };
-
-glm::dvec3 mul(const double (&m)[3][3], const glm::dvec3& v) {
-  return {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z, m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
-          m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
-}
 
 }  // namespace
 

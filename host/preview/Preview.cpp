@@ -32,6 +32,7 @@
 #include "preview/DisplayPass.h"
 #include "preview/OrbitCamera.h"
 #include "preview/PreviewHandles.h"
+#include "preview/PreviewInput.h"
 #include "preview/Swapchain.h"
 #include "render/RenderImage.h"
 #include "render/vulkan/Context.h"
@@ -76,61 +77,6 @@ const char* kControls =
 std::string render_hint(const std::string& scene) {
   return "use `pyrolume render " + scene + " -o out.png` instead";
 }
-
-// Input gathered by the GLFW callbacks between two frames; the frame applies it.
-struct Input {
-  double last_x = 0, last_y = 0;
-  bool have_last = false;
-  double orbit_x = 0, orbit_y = 0;  // pixels dragged with the left button
-  double pan_x = 0, pan_y = 0;      // pixels dragged with the right or middle button
-  double zoom = 0;                  // wheel steps
-  int exposure_steps = 0;
-  int temperature_steps = 0;
-  bool reset = false, save = false;
-  bool framebuffer_resized = false;
-};
-
-Input& input_of(GLFWwindow* w) { return *static_cast<Input*>(glfwGetWindowUserPointer(w)); }
-
-void on_cursor(GLFWwindow* w, double x, double y) {
-  Input& in = input_of(w);
-  if (in.have_last) {
-    const double dx = x - in.last_x, dy = y - in.last_y;
-    if (glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS) {
-      in.orbit_x += dx;
-      in.orbit_y += dy;
-    } else if (glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS ||
-               glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS) {
-      in.pan_x += dx;
-      in.pan_y += dy;
-    }
-  }
-  in.last_x = x;
-  in.last_y = y;
-  in.have_last = true;
-}
-
-void on_scroll(GLFWwindow* w, double, double dy) { input_of(w).zoom += dy; }
-
-// Characters, not keys: '+', '[' and ']' sit on different keys per layout.
-void on_char(GLFWwindow* w, unsigned int c) {
-  Input& in = input_of(w);
-  switch (c) {
-    case '+': case '=': in.exposure_steps++; break;  // '=' is unshifted '+' on US layouts
-    case '-': case '_': in.exposure_steps--; break;
-    case ']': in.temperature_steps++; break;
-    case '[': in.temperature_steps--; break;
-    case 'r': case 'R': in.reset = true; break;
-    case 's': case 'S': in.save = true; break;
-    default: break;
-  }
-}
-
-void on_key(GLFWwindow* w, int key, int, int action, int) {
-  if (key == GLFW_KEY_ESCAPE && action == GLFW_PRESS) glfwSetWindowShouldClose(w, GLFW_TRUE);
-}
-
-void on_framebuffer_size(GLFWwindow* w, int, int) { input_of(w).framebuffer_resized = true; }
 
 std::string timestamp() {
   std::time_t t = std::time(nullptr);
@@ -241,12 +187,7 @@ PreviewWindow::PreviewWindow(const PreviewArgs& args, Scene scene)
   window_.reset(glfwCreateWindow(win_w, win_h, "pyrolume preview", nullptr, nullptr));
   if (!window_) throw preview::NoDisplayError("cannot create a window (GLFW: " + g_glfw_error + ")");
   GLFWwindow* w = window_.get();
-  glfwSetWindowUserPointer(w, &input_);
-  glfwSetCursorPosCallback(w, on_cursor);
-  glfwSetScrollCallback(w, on_scroll);
-  glfwSetCharCallback(w, on_char);
-  glfwSetKeyCallback(w, on_key);
-  glfwSetFramebufferSizeCallback(w, on_framebuffer_size);
+  install_input_callbacks(w, &input_);
 
   vk::Context::Options options;
   options.device_index = args.device;
