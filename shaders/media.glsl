@@ -7,11 +7,11 @@
 // temperature grid's value (else 0). A sparse grid reads its tree instead.
 vec2 density_at(uint slot, vec3 u) {
   if (GRID_COUNT <= 1u) slot = 0u;
-  if (SPARSE_GRIDS && grids[slot].density_tree != 0u)
-    return vec2(sparse_trilinear(grids[slot].density_leaf_table, grids[slot].density_leaf_origin,
-                                 grids[slot].density_leaf_dims, u + grids[slot].density_index_origin),
+  if (SPARSE_GRIDS && grids[slot].density.tree != 0u)
+    return vec2(sparse_trilinear(grids[slot].density.leaf_table, grids[slot].density.leaf_origin,
+                                 grids[slot].density.leaf_dims, u + grids[slot].density.index_origin),
                 0.0);
-  const vec3 tc = u / grids[slot].density_dims;
+  const vec3 tc = u / grids[slot].density.dims;
   vec2 v;
   switch (slot) {
     case 0u: v = textureLod(density_tex[0], tc, 0.0).rg; break;
@@ -32,7 +32,7 @@ float stochastic_density(uint slot, vec3 u, inout uint rng) {
   if (GRID_COUNT <= 1u) slot = 0u;
   const vec3 f0 = u - 0.5, c = floor(f0), f = f0 - c;
   const vec3 xi = vec3(rng_next(rng), rng_next(rng), rng_next(rng));
-  const ivec3 dims = ivec3(grids[slot].density_dims);
+  const ivec3 dims = ivec3(grids[slot].density.dims);
   const ivec3 texel = clamp(ivec3(c) + ivec3(lessThan(xi, f)), ivec3(0), dims - 1);
   const int index = (texel.z * dims.y + texel.y) * dims.x + texel.x;
   switch (slot) {
@@ -46,10 +46,10 @@ float stochastic_density(uint slot, vec3 u, inout uint rng) {
 // T = (value - offset) * scale turns it into kelvin (emission_at below).
 float temperature_value_at(uint slot, vec3 u) {
   if (GRID_COUNT <= 1u) slot = 0u;
-  if (SPARSE_GRIDS && grids[slot].temperature_tree != 0u)
-    return sparse_trilinear(grids[slot].temperature_leaf_table, grids[slot].temperature_leaf_origin,
-                            grids[slot].temperature_leaf_dims, u + grids[slot].temperature_index_origin);
-  const vec3 tc = u / grids[slot].temperature_dims;
+  if (SPARSE_GRIDS && grids[slot].temperature.tree != 0u)
+    return sparse_trilinear(grids[slot].temperature.leaf_table, grids[slot].temperature.leaf_origin,
+                            grids[slot].temperature.leaf_dims, u + grids[slot].temperature.index_origin);
+  const vec3 tc = u / grids[slot].temperature.dims;
   switch (slot) {
     case 0u: return textureLod(temperature_tex[0], tc, 0.0).r;
     case 1u: return textureLod(temperature_tex[1], tc, 0.0).r;
@@ -86,11 +86,11 @@ vec3 albedo_texture_at(uint slot, vec2 uv) {
 
 vec3 density_texel(uint slot, vec3 p) {
   vec4 p1 = vec4(p, 1.0);
-  return vec3(dot(grids[slot].density_row0, p1), dot(grids[slot].density_row1, p1), dot(grids[slot].density_row2, p1));
+  return vec3(dot(grids[slot].density.row0, p1), dot(grids[slot].density.row1, p1), dot(grids[slot].density.row2, p1));
 }
 vec3 density_texel_dir(uint slot, vec3 d) {
   vec4 d0 = vec4(d, 0.0);
-  return vec3(dot(grids[slot].density_row0, d0), dot(grids[slot].density_row1, d0), dot(grids[slot].density_row2, d0));
+  return vec3(dot(grids[slot].density.row0, d0), dot(grids[slot].density.row1, d0), dot(grids[slot].density.row2, d0));
 }
 
 // A grid's stored temperature value in kelvin, T = (value − offset)·scale: the
@@ -109,8 +109,8 @@ vec3 grid_le(GpuMedium m, uint slot, vec3 x, float value_read) {
   float value = value_read;
   if (!TEMPERATURE_IN_DENSITY) {
     vec4 p1 = vec4(x, 1.0);
-    vec3 u = vec3(dot(grids[slot].temperature_row0, p1), dot(grids[slot].temperature_row1, p1),
-                  dot(grids[slot].temperature_row2, p1));
+    vec3 u = vec3(dot(grids[slot].temperature.row0, p1), dot(grids[slot].temperature.row1, p1),
+                  dot(grids[slot].temperature.row2, p1));
     value = temperature_value_at(slot, u);
   }
   const float T = temperature_kelvin(slot, value);
@@ -133,7 +133,7 @@ void media_spans(vec3 o, vec3 d, out vec2 span[MEDIA_N], out bool any_hit) {
       // (u = 0.5 .. dims − 0.5): outside it every lookup is 0, and a dense grid's
       // majorant there would only buy null collisions.
       hit = intersect_box(density_texel(slot, o), density_texel_dir(slot, d), vec3(0.5),
-                          grids[slot].density_dims - 0.5, t);
+                          grids[slot].density.dims - 0.5, t);
     } else if (shape == SHAPE_SPHERE) {
       hit = intersect_sphere(o, d, m.center, m.radius, t);
     } else {

@@ -2,8 +2,8 @@
 // the NanoVDB project's portable C/HLSL/GLSL reader (libnanovdb-dev). Every
 // tree sits in one uniform texel buffer of rgba32ui (BINDING_SPARSE; texel
 // buffers gather about as fast as 3D textures on lavapipe, storage buffers at
-// less than half the speed), at the byte offset GpuGrid density_tree /
-// temperature_tree gives. A lookup finds its leaf in a flat table of leaf
+// less than half the speed), at the byte offset GpuGrid density.tree /
+// temperature.tree gives. A lookup finds its leaf in a flat table of leaf
 // addresses instead of walking the tree from the root: PNanoVDB's walk
 // branches differently in every SIMD lane, ran at 0.4× the dense texture's
 // speed, and made lavapipe's pipeline compile take 20 s (docs/volumes.md

@@ -132,25 +132,41 @@ struct GpuMedium {
   float line_points;   // homogeneous, with the line estimator: collection points per chord (host/render/LineEstimator.h), else 0
 };
 
-// A grid medium's textures and majorant grid (192 bytes). "Texel coordinates"
-// u: texel i's centre is at u = i + 0.5, the sampler reads u / dims; the rows map
-// world points to u (index − origin + 0.5: OpenVDB values sit at integer index
-// points). The map is affine, so a ray keeps its parameter t in texel space.
-struct GpuGrid {
-  vec4 density_row0;      // u = (dot(row0, p1), dot(row1, p1), dot(row2, p1)), p1 = (p, 1)
-  vec4 density_row1;
-  vec4 density_row2;
-  vec3 density_dims;      // texels
-  float density_scale;
-  vec4 temperature_row0;  // the temperature texture's own world -> texel map
-  vec4 temperature_row1;
-  vec4 temperature_row2;
-  vec3 temperature_dims;  // texels
+// One grid of a grid medium (density, or temperature) as the shaders read
+// it: a dense texture's world -> texel map, or a sparse NanoVDB tree's.
+// "Texel coordinates" u: texel i's centre is at u = i + 0.5, the sampler
+// reads u / dims; the rows map world points to u (index − origin + 0.5:
+// OpenVDB values sit at integer index points). The map is affine, so a ray
+// keeps its parameter t in texel space.
+struct GridChannel {
+  vec4 row0;      // u = (dot(row0, p1), dot(row1, p1), dot(row2, p1)), p1 = (p, 1)
+  vec4 row1;
+  vec4 row2;
+  vec3 dims;      // texels
   float unused0;
+  // A sparse grid (texture_format "sparse", shaders/sparse.glsl), in the
+  // sparse buffer (BINDING_SPARSE): the byte offset of its NanoVDB grid (0:
+  // the grid is a dense texture); the index coordinate of texel coordinate 0
+  // (index = u + index_origin); and its flat leaf table, which maps a leaf
+  // coordinate (index >> 3) − leaf_origin, inside leaf_dims, to the byte
+  // offset of that leaf's 512 values.
+  vec3 index_origin;
+  uint tree;
+  ivec3 leaf_origin;
+  uint leaf_table;
+  uvec3 leaf_dims;
+  uint unused1;
+};
+
+// A grid medium's two grids, its temperature mapping and blackbody LUT, and
+// its majorant grid (288 bytes).
+struct GpuGrid {
+  GridChannel density;
+  GridChannel temperature;   // the temperature texture's own world -> texel map
   float temperature_offset;  // T = (value − temperature_offset) · temperature_scale kelvin
   float temperature_scale;
   float cutoff_k;            // no emission at or below
-  float unused1;
+  float density_scale;
   float lut_scale;  // the blackbody LUT's coordinate s = ln(T)·lut_scale + lut_offset
   float lut_offset;
   float t_min_k;    // the LUT's lower end: no emission below
@@ -162,24 +178,6 @@ struct GpuGrid {
   uint majorant_offset;   // cell (0,0,0)'s index in the majorant buffer
   vec3 majorant_cell;     // cell size in texels
   float majorant_scale;   // max channel of (sigma_a + sigma_s)·density_scale: a cell's value times this is its majorant
-  // A sparse grid (texture_format "sparse", shaders/sparse.glsl), in the
-  // sparse buffer (BINDING_SPARSE): the byte offset of its NanoVDB grid (0:
-  // the grid is a dense texture); the index coordinate of texel coordinate 0
-  // (index = u + index_origin); and its flat leaf table, which maps a leaf
-  // coordinate (index >> 3) − leaf_origin, inside leaf_dims, to the byte
-  // offset of that leaf's 512 values.
-  vec3 density_index_origin;
-  uint density_tree;
-  ivec3 density_leaf_origin;
-  uint density_leaf_table;
-  uvec3 density_leaf_dims;
-  uint unused2;
-  vec3 temperature_index_origin;
-  uint temperature_tree;
-  ivec3 temperature_leaf_origin;
-  uint temperature_leaf_table;
-  uvec3 temperature_leaf_dims;
-  uint unused3;
 };
 
 // Per-render constants (uniform buffer).
@@ -306,22 +304,18 @@ PYRO_OFFSET(GpuMedium, shape, 12); PYRO_OFFSET(GpuMedium, sigma_s, 16); PYRO_OFF
 PYRO_OFFSET(GpuMedium, emission, 32); PYRO_OFFSET(GpuMedium, emission_mode, 44); PYRO_OFFSET(GpuMedium, center, 48);
 PYRO_OFFSET(GpuMedium, radius, 60); PYRO_OFFSET(GpuMedium, box_min, 64); PYRO_OFFSET(GpuMedium, grid_slot, 76);
 PYRO_OFFSET(GpuMedium, box_max, 80); PYRO_OFFSET(GpuMedium, line_points, 92);
+static_assert(sizeof(GridChannel) == 112);
+PYRO_OFFSET(GridChannel, row1, 16); PYRO_OFFSET(GridChannel, row2, 32); PYRO_OFFSET(GridChannel, dims, 48);
+PYRO_OFFSET(GridChannel, unused0, 60); PYRO_OFFSET(GridChannel, index_origin, 64); PYRO_OFFSET(GridChannel, tree, 76);
+PYRO_OFFSET(GridChannel, leaf_origin, 80); PYRO_OFFSET(GridChannel, leaf_table, 92);
+PYRO_OFFSET(GridChannel, leaf_dims, 96); PYRO_OFFSET(GridChannel, unused1, 108);
 static_assert(sizeof(GpuGrid) == 288);
-PYRO_OFFSET(GpuGrid, density_row1, 16); PYRO_OFFSET(GpuGrid, density_row2, 32);
-PYRO_OFFSET(GpuGrid, density_dims, 48); PYRO_OFFSET(GpuGrid, density_scale, 60);
-PYRO_OFFSET(GpuGrid, temperature_row0, 64); PYRO_OFFSET(GpuGrid, temperature_row1, 80);
-PYRO_OFFSET(GpuGrid, temperature_row2, 96); PYRO_OFFSET(GpuGrid, temperature_dims, 112);
-PYRO_OFFSET(GpuGrid, unused0, 124); PYRO_OFFSET(GpuGrid, temperature_offset, 128);
-PYRO_OFFSET(GpuGrid, temperature_scale, 132); PYRO_OFFSET(GpuGrid, cutoff_k, 136); PYRO_OFFSET(GpuGrid, unused1, 140);
-PYRO_OFFSET(GpuGrid, lut_scale, 144); PYRO_OFFSET(GpuGrid, lut_offset, 148); PYRO_OFFSET(GpuGrid, t_min_k, 152);
-PYRO_OFFSET(GpuGrid, line_rate_offset, 156); PYRO_OFFSET(GpuGrid, majorant_res, 160);
-PYRO_OFFSET(GpuGrid, majorant_offset, 172); PYRO_OFFSET(GpuGrid, majorant_cell, 176);
-PYRO_OFFSET(GpuGrid, majorant_scale, 188); PYRO_OFFSET(GpuGrid, density_index_origin, 192);
-PYRO_OFFSET(GpuGrid, density_tree, 204); PYRO_OFFSET(GpuGrid, density_leaf_origin, 208);
-PYRO_OFFSET(GpuGrid, density_leaf_table, 220); PYRO_OFFSET(GpuGrid, density_leaf_dims, 224);
-PYRO_OFFSET(GpuGrid, temperature_index_origin, 240); PYRO_OFFSET(GpuGrid, temperature_tree, 252);
-PYRO_OFFSET(GpuGrid, temperature_leaf_origin, 256); PYRO_OFFSET(GpuGrid, temperature_leaf_table, 268);
-PYRO_OFFSET(GpuGrid, temperature_leaf_dims, 272);
+PYRO_OFFSET(GpuGrid, temperature, 112); PYRO_OFFSET(GpuGrid, temperature_offset, 224);
+PYRO_OFFSET(GpuGrid, temperature_scale, 228); PYRO_OFFSET(GpuGrid, cutoff_k, 232); PYRO_OFFSET(GpuGrid, density_scale, 236);
+PYRO_OFFSET(GpuGrid, lut_scale, 240); PYRO_OFFSET(GpuGrid, lut_offset, 244); PYRO_OFFSET(GpuGrid, t_min_k, 248);
+PYRO_OFFSET(GpuGrid, line_rate_offset, 252); PYRO_OFFSET(GpuGrid, majorant_res, 256);
+PYRO_OFFSET(GpuGrid, majorant_offset, 268); PYRO_OFFSET(GpuGrid, majorant_cell, 272);
+PYRO_OFFSET(GpuGrid, majorant_scale, 284);
 static_assert(sizeof(FrameConstants) == 128);
 PYRO_OFFSET(FrameConstants, tan_half_fov, 12); PYRO_OFFSET(FrameConstants, camera_forward, 16);
 PYRO_OFFSET(FrameConstants, aspect, 28); PYRO_OFFSET(FrameConstants, camera_right, 32);

@@ -259,8 +259,8 @@ TEST_F(SparseGridTest, HeadersForALiveEditKeepTheSparseLayoutWithoutItsTables) {
   const GpuScene full = build_gpu_scene(scene, volumes);
   ASSERT_EQ(full.grids.size(), 1u);
   ASSERT_FALSE(full.sparse_tables.empty());
-  EXPECT_NE(full.grids[0].density_tree, 0u);
-  EXPECT_NE(full.grids[0].temperature_tree, 0u);
+  EXPECT_NE(full.grids[0].density.tree, 0u);
+  EXPECT_NE(full.grids[0].temperature.tree, 0u);
   // The majorant cells were chosen once, by the line estimator's pass, and kept.
   ASSERT_EQ(full.line.majorant_res.size(), 1u);
   EXPECT_EQ(full.line.majorant_res[0], majorant_resolution(scene, scene.media[0], volumes[0]->density.grid));
@@ -274,13 +274,13 @@ TEST_F(SparseGridTest, HeadersForALiveEditKeepTheSparseLayoutWithoutItsTables) {
   EXPECT_EQ(edit.sparse_bytes, full.sparse_bytes);
   ASSERT_EQ(edit.grids.size(), 1u);
   const gpu::GpuGrid &a = edit.grids[0], &b = full.grids[0];
-  EXPECT_EQ(a.density_tree, b.density_tree);
-  EXPECT_EQ(a.density_leaf_table, b.density_leaf_table);
-  EXPECT_EQ(a.temperature_tree, b.temperature_tree);
-  EXPECT_EQ(a.temperature_leaf_table, b.temperature_leaf_table);
-  EXPECT_EQ(std::memcmp(&a.density_leaf_origin, &b.density_leaf_origin, sizeof a.density_leaf_origin), 0);
-  EXPECT_EQ(std::memcmp(&a.density_leaf_dims, &b.density_leaf_dims, sizeof a.density_leaf_dims), 0);
-  EXPECT_EQ(std::memcmp(&a.temperature_leaf_dims, &b.temperature_leaf_dims, sizeof a.temperature_leaf_dims), 0);
+  EXPECT_EQ(a.density.tree, b.density.tree);
+  EXPECT_EQ(a.density.leaf_table, b.density.leaf_table);
+  EXPECT_EQ(a.temperature.tree, b.temperature.tree);
+  EXPECT_EQ(a.temperature.leaf_table, b.temperature.leaf_table);
+  EXPECT_EQ(std::memcmp(&a.density.leaf_origin, &b.density.leaf_origin, sizeof a.density.leaf_origin), 0);
+  EXPECT_EQ(std::memcmp(&a.density.leaf_dims, &b.density.leaf_dims, sizeof a.density.leaf_dims), 0);
+  EXPECT_EQ(std::memcmp(&a.temperature.leaf_dims, &b.temperature.leaf_dims, sizeof a.temperature.leaf_dims), 0);
   EXPECT_EQ(a.density_scale, 2.0f * b.density_scale);  // while the edit itself goes through
 }
 

@@ -183,10 +183,10 @@ void pack_grid_emission(const Medium& m, const StoredVolume& v, bool with_luts, 
     g.emission = v3(glm::dvec3(m.emission.scale));
     g.emission_mode = gpu::EMIT_TEMPERATURE;
     src.temperature = &*v.temperature;
-    texel_rows(v.temperature->grid, grid.temperature_row0, grid.temperature_row1, grid.temperature_row2);
-    place_sparse(m.file.string(), v.temperature->grid, with_tables, out, grid.temperature_index_origin, grid.temperature_tree,
-                 grid.temperature_leaf_origin, grid.temperature_leaf_table, grid.temperature_leaf_dims);
-    grid.temperature_dims = v3(glm::dvec3(v.temperature->grid.dims));
+    texel_rows(v.temperature->grid, grid.temperature.row0, grid.temperature.row1, grid.temperature.row2);
+    place_sparse(m.file.string(), v.temperature->grid, with_tables, out, grid.temperature.index_origin, grid.temperature.tree,
+                 grid.temperature.leaf_origin, grid.temperature.leaf_table, grid.temperature.leaf_dims);
+    grid.temperature.dims = v3(glm::dvec3(v.temperature->grid.dims));
     grid.temperature_offset = float(m.temperature.offset);
     grid.temperature_scale = float(m.temperature.scale);
     grid.cutoff_k = float(m.temperature.cutoff_k);
@@ -208,10 +208,10 @@ void pack_grid_medium(const Medium& m, size_t i, const StoredVolume& v, bool wit
   GpuGridSource src;
   src.medium = i;
   src.density = &v.density;
-  texel_rows(v.density.grid, grid.density_row0, grid.density_row1, grid.density_row2);
-  grid.density_dims = v3(glm::dvec3(v.density.grid.dims));
-  place_sparse(m.file.string(), v.density.grid, with_tables, out, grid.density_index_origin, grid.density_tree, grid.density_leaf_origin,
-               grid.density_leaf_table, grid.density_leaf_dims);
+  texel_rows(v.density.grid, grid.density.row0, grid.density.row1, grid.density.row2);
+  grid.density.dims = v3(glm::dvec3(v.density.grid.dims));
+  place_sparse(m.file.string(), v.density.grid, with_tables, out, grid.density.index_origin, grid.density.tree, grid.density.leaf_origin,
+               grid.density.leaf_table, grid.density.leaf_dims);
   grid.density_scale = float(m.density_scale);
   // Depends on the medium's coefficients, not on the cells: edits change it.
   grid.majorant_scale = float(max3(m.sigma_a + m.sigma_s) * m.density_scale);
