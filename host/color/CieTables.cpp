@@ -1,5 +1,6 @@
 // GENERATED FILE - do not edit. Regenerate from the repository root with:
-//   tools/gen_cie_tables ../shared/data/color host/color/CieTables.cpp
+//   tools/gen_cie_tables CSV_DIR host/color/CieTables.cpp
+// where CSV_DIR holds the CIE's two CSV files named below (docs/blackbody.md).
 //
 // CIE colour-matching functions, 360-830 nm at 1 nm, values as published.
 //   CIE (2019), "CIE 1931 colour-matching functions, 2 degree observer", DOI 10.25039/CIE.DS.xvudnb9b;
