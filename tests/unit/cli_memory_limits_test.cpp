@@ -17,20 +17,6 @@ namespace fs = std::filesystem;
 
 constexpr uint64_t kGiB = uint64_t(1) << 20;  // in KiB, as ulimit -v takes it
 
-// AddressSanitizer reserves terabytes of address space for its shadow memory,
-// so an ASan build of pyrolume cannot start under `ulimit -v` (tools/sanitize).
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kAddressSanitizer = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kAddressSanitizer = true;
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
-
 class CliMemoryLimits : public ::testing::Test {
  protected:
   void SetUp() override {

@@ -51,12 +51,14 @@ void write_bytes(const fs::path& p, const Bytes& b, size_t n) {
 }
 
 // Where to cut or damage a file of n bytes: every byte of the first 160
-// (headers, metadata, descriptors), then about 160 spread over the rest,
-// so each sweep stays a few seconds under the sanitizers.
+// (headers, metadata, descriptors), then about 160 spread over the rest
+// (32 under AddressSanitizer, where the VDB damage sweep took 49 s of the
+// sanitizer stage with 160; fuzz_vdb and fuzz_image damage the rest there).
 std::vector<size_t> sample_positions(size_t n) {
   std::vector<size_t> at;
   for (size_t i = 0; i < n && i < 160; ++i) at.push_back(i);
-  const size_t step = std::max<size_t>(1, (n > 160 ? n - 160 : 0) / 160);
+  const size_t spread = test::kAddressSanitizer ? 32 : 160;
+  const size_t step = std::max<size_t>(1, (n > 160 ? n - 160 : 0) / spread);
   for (size_t i = 160; i < n; i += step) at.push_back(i);
   return at;
 }
@@ -160,7 +162,8 @@ TEST(CorruptVdb, EveryTruncationIsAnInputError) {
 }
 
 // Each byte in turn replaced by 0xff and by 0x7f: lengths, counts, offsets,
-// masks, chunk sizes and Blosc headers all get hit.
+// masks, chunk sizes and Blosc headers all get hit. Under AddressSanitizer
+// (three reads a file at ~15 ms each) a byte gets one of the two, in turn.
 TEST(CorruptVdb, EveryDamagedByteIsReadOrRefused) {
   const auto dir = test::temp_dir("vdbflip");
   for (uint32_t c : {kZipMask, kBlosc}) {
@@ -170,6 +173,7 @@ TEST(CorruptVdb, EveryDamagedByteIsReadOrRefused) {
     for (size_t i : sample_positions(good.size()))
       for (char v : {char(0xff), char(0x7f)}) {
         if (good[i] == v) continue;
+        if (test::kAddressSanitizer && (v == char(0xff)) != (i % 2 == 0)) continue;
         Bytes b = good;
         b[i] = v;
         write_bytes(p, b, b.size());
