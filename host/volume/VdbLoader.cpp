@@ -34,6 +34,7 @@
 
 #include "util/Error.h"
 #include "util/Memory.h"
+#include "volume/DenseBuilder.h"
 #include "volume/NanoVdbValidate.h"
 #include "volume/SparseGrid.h"
 #include "volume/VdbFile.h"
@@ -42,7 +43,16 @@ namespace pyrolume {
 
 namespace {
 
-enum class Role { Density, Temperature };
+using dense_build::DenseBuilder;
+using dense_build::empty_grid;
+using dense_build::finish_grid;
+using dense_build::finish_sparse;
+using dense_build::kHostBytesPerTexel;
+using dense_build::max_dense_texels;
+using dense_build::Role;
+using dense_build::role_key;
+using dense_build::ValueRules;
+using dense_build::within_memory;
 
 struct GridEntry {
   std::string name;
@@ -54,10 +64,6 @@ bool is_scalar_float_type(const std::string& t) {
   // there; NanoVDB names its quantised float grids Float4/8/16/N.
   static const char* ok[] = {"float", "double", "Half", "Float4", "Float8", "Float16", "FloatN"};
   return std::any_of(std::begin(ok), std::end(ok), [&](const char* s) { return t == s; });
-}
-
-std::string role_key(Role role, const std::string& grid) {
-  return std::string(role == Role::Density ? "density" : "temperature") + " grid \"" + grid + "\"";
 }
 
 std::string list_grids(const std::vector<GridEntry>& entries) {
@@ -120,254 +126,7 @@ GridChoice choose_grids(const std::vector<GridEntry>& entries, const VolumeOptio
   return c;
 }
 
-uint64_t max_dense_texels = uint64_t(1) << 32;
 uint64_t max_sparse_leaves = UINT32_MAX;
-constexpr uint64_t kHostBytesPerTexel = 12;  // 4 (float array) + 4 (texture copy) + 4 (its upload)
-
-int64_t floor_div(int64_t a, int64_t k) { return a >= 0 ? a / k : -((-a + k - 1) / k); }
-
-// What every loader keeps of a grid's values, dense or sparse (docs/volumes.md):
-// NaN/Inf -> 0 and negative density -> 0, each counted for the warnings, and
-// the range of what is kept.
-struct ValueRules {
-  bool clamp_negative;
-  uint64_t nonfinite = 0, negative = 0;
-  float lo = std::numeric_limits<float>::infinity(), hi = -std::numeric_limits<float>::infinity();
-
-  // One active value, standing for `voxels` voxels (a tile covers many).
-  float apply(double v, uint64_t voxels = 1) {
-    float f = float(v);
-    if (!std::isfinite(f)) {  // NaN, Inf, or a double beyond float range
-      nonfinite += voxels;
-      f = 0.0f;
-    } else if (f < 0.0f && clamp_negative) {
-      negative += voxels;
-      f = 0.0f;
-    }
-    lo = std::min(lo, f);
-    hi = std::max(hi, f);
-    return f;
-  }
-
-  void set_range(DenseGrid& out) const {
-    if (lo > hi) return;  // nothing was active
-    out.min_value = lo;
-    out.max_value = hi;
-  }
-};
-
-// Fills a DenseGrid from active voxels. With downsample k, coarse voxel J
-// averages the k^3 fine voxels k*J .. k*J + k-1 (inactive ones count as the
-// background 0); its centre, the mean of the fine centres, is fine index
-// k*J + (k-1)/2, which index_map() returns.
-class DenseBuilder {
- public:
-  DenseBuilder(DenseGrid& out, const glm::i64vec3& bmin, const glm::i64vec3& bmax, int k, bool clamp_negative,
-               const std::string& file, Role role, const DenseLimits& limits)
-      : rules{clamp_negative}, out_(out), k_(k) {
-    auto dims_at = [&](int64_t kk, glm::i64vec3* lo) {
-      glm::i64vec3 cmin, cmax;
-      for (int a = 0; a < 3; ++a) {
-        cmin[a] = floor_div(bmin[a], kk);
-        cmax[a] = floor_div(bmax[a], kk);
-      }
-      if (lo) *lo = cmin;
-      return glm::i64vec3(cmax - cmin + int64_t(3));  // + one padding texel each side
-    };
-    glm::i64vec3 cmin;
-    const glm::i64vec3 dims = dims_at(k, &cmin);
-    const uint64_t texels = uint64_t(dims.x) * uint64_t(dims.y) * uint64_t(dims.z);
-    // The device's limits, before anything is allocated; the suggestion is
-    // the smallest downsample that fits them.
-    auto fits = [&](const glm::i64vec3& d) {
-      const uint64_t n = uint64_t(d.x) * uint64_t(d.y) * uint64_t(d.z);
-      return (limits.max_dim == 0 || std::max({d.x, d.y, d.z}) <= int64_t(limits.max_dim)) &&
-             (limits.max_bytes == 0 || 2 * n <= limits.max_bytes);
-    };
-    if (!fits(dims)) {
-      int64_t suggest = k;
-      while (suggest <= 64 && !fits(dims_at(suggest, nullptr))) ++suggest;  // 64: the key's maximum
-      std::ostringstream s;
-      s << dims.x << "x" << dims.y << "x" << dims.z << " texels (with downsample " << k << ") exceed ";
-      if (limits.max_dim != 0 && std::max({dims.x, dims.y, dims.z}) > int64_t(limits.max_dim))
-        s << "this device's 3D texture limit of " << limits.max_dim << " per axis";
-      else
-        s << "what this device allows in one allocation (" << (limits.max_bytes >> 20) << " MiB at 2 B per texel)";
-      if (suggest <= 64) s << "; add \"downsample\": " << suggest << " to the medium";
-      else s << "; even \"downsample\": 64 does not fit: crop the grid";
-      throw input_error(file, role_key(role, out.name), s.str());
-    }
-    // 2^32 texels is 16 GiB as float: past what any host or device here holds,
-    // and texel offsets would overflow 32-bit shader arithmetic.
-    if (dims.x > (1 << 30) || dims.y > (1 << 30) || dims.z > (1 << 30) || texels > max_dense_texels) {
-      std::ostringstream s;
-      s << "active bounding box of " << dims.x - 2 << " x " << dims.y - 2 << " x " << dims.z - 2
-        << " voxels is too large for a dense texture; use \"downsample\": k (box filter by k)";
-      throw input_error(file, role_key(role, out.name), s.str());
-    }
-    // The host's memory, before the array exists: the dense floats, the
-    // texture copy the renderers store beside them and its upload (R32F at
-    // worst), kHostBytesPerTexel in all. Past it the grid is refused with the
-    // downsample that would fit, not allocated into std::bad_alloc.
-    const uint64_t room = memory_available_bytes();
-    auto host_fits = [&](const glm::i64vec3& d) {
-      return room == 0 || uint64_t(d.x) * uint64_t(d.y) * uint64_t(d.z) * kHostBytesPerTexel <= room;
-    };
-    if (!host_fits(dims)) {
-      int64_t suggest = k;
-      while (suggest <= 64 && !host_fits(dims_at(suggest, nullptr))) ++suggest;
-      std::ostringstream s;
-      s << dims.x << "x" << dims.y << "x" << dims.z << " texels (with downsample " << k << ") need "
-        << format_bytes(texels * kHostBytesPerTexel) << " of host memory (" << kHostBytesPerTexel
-        << " B per texel: the dense array, its texture copy and upload), more than the " << format_bytes(room)
-        << " this process can still allocate";
-      if (suggest <= 64) s << "; add \"downsample\": " << suggest << " to the medium";
-      throw input_error(file, role_key(role, out.name), s.str());
-    }
-    out_.origin = glm::ivec3(cmin - int64_t(1));
-    out_.dims = glm::ivec3(dims);
-    out_.values.assign(texels, 0.0f);
-  }
-
-  void add(int64_t i, int64_t j, int64_t k, double v) {
-    const float f = rules.apply(v);
-    if (f == 0.0f) return;
-    const int64_t x = floor_div(i, k_) - out_.origin.x, y = floor_div(j, k_) - out_.origin.y,
-                  z = floor_div(k, k_) - out_.origin.z;
-    out_.values[(size_t(z) * size_t(out_.dims.y) + size_t(y)) * size_t(out_.dims.x) + size_t(x)] += f;
-  }
-
-  void add_box(const openvdb::CoordBBox& box, double v) {
-    for (int64_t k = box.min().z(); k <= box.max().z(); ++k)
-      for (int64_t j = box.min().y(); j <= box.max().y(); ++j)
-        for (int64_t i = box.min().x(); i <= box.max().x(); ++i) add(i, j, k, v);
-  }
-
-  void finish() {
-    if (k_ > 1) {
-      const float w = 1.0f / float(k_ * k_ * k_);
-      for (float& v : out_.values) v *= w;
-    }
-    rules.set_range(out_);
-  }
-
-  // Coarse index -> fine index (identity for k = 1).
-  glm::dmat4 index_map() const {
-    glm::dmat4 D = glm::translate(glm::dmat4(1.0), glm::dvec3(0.5 * (k_ - 1)));
-    return glm::scale(D, glm::dvec3(double(k_)));
-  }
-
-  ValueRules rules;
-
- private:
-  DenseGrid& out_;
-  int k_;
-};
-
-// An allocation that failed inside OpenVDB or NanoVDB while a grid was read:
-// std::bad_alloc, or the std::runtime_error NanoVDB's HostBuffer throws for
-// it ("Pool::Pool malloc failed"), which named neither file nor grid. The
-// checks before each large allocation (DenseBuilder, require_sparse_memory,
-// the grid's size before nanovdb::io reads it) should leave nothing for this
-// to catch; it names the file and grid when a smaller allocation still fails.
-template <class F>
-auto within_memory(const std::string& file, const std::string& key, F&& read) -> decltype(read()) {
-  auto ran_out = [&] {
-    return input_error(file, key, "memory ran out while reading it (" + format_bytes(memory_available_bytes()) +
-                                      " left to this process); give it more memory or add \"downsample\": k to the medium");
-  };
-  try {
-    return read();
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::bad_alloc&) {
-    throw ran_out();
-  } catch (const std::runtime_error& e) {
-    const std::string w = e.what();
-    if (w.rfind("Pool::", 0) == 0 && (w.find("malloc failed") != std::string::npos ||
-                                      w.find("insufficient memory") != std::string::npos ||
-                                      w.find("allocation failed") != std::string::npos))
-      throw ran_out();
-    throw;
-  }
-}
-
-// The renderers map rays into the grid with these matrices (the GPU in
-// float): entries beyond kMaxMapEntry, or non-finite ones, lose the grid and
-// turn samples non-finite (a transform scale of 1e-300 gave voxels of 1e-300
-// and a world-to-index map of 1e300). Voxels from 1e-15 to 1e15 scene units pass.
-constexpr double kMaxMapEntry = 1e15;
-
-void check_index_maps(const DenseGrid& g, const std::string& file, Role role) {
-  auto within = [](const glm::dmat4& M) {
-    for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 4; ++r)
-        if (!(std::abs(M[c][r]) <= kMaxMapEntry)) return false;
-    return true;
-  };
-  if (within(g.index_to_world) && within(g.world_to_index)) return;
-  std::ostringstream s;
-  s << "its index-to-world map with the medium's transform on top is degenerate or beyond float range (a voxel is "
-    << glm::length(glm::dvec3(g.index_to_world[0])) << " units along x; at most " << kMaxMapEntry
-    << " either way): check the medium's transform.scale";
-  throw input_error(file, role_key(role, g.name), s.str());
-}
-
-void report_counts(const ValueRules& r, const std::string& file, Role role, const std::string& grid,
-                   std::vector<std::string>& warnings) {
-  if (r.nonfinite)
-    warnings.push_back(file + ": " + role_key(role, grid) + ": " + std::to_string(r.nonfinite) +
-                       " NaN/Inf voxels treated as 0");
-  if (r.negative)
-    warnings.push_back(file + ": " + role_key(role, grid) + ": " + std::to_string(r.negative) +
-                       " negative density voxels clamped to 0");
-}
-
-// The medium's transform on top of the grid's map, after the source's voxel
-// placement (VolumeOptions::index_offset).
-glm::dmat4 placed(const VolumeOptions& m, const glm::dmat4& grid_to_world) {
-  return m.transform * grid_to_world * glm::translate(glm::dmat4(1.0), glm::dvec3(m.index_offset));
-}
-
-void set_index_maps(DenseGrid& out, const glm::dmat4& index_to_world, const std::string& file, Role role) {
-  out.index_to_world = index_to_world;
-  out.world_to_index = glm::inverse(out.index_to_world);
-  check_index_maps(out, file, role);
-}
-
-// A filled dense grid: its counts reported, its index maps set and checked.
-DenseGrid finish_grid(DenseBuilder& b, DenseGrid& out, const glm::dmat4& grid_to_world, const VolumeOptions& m,
-                      Role role, const std::string& file, std::vector<std::string>& warnings) {
-  b.finish();
-  report_counts(b.rules, file, role, out.name, warnings);
-  set_index_maps(out, placed(m, grid_to_world) * b.index_map(), file, role);
-  return std::move(out);
-}
-
-// The same for a sparse grid whose active voxels span lo..hi: the box the
-// dense texture would have (one texel of padding each side), the tree kept.
-DenseGrid finish_sparse(DenseGrid& out, std::shared_ptr<SparseGrid> sparse, const glm::i64vec3& lo,
-                        const glm::i64vec3& hi, const ValueRules& rules, const glm::dmat4& grid_to_world,
-                        const VolumeOptions& m, Role role, const std::string& file, std::vector<std::string>& warnings) {
-  report_counts(rules, file, role, out.name, warnings);
-  out.sparse = std::move(sparse);
-  out.origin = glm::ivec3(lo - int64_t(1));
-  out.dims = glm::ivec3(hi - lo + int64_t(3));
-  rules.set_range(out);
-  set_index_maps(out, placed(m, grid_to_world), file, role);
-  return std::move(out);
-}
-
-// A grid with no active voxels: no texels, only its index maps, and a warning.
-DenseGrid empty_grid(std::string name, const glm::dmat4& grid_to_world, const VolumeOptions& m, Role role,
-                     const std::string& file, std::vector<std::string>& warnings) {
-  DenseGrid out;
-  out.name = std::move(name);
-  set_index_maps(out, placed(m, grid_to_world), file, role);
-  warnings.push_back(file + ": " + role_key(role, out.name) + ": empty grid (no active voxels): " +
-                     (role == Role::Density ? "renders as no medium" : "the medium does not emit"));
-  return out;
-}
 
 // ---- OpenVDB ----
 
@@ -391,7 +150,8 @@ DenseGrid dense_from_openvdb(const GridT& grid, const VolumeOptions& m, Role rol
     } else {
       openvdb::CoordBBox box;
       it.getBoundingBox(box);
-      b.add_box(box, double(*it));
+      b.add_box({box.min().x(), box.min().y(), box.min().z()}, {box.max().x(), box.max().y(), box.max().z()},
+                double(*it));
     }
   }
   return finish_grid(b, out, grid_to_world, m, role, file, warnings);
