@@ -137,11 +137,11 @@ inline void expect_same_image(const Image& a, const Image& b) {
   EXPECT_EQ(differ, 0u) << "of " << a.variance.size() << " variance values differ";
 }
 
-// A real SIGINT in the middle of a 10 000 spp render (sent once the first
-// checkpoint exists): exit 130, the image so far with its spp in the EXR
-// header and in the message, the checkpoint beside it; `--resume` then
-// completes it to 10 000 spp, identical to an uninterrupted render, and
-// removes the checkpoint.
+// A real SIGINT in the middle of a 10 000 spp render (2 500 under ASan; sent
+// once the first checkpoint exists): exit 130, the image so far with its spp
+// in the EXR header and in the message, the checkpoint beside it; `--resume`
+// then completes it, identical to an uninterrupted render, and removes the
+// checkpoint.
 inline void expect_cli_interrupt_then_resume(const std::string& backend) {
   // The render is interrupted, resumed to the end and rendered whole: under
   // AddressSanitizer (~7x slower) a quarter of the samples keeps the two
