@@ -29,12 +29,6 @@
 
 namespace pyrolume::cli_output {
 
-std::string lower_extension(const std::filesystem::path& p) {
-  std::string e = p.extension().string();
-  for (auto& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return e;
-}
-
 std::string format_seconds(double s) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3f", s);

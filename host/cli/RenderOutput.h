@@ -22,8 +22,6 @@
 
 namespace pyrolume::cli_output {
 
-std::string lower_extension(const std::filesystem::path& p);
-
 std::string format_seconds(double s);
 
 // What a black image's warning names (film_look_warning).

@@ -46,13 +46,13 @@ unsigned char srgb_encode_u8(float linear, double exposure_stops) {
   return static_cast<unsigned char>(std::lround(255.0f * srgb_encode(scaled)));
 }
 
-namespace {
-
 std::string lower_extension(const fs::path& p) {
   std::string ext = p.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   return ext;
 }
+
+namespace {
 
 // OpenEXR messages can span lines; the CLI prints errors as one line.
 std::string one_line(std::string s) {

@@ -2,6 +2,7 @@
 // Image files: EXR (linear float, the lossless format every render and compare
 // uses) and PNG (8-bit sRGB for looking at). Errors are InputError "FILE: REASON".
 #include <filesystem>
+#include <string>
 
 #include "image/Image.h"
 #include "scene/Scene.h"
@@ -33,6 +34,10 @@ unsigned char srgb_encode_u8(float linear, double exposure_stops = 0.0);
 // Unknown extension, empty image, or an I/O failure → InputError.
 void write_image(const std::filesystem::path& file, const Image& img, double exposure_stops = 0.0,
                  ViewTransform view = ViewTransform::Standard);
+
+// The file name's extension in lower case (".exr", ".png"): what chooses
+// write_image's format, and what the CLI and the preview check outputs by.
+std::string lower_extension(const std::filesystem::path& file);
 
 // Reads by content, not by extension:
 //   EXR: data window; R, G, B (missing ones read as 0); a Y-only file gives

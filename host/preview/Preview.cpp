@@ -520,12 +520,6 @@ void PreviewWindow::print_summary() const {
   std::fflush(stdout);
 }
 
-std::string lower_extension(const fs::path& p) {
-  std::string e = p.extension().string();
-  for (auto& c : e) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return e;
-}
-
 }  // namespace
 
 bool preview_available() { return true; }

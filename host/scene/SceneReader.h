@@ -104,13 +104,17 @@ class Reader {
   }
   glm::dvec3 vec3(const std::string& key, glm::dvec3 fallback) {
     if (!has(key)) return fallback;
-    const json& v = raw(key);
-    if (!v.is_array() || v.size() != 3) fail(key, "expected an array of 3 numbers");
+    return finite_vec3(raw(key), key, "expected an array of 3 numbers");
+  }
+  // v as three finite numbers; `at` and `expected` name the key and the
+  // shape in the error.
+  glm::dvec3 finite_vec3(const json& v, const std::string& at, const char* expected) const {
+    if (!v.is_array() || v.size() != 3) fail(at, expected);
     glm::dvec3 r;
     for (int i = 0; i < 3; ++i) {
-      if (!v[i].is_number()) fail(key, "expected an array of 3 numbers");
+      if (!v[i].is_number()) fail(at, expected);
       r[i] = v[i].get<double>();
-      if (!std::isfinite(r[i])) fail(key, "must be finite");
+      if (!std::isfinite(r[i])) fail(at, "must be finite");
     }
     return r;
   }
@@ -129,14 +133,7 @@ class Reader {
   glm::dvec3 vec3_keyed(const std::string& key, glm::dvec3 fallback, Keyframes<glm::dvec3>& keys) {
     if (!has(key) || !j_.at(key).is_object()) return vec3(key, fallback);
     read_keys(key, keys, [&](const json& v, const std::string& at) {
-      if (!v.is_array() || v.size() != 3) fail(at, "expected [x, y, z] as the key's value");
-      glm::dvec3 r;
-      for (int i = 0; i < 3; ++i) {
-        if (!v[i].is_number()) fail(at, "expected [x, y, z] as the key's value");
-        r[i] = v[i].get<double>();
-        if (!std::isfinite(r[i])) fail(at, "must be finite");
-      }
-      return r;
+      return finite_vec3(v, at, "expected [x, y, z] as the key's value");
     });
     return keys.at(0.0);
   }

@@ -16,15 +16,12 @@
 #include "volume/VdbLoader.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <limits>
 #include <optional>
 #include <sstream>
 #include <type_traits>
 
-#include <glm/gtc/matrix_transform.hpp>
 #include <nanovdb/NanoVDB.h>
 #include <nanovdb/util/IO.h>
 #include <nanovdb/util/NanoToOpenVDB.h>
