@@ -6,11 +6,13 @@
 
 namespace pyrolume::test {
 
-// Built with AddressSanitizer (tools/sanitize): such a process cannot start
-// under `ulimit -v` (the shadow memory reserves terabytes of address space),
-// and byte-by-byte sweeps of damaged files run ~7x slower, so they sample
-// fewer positions there (the fuzzers cover the rest under the sanitizers).
-#if defined(__SANITIZE_ADDRESS__)
+// Linked with AddressSanitizer (tools/sanitize; CMake defines
+// PYROLUME_SANITIZE, since the test files themselves are compiled without
+// it): such a process, and the CLI it starts, cannot run under `ulimit -v`
+// (the shadow memory reserves terabytes of address space), and byte-by-byte
+// sweeps of damaged files run ~7x slower, so they sample fewer positions
+// there (the fuzzers cover the rest under the sanitizers).
+#if defined(PYROLUME_SANITIZE) || defined(__SANITIZE_ADDRESS__)
 constexpr bool kAddressSanitizer = true;
 #elif defined(__has_feature)
 #if __has_feature(address_sanitizer)
