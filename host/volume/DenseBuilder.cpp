@@ -28,6 +28,13 @@ DenseBuilder::DenseBuilder(DenseGrid& out, const glm::i64vec3& bmin, const glm::
     if (lo) *lo = cmin;
     return glm::i64vec3(cmax - cmin + int64_t(3));  // + one padding texel each side
   };
+  // The smallest downsample from k up to the key's maximum, 64, whose dims
+  // pass `ok` (the suggestion in an error); 65 where none does.
+  auto smallest_fitting = [&](auto&& ok) {
+    int64_t suggest = k;
+    while (suggest <= 64 && !ok(dims_at(suggest, nullptr))) ++suggest;
+    return suggest;
+  };
   glm::i64vec3 cmin;
   const glm::i64vec3 dims = dims_at(k, &cmin);
   const uint64_t texels = uint64_t(dims.x) * uint64_t(dims.y) * uint64_t(dims.z);
@@ -39,8 +46,7 @@ DenseBuilder::DenseBuilder(DenseGrid& out, const glm::i64vec3& bmin, const glm::
            (limits.max_bytes == 0 || 2 * n <= limits.max_bytes);
   };
   if (!fits(dims)) {
-    int64_t suggest = k;
-    while (suggest <= 64 && !fits(dims_at(suggest, nullptr))) ++suggest;  // 64: the key's maximum
+    const int64_t suggest = smallest_fitting(fits);
     std::ostringstream s;
     s << dims.x << "x" << dims.y << "x" << dims.z << " texels (with downsample " << k << ") exceed ";
     if (limits.max_dim != 0 && std::max({dims.x, dims.y, dims.z}) > int64_t(limits.max_dim))
@@ -68,8 +74,7 @@ DenseBuilder::DenseBuilder(DenseGrid& out, const glm::i64vec3& bmin, const glm::
     return room == 0 || uint64_t(d.x) * uint64_t(d.y) * uint64_t(d.z) * kHostBytesPerTexel <= room;
   };
   if (!host_fits(dims)) {
-    int64_t suggest = k;
-    while (suggest <= 64 && !host_fits(dims_at(suggest, nullptr))) ++suggest;
+    const int64_t suggest = smallest_fitting(host_fits);
     std::ostringstream s;
     s << dims.x << "x" << dims.y << "x" << dims.z << " texels (with downsample " << k << ") need "
       << format_bytes(texels * kHostBytesPerTexel) << " of host memory (" << kHostBytesPerTexel
