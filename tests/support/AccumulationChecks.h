@@ -146,7 +146,7 @@ inline void expect_cli_interrupt_then_resume(const std::string& backend) {
   // The render is interrupted, resumed to the end and rendered whole: under
   // AddressSanitizer (~7x slower) a quarter of the samples keeps the two
   // full renders from being the sanitized run's last 40 s.
-  const int spp = kAddressSanitizer ? 2500 : 10000;
+  const int spp = address_sanitizer() ? 2500 : 10000;
   const std::string spp_arg = std::to_string(spp);
   auto dir = temp_dir("cli-resume-" + backend);
   write_file(dir / "s.json", kSlowBallJson);

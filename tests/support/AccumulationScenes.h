@@ -103,7 +103,7 @@ struct CliProcess {
 
 inline CliProcess start_cli(const std::vector<std::string>& args, const std::filesystem::path& dir) {
   CliProcess p{-1, dir / "bg_stdout.txt", dir / "bg_stderr.txt"};
-  std::vector<std::string> argv_s{PYROLUME_BIN};
+  std::vector<std::string> argv_s{pyrolume_bin()};
   argv_s.insert(argv_s.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (auto& a : argv_s) argv.push_back(a.data());
@@ -114,7 +114,7 @@ inline CliProcess start_cli(const std::vector<std::string>& args, const std::fil
     int e = open(p.err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(o, 1);
     dup2(e, 2);
-    execv(PYROLUME_BIN, argv.data());
+    execv(argv_s[0].c_str(), argv.data());
     _exit(99);
   }
   return p;

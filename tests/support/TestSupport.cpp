@@ -4,19 +4,30 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <random>
 #include <sstream>
 #include <stdexcept>
 
+// Defined by the AddressSanitizer runtime, absent (null) elsewhere.
+extern "C" void __asan_init() __attribute__((weak));
+
 namespace pyrolume::test {
+
+bool address_sanitizer() { return __asan_init != nullptr; }
+
+const char* pyrolume_bin() {
+  const char* env = std::getenv("PYROLUME_BIN");
+  return env && *env ? env : PYROLUME_BIN;
+}
 
 namespace {
 CliResult run_shell(const std::string& prefix, const std::string& args) {
   auto dir = temp_dir("cli");
   auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-  std::string cmd = prefix + std::string(PYROLUME_BIN) + " " + args + " >" + out.string() + " 2>" + err.string();
+  std::string cmd = prefix + std::string(pyrolume_bin()) + " " + args + " >" + out.string() + " 2>" + err.string();
   int raw = std::system(cmd.c_str());
   CliResult r;
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;

@@ -6,30 +6,24 @@
 
 namespace pyrolume::test {
 
-// Linked with AddressSanitizer (tools/sanitize; CMake defines
-// PYROLUME_SANITIZE, since the test files themselves are compiled without
-// it): such a process, and the CLI it starts, cannot run under `ulimit -v`
-// (the shadow memory reserves terabytes of address space), and byte-by-byte
-// sweeps of damaged files run ~7x slower, so they sample fewer positions
-// there (the fuzzers cover the rest under the sanitizers).
-#if defined(PYROLUME_SANITIZE) || defined(__SANITIZE_ADDRESS__)
-constexpr bool kAddressSanitizer = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kAddressSanitizer = true;
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
+// Linked with AddressSanitizer (tools/sanitize): such a process, and the CLI
+// it starts, cannot run under `ulimit -v` (the shadow memory reserves
+// terabytes of address space), and byte-by-byte sweeps of damaged files run
+// ~7x slower, so they sample fewer positions there (the fuzzers cover the
+// rest under the sanitizers). Asked at run time: the sanitizer build links
+// the test files the gcc build compiled (docs/robustness.md "Sanitizers").
+bool address_sanitizer();
+
+// The pyrolume binary the tests run: $PYROLUME_BIN when set (the sanitizer
+// build's ctest sets its own CLI there), else the one built beside the tests.
+const char* pyrolume_bin();
 
 struct CliResult {
   int status = -1;  // exit status of the pyrolume binary
   std::string out, err;
 };
 
-// Runs PYROLUME_BIN with the given argument string (shell-quoted by the caller).
+// Runs pyrolume_bin() with the given argument string (shell-quoted by the caller).
 CliResult run_cli(const std::string& args);
 // The same with address space limited to `kib` KiB (`ulimit -v`), as a render
 // farm limits a job: what a memory check must refuse before allocating.

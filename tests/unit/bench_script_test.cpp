@@ -43,7 +43,7 @@ TEST(BenchScript, TinyCpuRunWritesCsvAndKeepsHandWrittenMarkdown) {
   write_file(dir / "benchmarks.md",
              "# hand-written title\n<!-- bench:begin -->\nold numbers\n<!-- bench:end -->\nhand-written tail\n");
 
-  const std::string cmd = std::string(kPython) + " " + script.string() + " --pyrolume " + PYROLUME_BIN +
+  const std::string cmd = std::string(kPython) + " " + script.string() + " --pyrolume " + pyrolume::test::pyrolume_bin() +
                           " --scenes homogeneous_spheres,fire --configs 'cpu*' --ref-backend cpu" +
                           " --resolution 24x16 --spp-max 2 --ref-spp 8 --reps 1 --quick --no-plot" +
                           " --data-dir " + (dir / "no-such-dir").string() + " --out-dir " + dir.string() +

@@ -20,7 +20,7 @@ constexpr uint64_t kGiB = uint64_t(1) << 20;  // in KiB, as ulimit -v takes it
 class CliMemoryLimits : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (kAddressSanitizer) GTEST_SKIP() << "ulimit -v and AddressSanitizer do not mix";
+    if (address_sanitizer()) GTEST_SKIP() << "ulimit -v and AddressSanitizer do not mix";
   }
 };
 

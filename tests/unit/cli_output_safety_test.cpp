@@ -252,7 +252,7 @@ TEST(CliOutputSafety, RegularFilesUnderDevAreReplacedNotAppendedTo) {
 // Runs the CLI as a farm job logs: stdout appended (>>) to `log`.
 CliResult run_cli_into_log(const std::string& args, const fs::path& log) {
   const fs::path err = log.parent_path() / "stderr.txt";
-  const int raw = std::system((std::string(PYROLUME_BIN) + " " + args + " >>" + q(log) + " 2>" + q(err)).c_str());
+  const int raw = std::system((std::string(pyrolume_bin()) + " " + args + " >>" + q(log) + " 2>" + q(err)).c_str());
   CliResult r;
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
   r.err = read_file(err);

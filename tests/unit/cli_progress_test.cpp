@@ -62,7 +62,7 @@ TEST(CliProgress, TerminalShowsLoadingThenTheBarAndClearsTheLine) {
   const fs::path out = dir / "fire.exr";
   int status = -1;
   const std::string drawn =
-      stderr_on_terminal({PYROLUME_BIN, "render", std::string(PYROLUME_SOURCE_DIR) + "/assets/scenes/fire.json", "-o",
+      stderr_on_terminal({pyrolume_bin(), "render", std::string(PYROLUME_SOURCE_DIR) + "/assets/scenes/fire.json", "-o",
                           out.string(), "--backend", "cpu", "--spp", "4", "--width", "16", "--height", "9"},
                          status);
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << drawn;
@@ -82,7 +82,7 @@ TEST(CliProgress, TerminalShowsLoadingThenTheBarAndClearsTheLine) {
 
 TEST(CliProgress, NothingIsDrawnOffATerminal) {
   const fs::path dir = temp_dir("progress_pipe");
-  const std::string cmd = std::string(PYROLUME_BIN) + " render '" + PYROLUME_SOURCE_DIR +
+  const std::string cmd = std::string(pyrolume_bin()) + " render '" + PYROLUME_SOURCE_DIR +
                           "/assets/scenes/fire.json' -o '" + (dir / "fire.exr").string() +
                           "' --backend cpu --spp 4 --width 16 --height 9 >/dev/null 2>'" + (dir / "err").string() + "'";
   const int raw = std::system(cmd.c_str());

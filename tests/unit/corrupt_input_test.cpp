@@ -57,7 +57,7 @@ void write_bytes(const fs::path& p, const Bytes& b, size_t n) {
 std::vector<size_t> sample_positions(size_t n) {
   std::vector<size_t> at;
   for (size_t i = 0; i < n && i < 160; ++i) at.push_back(i);
-  const size_t spread = test::kAddressSanitizer ? 32 : 160;
+  const size_t spread = test::address_sanitizer() ? 32 : 160;
   const size_t step = std::max<size_t>(1, (n > 160 ? n - 160 : 0) / spread);
   for (size_t i = 160; i < n; i += step) at.push_back(i);
   return at;
@@ -173,7 +173,7 @@ TEST(CorruptVdb, EveryDamagedByteIsReadOrRefused) {
     for (size_t i : sample_positions(good.size()))
       for (char v : {char(0xff), char(0x7f)}) {
         if (good[i] == v) continue;
-        if (test::kAddressSanitizer && (v == char(0xff)) != (i % 2 == 0)) continue;
+        if (test::address_sanitizer() && (v == char(0xff)) != (i % 2 == 0)) continue;
         Bytes b = good;
         b[i] = v;
         write_bytes(p, b, b.size());

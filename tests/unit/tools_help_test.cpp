@@ -15,7 +15,7 @@ namespace fs = std::filesystem;
 using namespace pyrolume::test;
 
 TEST(ToolsHelp, EveryToolAnswersHelpWritesNothingAndExitsZero) {
-  const fs::path bin = fs::path(PYROLUME_BIN).parent_path(), tools = fs::path(PYROLUME_SOURCE_DIR) / "tools";
+  const fs::path bin = fs::path(pyrolume_bin()).parent_path(), tools = fs::path(PYROLUME_SOURCE_DIR) / "tools";
   // The C++ tools are not built in the sanitizer build; the scripts always exist.
   std::vector<fs::path> list = {tools / "demo",     tools / "test",   tools / "fuzz",
                                 tools / "sanitize", tools / "encode", tools / "gen_cie_tables",
@@ -43,7 +43,7 @@ TEST(ToolsHelp, EveryToolAnswersHelpWritesNothingAndExitsZero) {
 // A bad argument: exit status 2, nothing written, and a line on stderr that
 // names it (docs: bad input gets a one-line error naming the key).
 TEST(ToolsHelp, EveryCppToolNamesABadArgumentAndExitsTwo) {
-  const fs::path bin = fs::path(PYROLUME_BIN).parent_path();
+  const fs::path bin = fs::path(pyrolume_bin()).parent_path();
   struct Case {
     std::vector<std::string> args;  // tool, then its arguments
     std::string named;              // what stderr must name

@@ -42,7 +42,7 @@ bool on_path(const std::string& program) {
 CliResult run_wrapped(const std::string& prefix, const std::string& args) {
   auto dir = temp_dir("preview-cli");
   auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-  std::string cmd = prefix + " " + PYROLUME_BIN + " " + args + " >" + out.string() + " 2>" + err.string();
+  std::string cmd = prefix + " " + pyrolume_bin() + " " + args + " >" + out.string() + " 2>" + err.string();
   int raw = std::system(cmd.c_str());
   CliResult r;
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;

@@ -39,7 +39,7 @@ TEST(SequenceFarm, XargsParallelFramesMatchASerialRun) {
   ASSERT_EQ(serial.status, 0) << serial.err;
 
   // As in docs/render-farm.md: one process per frame, three at a time.
-  const std::string cmd = "cd '" + dir.string() + "' && seq 1 3 | xargs -P 3 -I{} '" + PYROLUME_BIN +
+  const std::string cmd = "cd '" + dir.string() + "' && seq 1 3 | xargs -P 3 -I{} '" + std::string(test::pyrolume_bin()) +
                           "' render s.json --frames {} -o 'farm/f_####.exr' --skip-existing >farm.log 2>&1";
   int raw = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << read_file(dir / "farm.log");
