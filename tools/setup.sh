@@ -50,8 +50,7 @@ pyrolume_build() {
 # The clang ASan+UBSan+libFuzzer build (tools/sanitize, tools/fuzz; one build
 # dir serves both): pyrolume_core, the CLI and tests/fuzz. The unit tests are
 # linked from the test files the gcc build compiled (they are not
-# instrumented either way), so that build makes those first, and the fuzzers'
-# seed writer, which only writes files.
+# instrumented either way), so that build makes those first.
 # -O2 keeps the Monte Carlo unit tests quick; no NDEBUG, so asserts are on.
 # No debug info by default: line tables cost about a sixth of the build
 # (the OpenVDB batch 156 s with -g1, 129 s without); reports still name each
@@ -60,7 +59,7 @@ PYROLUME_FUZZ_BUILD="${PYROLUME_FUZZ_BUILD:-$PYROLUME_ROOT/build-fuzz}"
 pyrolume_build_fuzz() {
   local jobs
   jobs="$(nproc 2>/dev/null || echo 2)"
-  pyrolume_build pyrolume_test_support unit_test_cases fuzz_seeds
+  pyrolume_build pyrolume_test_support unit_test_cases
   cmake -S "$PYROLUME_ROOT" -B "$PYROLUME_FUZZ_BUILD" -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 ${PYROLUME_SANITIZE_G:--g0}" \
     -DPYROLUME_FUZZ=ON -DPYROLUME_TEST_OBJECTS_FROM="$PYROLUME_BUILD" >&2
