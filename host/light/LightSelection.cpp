@@ -36,6 +36,17 @@ LightCandidates light_candidates(const Scene& scene) {
   return c;
 }
 
+LineMediaRule line_media_rule(const Integrator& in) {
+  if (!in.emission_estimator) return LineMediaRule::Thin;
+  return *in.emission_estimator == EmissionEstimator::Line ? LineMediaRule::EveryEmitting : LineMediaRule::None;
+}
+
+EmissionEstimator choose_emission_estimator(const Integrator& in, bool line_media, LightStrategy strategy) {
+  if (in.emission_estimator) return *in.emission_estimator;
+  if (line_media) return EmissionEstimator::Line;
+  return strategy == LightStrategy::Bsdf ? EmissionEstimator::Absorption : EmissionEstimator::Collision;
+}
+
 LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs,
                              bool line_media) {
   const Integrator& in = scene.integrator;
@@ -69,9 +80,7 @@ LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, cons
     if (power[i] > 0.0) s.p_light[i] = distant ? far_share * power[i] / far_power : near_share * power[i] / near_power;
   }
   s.strategy = !s.any() ? LightStrategy::Bsdf : (in.light_only ? LightStrategy::LightOnly : LightStrategy::Mis);
-  s.estimator = in.emission_estimator.value_or(line_media                        ? EmissionEstimator::Line
-                                               : s.strategy == LightStrategy::Bsdf ? EmissionEstimator::Absorption
-                                                                                   : EmissionEstimator::Collision);
+  s.estimator = choose_emission_estimator(in, line_media, s.strategy);
   s.p_continue_own =
       s.strategy == LightStrategy::Bsdf ? 1.0 : 1.0 - in.guided_continuation.value_or(1.0 - kContinueOwn);
   s.surface_light_samples = s.strategy == LightStrategy::Bsdf ? 1 : in.surface_light_samples;

@@ -54,10 +54,7 @@ struct LightSelection {
   // Per entry of Scene::lights: probability of picking it.
   std::vector<double> p_light;
   LightStrategy strategy = LightStrategy::Bsdf;
-  // What both backends render with: the file's estimator, or for "auto" the
-  // line estimator where it collects some medium (line_media), else
-  // the collision estimator with light sampling (what MIS is written for) and
-  // the absorption estimator without (the fastest for BSDF/phase sampling).
+  // What both backends render with (choose_emission_estimator).
   EmissionEstimator estimator = EmissionEstimator::Absorption;
   // With next-event estimation, the probability that a vertex's continuation
   // is drawn from its own lobe; otherwise from the lights, by the same
@@ -81,6 +78,22 @@ struct LightSelection {
   }
 };
 
+// The emission estimator is chosen here and only here: these two functions
+// are the only readers of integrator.emission_estimator's choice. The
+// scene's estimator when it names one; for "auto", the line estimator where
+// it collects some medium, else the collision estimator with light sampling
+// (what MIS is written for) and the absorption estimator without (the
+// fastest for BSDF/phase sampling).
+//
+// Which emitting media the line estimator collects (line_media in
+// host/render/LineEstimator.h applies it): none when the scene names another
+// estimator, every emitting medium when it names "line", and for "auto" the
+// thin ones that give a fair share of the emitted power.
+enum class LineMediaRule { None, EveryEmitting, Thin };
+LineMediaRule line_media_rule(const Integrator& in);
+// line_media: the line estimator collects some medium (LineMedia::any).
+EmissionEstimator choose_emission_estimator(const Integrator& in, bool line_media, LightStrategy strategy);
+
 // env: the loaded environment map or null; cdfs: per scene medium, its emission
 // CDF or null (homogeneous media and grids that emit nothing are not lights).
 // Only the kinds light_candidates allows are sampled: every other light gets
@@ -99,9 +112,9 @@ struct LightSelection {
 // (EmissionCdf::power) against light_power's watts.
 //
 // Strategy: Mis (LightOnly with integrator.light_only) when at least one light
-// is sampled, otherwise Bsdf. Estimator: as the file says, "auto" resolved by
-// line_media (the line estimator collects some medium: line_media() in
-// host/render/LineEstimator.h) and the strategy. Throws std::invalid_argument
+// is sampled, otherwise Bsdf. Estimator: choose_emission_estimator, with
+// line_media telling whether the line estimator collects some medium
+// (line_media() in host/render/LineEstimator.h). Throws std::invalid_argument
 // for integrator keys that contradict each other (integrator_conflict; the
 // loader refuses such files).
 LightSelection select_lights(const Scene& scene, const EnvironmentMap* env, const std::vector<const EmissionCdf*>& cdfs,

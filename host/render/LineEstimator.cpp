@@ -5,6 +5,7 @@
 
 #include "color/ColorSpace.h"
 #include "light/EmissionCdf.h"
+#include "light/LightSelection.h"
 #include "scene/MediumVolume.h"
 #include "util/Math.h"
 
@@ -97,12 +98,13 @@ bool homogeneous_emission_is_thin(const Medium& m) {
 
 LineMedia line_media(const Scene& scene, const std::vector<const StoredVolume*>& volumes) {
   const size_t n = scene.media.size();
-  const std::optional<EmissionEstimator> asked = scene.integrator.emission_estimator;
+  const LineMediaRule rule = line_media_rule(scene.integrator);
+  const bool every = rule == LineMediaRule::EveryEmitting;
   LineMedia out;
   out.line.assign(n, false);
   out.rates.resize(n);
   out.majorant_res.assign(n, glm::ivec3(0));
-  if (asked && *asked != EmissionEstimator::Line) return out;
+  if (rule == LineMediaRule::None) return out;
   std::vector<double> power(n, 0.0);
   double total = 0.0;
   for (size_t i = 0; i < n; ++i) {
@@ -110,7 +112,7 @@ LineMedia line_media(const Scene& scene, const std::vector<const StoredVolume*>&
     if (!m.emission.emits()) continue;
     if (m.type == Medium::Type::Homogeneous) {
       power[i] = color::srgb_luminance(m.sigma_a * homogeneous_le(m.emission)) * m.bounds.volume();
-      out.line[i] = asked || homogeneous_emission_is_thin(m);
+      out.line[i] = every || homogeneous_emission_is_thin(m);
     } else {
       const StoredVolume* vol = i < volumes.size() ? volumes[i] : nullptr;
       if (!vol || vol->density.grid.empty()) continue;
@@ -120,13 +122,13 @@ LineMedia line_media(const Scene& scene, const std::vector<const StoredVolume*>&
       out.majorant_res[i] = majorant_resolution(scene, m, density);
       LineRates rates = line_rates(m, density, temperature, build_majorant_grid(density, out.majorant_res[i]));
       power[i] = rates.power;
-      out.line[i] = asked || rates.thin();
+      out.line[i] = every || rates.thin();
       out.rates[i] = std::move(rates.rate);
     }
     total += std::max(0.0, power[i]);
   }
   for (size_t i = 0; i < n; ++i) {
-    if (!asked) out.line[i] = out.line[i] && power[i] >= kLineMinPowerShare * total;
+    if (rule == LineMediaRule::Thin) out.line[i] = out.line[i] && power[i] >= kLineMinPowerShare * total;
     if (!out.line[i]) out.rates[i].clear();
   }
   return out;

@@ -77,12 +77,14 @@ struct LineMedia {
   bool any() const { return std::find(line.begin(), line.end(), true) != line.end(); }
 };
 
-// Which media the line estimator collects: every emitting medium where the
-// file asks for "line"; with "auto", the media whose emission is thin and that
-// give at least kLineMinPowerShare of the emitted power (Y(σa·Le) over the
-// medium's volume; for grids the emission bound's integral). volumes[i]:
-// medium i's grids (null for homogeneous media). The scene's estimator is
-// "line" where any medium is (select_lights).
+// Which media the line estimator collects, by line_media_rule
+// (host/light/LightSelection.h, where the estimator is chosen): every
+// emitting medium where the file asks for "line"; with "auto", the media
+// whose emission is thin and that give at least kLineMinPowerShare of the
+// emitted power (Y(σa·Le) over the medium's volume; for grids the emission
+// bound's integral). volumes[i]: medium i's grids (null for homogeneous
+// media). The render's estimator is "line" where any medium is
+// (choose_emission_estimator).
 LineMedia line_media(const Scene& scene, const std::vector<const StoredVolume*>& volumes);
 
 }  // namespace pyrolume

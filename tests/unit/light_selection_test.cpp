@@ -146,6 +146,31 @@ TEST(LightDefaults, CandidatesFromTheKeys) {
   }
 }
 
+// The estimator is chosen in one place: every estimator the file can name
+// (or "auto"), with and without a medium the line estimator would collect,
+// with and without light sampling, and which media the line estimator takes.
+TEST(LightDefaults, OneChoiceOfEstimator) {
+  using E = EmissionEstimator;
+  const std::optional<E> asked[] = {std::nullopt, E::Absorption, E::Collision, E::Line};
+  for (const std::optional<E>& a : asked)
+    for (bool line : {false, true})
+      for (LightStrategy k : {LightStrategy::Bsdf, LightStrategy::Mis, LightStrategy::LightOnly}) {
+        Integrator in;
+        in.emission_estimator = a;
+        const E want = a ? *a : line ? E::Line : k == LightStrategy::Bsdf ? E::Absorption : E::Collision;
+        EXPECT_EQ(choose_emission_estimator(in, line, k), want)
+            << (a ? to_string(*a) : "auto") << " line " << line << " " << strategy_name(k);
+      }
+  Integrator in;
+  EXPECT_EQ(line_media_rule(in), LineMediaRule::Thin);
+  in.emission_estimator = E::Line;
+  EXPECT_EQ(line_media_rule(in), LineMediaRule::EveryEmitting);
+  for (E other : {E::Absorption, E::Collision}) {
+    in.emission_estimator = other;
+    EXPECT_EQ(line_media_rule(in), LineMediaRule::None) << to_string(other);
+  }
+}
+
 // A fire alone: BSDF/phase sampling with the absorption estimator, its grid
 // not a light; "mis": true written out samples it.
 TEST_F(LightResolution, FireAlone) {
