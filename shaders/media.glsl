@@ -67,23 +67,6 @@ vec3 blackbody_at(uint slot, float s) {
   }
 }
 
-// Grid fields are read straight from the uniform block, and with at most one
-// texture the switch's other lookups compile out (docs/rendering.md "llvmpipe workarounds": no struct copies of
-// large uniforms; every branch runs).
-vec3 albedo_texture_at(uint slot, vec2 uv) {
-  if (ALBEDO_TEXTURE_COUNT <= 1u) return textureLod(albedo_tex[0], uv, 0.0).rgb;
-  switch (slot) {
-    case 0u: return textureLod(albedo_tex[0], uv, 0.0).rgb;
-    case 1u: return textureLod(albedo_tex[1], uv, 0.0).rgb;
-    case 2u: return textureLod(albedo_tex[2], uv, 0.0).rgb;
-    case 3u: return textureLod(albedo_tex[3], uv, 0.0).rgb;
-    case 4u: return textureLod(albedo_tex[4], uv, 0.0).rgb;
-    case 5u: return textureLod(albedo_tex[5], uv, 0.0).rgb;
-    case 6u: return textureLod(albedo_tex[6], uv, 0.0).rgb;
-    default: return textureLod(albedo_tex[7], uv, 0.0).rgb;
-  }
-}
-
 vec3 density_texel(uint slot, vec3 p) {
   vec4 p1 = vec4(p, 1.0);
   return vec3(dot(grids[slot].density.row0, p1), dot(grids[slot].density.row1, p1), dot(grids[slot].density.row2, p1));
