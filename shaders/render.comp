@@ -19,6 +19,7 @@ layout(local_size_x = WORKGROUP_SIZE_X, local_size_y = WORKGROUP_SIZE_Y) in;
 
 #include "render_bindings.glsl"
 #include "media.glsl"
+#include "majorant_walk.glsl"
 #include "surface_textures.glsl"
 #include "light_sampling.glsl"
 #include "path_state.glsl"

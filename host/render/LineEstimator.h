@@ -59,7 +59,7 @@ LineRates line_rates(const Medium& m, const DenseGrid& density, const DenseGrid*
 glm::ivec3 majorant_resolution(const Scene& scene, const Medium& m, const DenseGrid& density);
 
 // A homogeneous medium (constant emission) is one cell: each ray gets
-// kLinePointsPerCell points along its chord through it (shaders/media.glsl
+// kLinePointsPerCell points along its chord through it (shaders/majorant_walk.glsl
 // majorant_at). Its emission is thin where it emits and σt times its
 // Bounds::smallest_extent is below kThinCollisionsAcross.
 bool homogeneous_emission_is_thin(const Medium& m);

@@ -245,7 +245,7 @@ GpuScene pack_gpu_media(const Scene& scene, const std::vector<std::optional<Stor
     const Medium& m = scene.media[i];
     if (m.type == Medium::Type::Homogeneous) {
       out.media.push_back(pack_analytic_medium(m));
-      // Its line rate comes from each ray's chord (shaders/media.glsl majorant_at).
+      // Its line rate comes from each ray's chord (shaders/majorant_walk.glsl majorant_at).
       if (out.line.line[i]) out.media.back().line_points = float(kLinePointsPerCell);
       out.has_analytic = true;
       out.has_emission = out.has_emission || max3(glm::dvec3(out.media.back().emission)) > 0.0;
