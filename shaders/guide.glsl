@@ -53,12 +53,11 @@ void guide_media(vec3 o, vec3 d, float t_end, vec2 span[MEDIA_N], inout vec3 L, 
     for (uint j = 0u; j < steps && n < GUIDE_MAX_STEPS; ++j, ++n) {
       const float tm = t + (float(j) + 0.5) * dt;
       const vec3 x = o + tm * d;
-      vec3 sigma_a, sigma_s;
-      float rho[MEDIA_N], temperature_value[MEDIA_N];
       uint no_rng = 0u;  // the guide's march reads the trilinear density
-      coefficients_at(x, tm, span, false, sigma_a, sigma_s, rho, temperature_value, stats, no_rng);
-      const vec3 E = emission_at(x, tm, span, rho, temperature_value);
-      const vec3 sigma_t = sigma_a + sigma_s;
+      MediumPoint mp;
+      coefficients_at(x, tm, span, false, mp, stats, no_rng);
+      const vec3 E = emission_at(x, tm, span, mp);
+      const vec3 sigma_t = mp.sigma_a + mp.sigma_s;
       const vec3 tr = exp(-sigma_t * dt);
       // E·Δt where σt·Δt is too small for (1 − e^(−σt·Δt))/σt to keep its digits.
       L += T * mix(E * dt, E * (1.0 - tr) / max(sigma_t, vec3(1e-30)), greaterThan(sigma_t * dt, vec3(1e-4)));

@@ -127,21 +127,31 @@ void media_spans(vec3 o, vec3 d, out vec2 span[MEDIA_N], out bool any_hit) {
   }
 }
 
-// Media coefficients at a tentative collision; rho[i] keeps each grid's
-// density_scale · density for the scattering-lobe choice, and
-// temperature_value[i] its temperature grid's value where the density lookup
-// reads it (TEMPERATURE_IN_DENSITY; else 0). With `stochastic` and
+// What the media are at a point, as one record (coefficients_at): σa and σs
+// summed over the media present; per medium, rho[i] its density_scale ·
+// density (1 for a homogeneous medium; the scattering-lobe choice and the
+// emission read it) and temperature_value[i] its temperature grid's value
+// where the density lookup reads it (TEMPERATURE_IN_DENSITY; else 0). What
+// the path does there (absorb, scatter, null) is the integrator's
+// (tracking.glsl path_track).
+struct MediumPoint {
+  vec3 sigma_a, sigma_s;
+  float rho[MEDIA_N];
+  float temperature_value[MEDIA_N];
+};
+
+// The media at a tentative collision (arrays sized by a specialization
+// constant cannot be returned: an out parameter). With `stochastic` and
 // STOCHASTIC_DENSITY the grids' densities are stochastic_density's unbiased
 // one-texel estimates, and temperature_value is 0 (event_temperatures reads it
 // where the path has its event).
-void coefficients_at(vec3 x, float t, vec2 span[MEDIA_N], bool stochastic, out vec3 sigma_a, out vec3 sigma_s,
-                     out float rho[MEDIA_N], out float temperature_value[MEDIA_N], inout PathStats stats,
-                     inout uint rng) {
-  sigma_a = vec3(0.0);
-  sigma_s = vec3(0.0);
+void coefficients_at(vec3 x, float t, vec2 span[MEDIA_N], bool stochastic, out MediumPoint mp,
+                     inout PathStats stats, inout uint rng) {
+  mp.sigma_a = vec3(0.0);
+  mp.sigma_s = vec3(0.0);
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
-    rho[i] = 0.0;
-    temperature_value[i] = 0.0;
+    mp.rho[i] = 0.0;
+    mp.temperature_value[i] = 0.0;
     if (!(span[i].x <= t && t < span[i].y)) continue;
     GpuMedium m = media[i];
     float r = 1.0;
@@ -150,12 +160,12 @@ void coefficients_at(vec3 x, float t, vec2 span[MEDIA_N], bool stochastic, out v
       const vec2 v = STOCHASTIC_DENSITY && stochastic ? vec2(stochastic_density(slot, density_texel(slot, x), rng), 0.0)
                                                       : density_at(slot, density_texel(slot, x));
       r = grids[slot].density_scale * v.x;
-      temperature_value[i] = v.y;
+      mp.temperature_value[i] = v.y;
       stats.lookups += 1.0;
     }
-    rho[i] = r;
-    sigma_a += r * m.sigma_a;
-    sigma_s += r * m.sigma_s;
+    mp.rho[i] = r;
+    mp.sigma_a += r * m.sigma_a;
+    mp.sigma_s += r * m.sigma_s;
   }
 }
 
@@ -163,23 +173,23 @@ void coefficients_at(vec3 x, float t, vec2 span[MEDIA_N], bool stochastic, out v
 // (TEMPERATURE_IN_DENSITY reads them with the density; otherwise grid_le reads
 // its own texture): the emission needs the trilinear value, since Le is not
 // linear in T.
-void event_temperatures(vec3 x, float t, vec2 span[MEDIA_N], inout float temperature_value[MEDIA_N]) {
+void event_temperatures(vec3 x, float t, vec2 span[MEDIA_N], inout MediumPoint mp) {
   if (!STOCHASTIC_DENSITY || !TEMPERATURE_IN_DENSITY) return;
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     if (!(span[i].x <= t && t < span[i].y) || !is_grid(media[i])) continue;
     const uint slot = media[i].grid_slot;
-    temperature_value[i] = density_at(slot, density_texel(slot, x)).y;
+    mp.temperature_value[i] = density_at(slot, density_texel(slot, x)).y;
   }
 }
 
 // Emitted power per unit length, Σ sigma_a_i(x)·Le_i(x), over the media at t.
-vec3 emission_at(vec3 x, float t, vec2 span[MEDIA_N], float rho[MEDIA_N], float temperature_value[MEDIA_N]) {
+vec3 emission_at(vec3 x, float t, vec2 span[MEDIA_N], MediumPoint mp) {
   vec3 E = vec3(0.0);
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     if (!(span[i].x <= t && t < span[i].y)) continue;
     GpuMedium m = media[i];
     if (is_grid(m)) {
-      if (rho[i] > 0.0) E += rho[i] * m.sigma_a * grid_le(m, m.grid_slot, x, temperature_value[i]);
+      if (mp.rho[i] > 0.0) E += mp.rho[i] * m.sigma_a * grid_le(m, m.grid_slot, x, mp.temperature_value[i]);
     } else {
       E += m.emission;
     }

@@ -62,8 +62,8 @@ int path_begin(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng) {
 
 
 // What a ray segment's event does (path_step's end); true when the path has ended.
-bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, float rho[MEDIA_N],
-                float temperature_value[MEDIA_N], inout uint rng, inout PathStats stats) {
+bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, MediumPoint mp, inout uint rng,
+                inout PathStats stats) {
   const vec3 x = c.x, sigma_s = c.sigma_s;
   const float sigma_maj = c.sigma_maj, p_a = c.p_a, p_s = c.p_s;
   if (event == EVENT_ESCAPE) {
@@ -105,13 +105,13 @@ bool path_event(inout PathState p, vec2 span[MEDIA_N], uint event, Collision c, 
       // rho is the free flight's (stochastic) estimate, as in P_a and P_s:
       // sigma_a(rho)/(sigma_maj·P) keeps its expectation; the temperature is
       // the trilinear value (media.glsl event_temperatures).
-      event_temperatures(x, p.t, span, temperature_value);
-      p.L += p.w * emission_at(x, p.t, span, rho, temperature_value) /
+      event_temperatures(x, p.t, span, mp);
+      p.L += p.w * emission_at(x, p.t, span, mp) /
              (sigma_maj * (event == EVENT_ABSORB ? p_a : p_s));
     }
     if (event == EVENT_ABSORB) return ray_ends(p);
   }
-  return scatter_vertex(p, surface, x, sigma_s, sigma_maj, p_s, rho, rng, stats);
+  return scatter_vertex(p, surface, x, sigma_s, sigma_maj, p_s, mp.rho, rng, stats);
 }
 
 // One step of delta tracking along one path: its next ray if needed, free
@@ -120,10 +120,10 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   const int begun = path_begin(p, span, rng);
   if (begun != RAY_READY) return begun == PATH_ENDED;
   Collision c;
-  float rho[MEDIA_N], temperature_value[MEDIA_N];
-  const uint event = path_track(p, span, rng, stats, c, rho, temperature_value);
+  MediumPoint mp;
+  const uint event = path_track(p, span, rng, stats, c, mp);
   if (event == EVENT_NONE) return false;  // EARLY_EVENT_EXIT: still in free flight
-  return path_event(p, span, event, c, rho, temperature_value, rng, stats);
+  return path_event(p, span, event, c, mp, rng, stats);
 }
 
 // The camera ray's direction through film point pixel + jitter (jitter in [0,1)²).

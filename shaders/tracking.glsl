@@ -23,10 +23,9 @@ vec3 transmittance(vec3 o, vec3 d, bool ratio, inout uint rng, inout PathStats s
     float dt = sample_free_flight(sigma_maj, rng_next(rng));
     if (t + dt >= t_next) { t = t_next; continue; }
     t += dt;
-    vec3 sigma_a, sigma_s;
-    float rho[MEDIA_N], temperature_value[MEDIA_N];
-    coefficients_at(o + t * d, t, span, true, sigma_a, sigma_s, rho, temperature_value, stats, rng);
-    vec3 sigma_n = max(vec3(sigma_maj) - sigma_a - sigma_s, vec3(0.0));
+    MediumPoint mp;
+    coefficients_at(o + t * d, t, span, true, mp, stats, rng);
+    vec3 sigma_n = max(vec3(sigma_maj) - mp.sigma_a - mp.sigma_s, vec3(0.0));
     if (ratio) {
       T *= sigma_n / sigma_maj;
       float q = max3(T);
@@ -71,7 +70,7 @@ const bool ONE_GRID = HAS_GRIDS && !HAS_ANALYTIC_MEDIA && MEDIUM_COUNT == 1u;
 // path weight w then picks up sigma_x / (sigma_maj·P_x) per channel. For grey
 // media every factor is 1 and this is plain delta tracking.
 uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout PathStats stats, out Collision c_out,
-                out float rho[MEDIA_N], out float temperature_value[MEDIA_N]) {
+                out MediumPoint mp) {
   // Free flights, until the ray meets what needs more than a density lookup:
   // a surface, a real event, the end of the media, a light ray's lost
   // roulette. The cheap steps loop here and the event code runs once per
@@ -86,7 +85,8 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
   // way, so the image is bit-identical.
   uint event = EVENT_NONE;
   float sigma_maj = 0.0, p_a = 0.0, p_s = 0.0;
-  vec3 x = vec3(0.0), sigma_a = vec3(0.0), sigma_s = vec3(0.0);
+  vec3 x = vec3(0.0);
+  mp.sigma_a = mp.sigma_s = vec3(0.0);
   for (;;) {
     if (event == EVENT_NONE) do {
       const float t_surface = p.has_hit ? p.hit.t : INF;
@@ -132,16 +132,16 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
       x = p.o + p.t * p.d;
       // The collision estimator collects emission at every tentative collision: it
       // reads the trilinear density and temperature there.
-      coefficients_at(x, p.t, span, !COLLISION_ESTIMATOR, sigma_a, sigma_s, rho, temperature_value, stats, rng);
+      coefficients_at(x, p.t, span, !COLLISION_ESTIMATOR, mp, stats, rng);
       if (HAS_EMISSION && COLLISION_ESTIMATOR && !p.skip_segment) {
         // Collision estimator (pbrt-v4 volpath): sigma_a·Le/sigma_maj at every tentative collision;
         // the line estimator is this one with sigma_maj raised to the line rates (grid_majorant).
         // With next-event estimation the ray's own MIS weight (light rays: 1). A skipped
         // segment (ratio-tracked continuation) was already collected: no lookup.
-        vec3 e = emission_at(x, p.t, span, rho, temperature_value);
+        vec3 e = emission_at(x, p.t, span, mp);
         if (max3(e) > 0.0) p.L += (unidirectional_weight(p.pdf_dir, p.p_light) / sigma_maj) * p.w * e;
       }
-      vec3 sigma_n = max(vec3(sigma_maj) - sigma_a - sigma_s, vec3(0.0));
+      vec3 sigma_n = max(vec3(sigma_maj) - mp.sigma_a - mp.sigma_s, vec3(0.0));
       if (NEE && p.light_ray) {
         // Light rays: ratio tracking (docs/mis.md "Light rays"): no event is
         // chosen, the weight takes the null fraction, Russian roulette once the
@@ -160,8 +160,8 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
         continue;
       }
       float c = sigma_maj * avg3(p.w);
-      p_a = avg3(sigma_a * p.w) / c;
-      p_s = HAS_SCATTERING ? avg3(sigma_s * p.w) / c : 0.0;
+      p_a = avg3(mp.sigma_a * p.w) / c;
+      p_s = HAS_SCATTERING ? avg3(mp.sigma_s * p.w) / c : 0.0;
       // A real collision scatters whenever it can (implicit capture,
       // docs/mis.md "No absorption events"): the scattering's weight
       // sigma_s / (sigma_maj·(P_a + P_s)) keeps the expectation, and the
@@ -192,6 +192,6 @@ uint path_track(inout PathState p, vec2 span[MEDIA_N], inout uint rng, inout Pat
       if (2u * tracking <= lanes) break;
     }
   }
-  c_out = Collision(x, sigma_s, sigma_maj, p_a, p_s, sigma_a);
+  c_out = Collision(x, mp.sigma_s, sigma_maj, p_a, p_s, mp.sigma_a);
   return event;
 }

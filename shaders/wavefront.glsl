@@ -78,7 +78,7 @@ uint b2u(bool b) { return b ? 1u : 0u; }
 // Path slot `slot`'s state. TRACK moves only what free flights read and
 // write (everything = false): words 0–8 and each medium's first word.
 void path_io(bool store, bool everything, uint slot, inout PathState p, inout SlotState s, inout vec2 span[MEDIA_N],
-             inout float rho[MEDIA_N], inout float temperature_value[MEDIA_N]) {
+             inout MediumPoint mp) {
   const uint base = slot * PATH_STRIDE;
   io_v3f(store, base + 0u, p.o, p.t);
   io_v3f(store, base + 1u, p.d, p.pdf_dir);
@@ -104,13 +104,13 @@ void path_io(bool store, bool everything, uint slot, inout PathState p, inout Sl
   p.alpha = uintBitsToFloat(u.z);
   for (uint i = 0u; i < MEDIUM_COUNT; ++i) {
     const uint m = base + WAVEFRONT_PATH_WORDS + i * WAVEFRONT_PATH_WORDS_PER_MEDIUM;
-    vec4 f = vec4(span[i], rho[i], temperature_value[i]);
+    vec4 f = vec4(span[i], mp.rho[i], mp.temperature_value[i]);
     u = floatBitsToUint(f);
     io(store, m, u);
     f = uintBitsToFloat(u);
     span[i] = f.xy;
-    rho[i] = f.z;
-    temperature_value[i] = f.w;
+    mp.rho[i] = f.z;
+    mp.temperature_value[i] = f.w;
     if (everything) io_v3f(store, m + 1u, p.vertex_share[i], p.vertex_q[i]);
   }
   if (!everything) return;
@@ -213,7 +213,7 @@ void wavefront_main() {
   PathState p;
   SlotState s;
   vec2 span[MEDIA_N];
-  float rho[MEDIA_N], temperature_value[MEDIA_N];
+  MediumPoint mp;  // per medium rho and temperature_value travel (path_io); sigma_a, sigma_s do not
   const uint read = queues.track_read, fill = read ^ 1u;
   if (WAVEFRONT_STAGE == WAVEFRONT_START) {
     const uvec2 pixel = gl_GlobalInvocationID.xy + uvec2(0u, pass_constants.row_begin);
@@ -226,13 +226,13 @@ void wavefront_main() {
     s.stats = PathStats(0.0, 0.0);
     s.event = EVENT_NONE;
     s.c = Collision(vec3(0.0), vec3(0.0), 0.0, 0.0, 0.0, vec3(0.0));
-    for (uint i = 0u; i < MEDIUM_COUNT; ++i) rho[i] = temperature_value[i] = 0.0;
+    for (uint i = 0u; i < MEDIUM_COUNT; ++i) mp.rho[i] = mp.temperature_value[i] = 0.0;
     camera_path(pixel, s.k, s.rng, p);
     if (!settle(pixel, p, s, span, false)) {
       finish_slot(slot, s);
       return;
     }
-    path_io(true, true, slot, p, s, span, rho, temperature_value);
+    path_io(true, true, slot, p, s, span, mp);
     enqueue(fill, slot);
     return;
   }
@@ -240,9 +240,9 @@ void wavefront_main() {
   if (WAVEFRONT_STAGE == WAVEFRONT_TRACK) {
     if (j >= (read == 0u ? queues.track_count0 : queues.track_count1)) return;
     const uint slot = queue_slots[read * queues.capacity + j];
-    path_io(false, false, slot, p, s, span, rho, temperature_value);
-    if (s.pending == 0u) s.event = path_track(p, span, s.rng, s.stats, s.c, rho, temperature_value);
-    path_io(true, false, slot, p, s, span, rho, temperature_value);
+    path_io(false, false, slot, p, s, span, mp);
+    if (s.pending == 0u) s.event = path_track(p, span, s.rng, s.stats, s.c, mp);
+    path_io(true, false, slot, p, s, span, mp);
     enqueue(s.pending != 0u ? (WAVEFRONT_SPLIT ? BEGIN_QUEUE : EVENT_QUEUE) : s.event != EVENT_NONE ? EVENT_QUEUE : fill,
             slot);
     return;
@@ -250,12 +250,12 @@ void wavefront_main() {
   if (WAVEFRONT_STAGE == WAVEFRONT_EVENT) {
     if (j >= queues.event_count) return;
     const uint slot = queue_slots[EVENT_QUEUE * queues.capacity + j];
-    path_io(false, true, slot, p, s, span, rho, temperature_value);
+    path_io(false, true, slot, p, s, span, mp);
     const bool ended = s.pending != 0u ? s.pending == 2u
-                                       : path_event(p, span, s.event, s.c, rho, temperature_value, s.rng, s.stats);
+                                       : path_event(p, span, s.event, s.c, mp, s.rng, s.stats);
     if (WAVEFRONT_SPLIT) {
       s.pending = ended ? 2u : 1u;
-      path_io(true, true, slot, p, s, span, rho, temperature_value);
+      path_io(true, true, slot, p, s, span, mp);
       enqueue(BEGIN_QUEUE, slot);
       return;
     }
@@ -263,18 +263,18 @@ void wavefront_main() {
       finish_slot(slot, s);
       return;
     }
-    path_io(true, true, slot, p, s, span, rho, temperature_value);
+    path_io(true, true, slot, p, s, span, mp);
     enqueue(fill, slot);
   }
   if (WAVEFRONT_STAGE == WAVEFRONT_BEGIN) {
     if (j >= queues.begin_count) return;
     const uint slot = queue_slots[BEGIN_QUEUE * queues.capacity + j];
-    path_io(false, true, slot, p, s, span, rho, temperature_value);
+    path_io(false, true, slot, p, s, span, mp);
     if (!settle(slot_pixel(slot), p, s, span, s.pending == 2u)) {
       finish_slot(slot, s);
       return;
     }
-    path_io(true, true, slot, p, s, span, rho, temperature_value);
+    path_io(true, true, slot, p, s, span, mp);
     enqueue(fill, slot);
   }
 }

@@ -12,10 +12,9 @@
 
 namespace pyrolume::cpu {
 
-void coefficients_at(const MediaData& md, int c, const glm::dvec3& x, Scratch& s, ThreadCounters& cnt,
-                     double& sigma_a, double& sigma_s) {
+MediumCoefficients coefficients_at(const MediaData& md, int c, const glm::dvec3& x, Scratch& s, ThreadCounters& cnt) {
   cnt.step();  // once per tentative collision, the unit every tracking loop advances by
-  sigma_a = sigma_s = 0.0;
+  MediumCoefficients k;
   s.rho.resize(s.present.size());
   for (size_t j = 0; j < s.present.size(); ++j) {
     const MediumData& m = md.media[s.present[j]];
@@ -25,9 +24,10 @@ void coefficients_at(const MediaData& md, int c, const glm::dvec3& x, Scratch& s
       ++cnt.density_lookups;
     }
     s.rho[j] = rho;
-    sigma_a += m.sigma_a[c] * rho;
-    sigma_s += m.sigma_s[c] * rho;
+    k.sigma_a += m.sigma_a[c] * rho;
+    k.sigma_s += m.sigma_s[c] * rho;
   }
+  return k;
 }
 
 double emitted_at(const MediaData& md, int c, const glm::dvec3& x, Scratch& s) {
@@ -67,8 +67,7 @@ double delta_light_ray(const WalkScene& ws, int c, const glm::dvec3& o, const gl
     for (double t = a;;) {
       t += sample_free_flight(sigma_maj, rng.uniform());
       if (!(t < b)) break;
-      double sigma_a, sigma_s;
-      coefficients_at(ws.md, c, o + t * d, s, cnt, sigma_a, sigma_s);
+      const auto [sigma_a, sigma_s] = coefficients_at(ws.md, c, o + t * d, s, cnt);
       if (exceeds_majorant(sigma_a + sigma_s, sigma_maj)) ++cnt.majorant_violations;
       W *= std::max(0.0, 1.0 - (sigma_a + sigma_s) / sigma_maj);
       if (W < kRatioTrackingRouletteBelow) {
@@ -299,15 +298,12 @@ Flight track_media(Walk& w, double t_surf, double w_ray) {
       if (line_rate > 0.0 && w_ray > 0.0)
         for (double t_line = t + sample_free_flight(line_rate, w.rng.uniform()); t_line < std::min(t_flight, b);
              t_line += sample_free_flight(line_rate, w.rng.uniform())) {
-          double sigma_a, sigma_s;
-          coefficients_at(md, c, w.o + t_line * w.d, s, w.cnt, sigma_a, sigma_s);
-          if (sigma_a > 0.0) w.L += w.beta * w_ray * emitted_at(md, c, w.o + t_line * w.d, s) / collect_rate;
+          if (coefficients_at(md, c, w.o + t_line * w.d, s, w.cnt).sigma_a > 0.0) w.L += w.beta * w_ray * emitted_at(md, c, w.o + t_line * w.d, s) / collect_rate;
         }
       t = t_flight;
       if (!(t < b)) break;  // memoryless: restart the flight at b
       const glm::dvec3 x = w.o + t * w.d;
-      double sigma_a, sigma_s;
-      coefficients_at(md, c, x, s, w.cnt, sigma_a, sigma_s);
+      const auto [sigma_a, sigma_s] = coefficients_at(md, c, x, s, w.cnt);
       if (exceeds_majorant(sigma_a + sigma_s, sigma_maj)) ++w.cnt.majorant_violations;
       if (collision_estimator && sigma_a > 0.0) w.L += w.beta * w_ray * emitted_at(md, c, x, s) / collect_rate;
       if (w.role == WalkRole::LightRay) {

@@ -79,10 +79,13 @@ struct WalkScene {
   }
 };
 
-// σa and σs of channel c at x, summed over the media present (s.present);
-// s.rho keeps each one's density for the phase mixture and the emission.
-void coefficients_at(const MediaData& md, int c, const glm::dvec3& x, Scratch& s, ThreadCounters& cnt,
-                     double& sigma_a, double& sigma_s);
+// What the media are at a point, channel c: σa and σs summed over the media
+// present (s.present), one record; s.rho keeps each one's density for the
+// phase mixture and the emission. The walk decides absorb, scatter or null.
+struct MediumCoefficients {
+  double sigma_a = 0.0, sigma_s = 0.0;
+};
+MediumCoefficients coefficients_at(const MediaData& md, int c, const glm::dvec3& x, Scratch& s, ThreadCounters& cnt);
 
 // Σ σa_i Le_i of channel c at x over the media present (after coefficients_at).
 double emitted_at(const MediaData& md, int c, const glm::dvec3& x, Scratch& s);
