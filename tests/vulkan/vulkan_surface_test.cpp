@@ -168,7 +168,10 @@ Scene emissive_medium_over_plane(const std::filesystem::path& dir, int spp, uint
 
 TEST_F(VulkanSurface, AgreesWithCpuOnEmissiveMediumOverTexturedPlane) {
   auto dir = test::temp_dir("vk_surface_medium_plane");
-  const int spp = 1024;
+  // 512 spp: the pooled bias's SE is ~0.07 %, under the 0.25 % asked of it
+  // and a seventh of the 0.5 % tolerance; the 5 % brighter reference still
+  // lies ~7 SE past the tolerance.
+  const int spp = 512;
   RenderResult gpu = render(emissive_medium_over_plane(dir, spp, 21, 60.0));
   RenderResult cpu = render_cpu(emissive_medium_over_plane(dir, spp, 22, 60.0));
   expect_same(gpu, cpu, 0.005, 0.0025, "emissive medium over textured plane");
