@@ -228,9 +228,14 @@ TEST_P(Vdb, TinyDensityWithHighTemperature) {
   }
 }
 
-// Camera inside the grid (in its constant region, looking across it).
+// Camera inside the grid (in its constant region, looking across it). Every
+// pixel looks through the medium to a face, so under AddressSanitizer a
+// quarter of the samples (a quarter of the time) still takes every lookup
+// the sanitizers check, and the pooled bias's SE (~0.12 %) stays well under
+// the 0.5 % tolerance. Not so for the cases below, whose edge pixels see the
+// medium in a few samples: at 128 spp some of them saw it in none.
 TEST_P(Vdb, CameraInsideTheVolume) {
-  Scene s = constant_box_scene(24, 24, 512, {0.8, 1.6, 3.2}, {0, 0, 0});
+  Scene s = constant_box_scene(24, 24, address_sanitizer() ? 128 : 512, {0.8, 1.6, 3.2}, {0, 0, 0});
   s.camera.position = {0.1, 0.05, -0.3};
   s.camera.look_at = {0.3, 0.2, 1.0};
   s.camera.fov_deg = 70.0;
