@@ -9,6 +9,8 @@
 #include <cstring>
 #include <string>
 
+#include "render/vulkan/Pipeline.h"
+
 namespace pyrolume::vk {
 
 namespace {
@@ -279,6 +281,7 @@ Context::Context(const Options& options) {
   set_name(pool, "one-shot command pool");
   set_name(command_buffer_, "one-shot command buffer");
   set_name(fence, "one-shot fence");
+  pipelines_ = std::make_unique<PipelineCache>();
 }
 
 Context::~Context() {

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <vector>
 
@@ -14,6 +15,8 @@
 #include "render/vulkan/VkCheck.h"
 
 namespace pyrolume::vk {
+
+class PipelineCache;  // render/vulkan/Pipeline.h
 
 class Context {
  public:
@@ -70,6 +73,10 @@ class Context {
   // For uploads, readbacks and one-off work; thread-safe (serialised).
   void submit_and_wait(const std::function<void(VkCommandBuffer)>& record);
 
+  // The pipelines this device made, shared by the sessions that ask for the
+  // same one again (render/vulkan/Pipeline.h).
+  PipelineCache& pipelines() { return *pipelines_; }
+
  private:
   static VKAPI_ATTR VkBool32 VKAPI_CALL debug_callback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                        VkDebugUtilsMessageTypeFlagsEXT types,
@@ -98,6 +105,8 @@ class Context {
   UniqueCommandPool command_pool_;
   VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;  // freed with the pool
   UniqueFence fence_;
+  // Last: its pipelines go before the device does.
+  std::unique_ptr<PipelineCache> pipelines_;
 };
 
 // Same as ctx.submit_and_wait(record).

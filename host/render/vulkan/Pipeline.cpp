@@ -72,6 +72,30 @@ ComputePipeline::ComputePipeline(Context& ctx, const std::vector<uint32_t>& spir
   ctx.set_name(p, name_.c_str());
 }
 
+std::shared_ptr<const ComputePipeline> PipelineCache::get(
+    Context& ctx, const std::vector<uint32_t>& spirv, const std::vector<ComputePipeline::Binding>& bindings,
+    uint32_t push_constant_bytes, const std::vector<std::pair<uint32_t, uint32_t>>& specialization,
+    const char* debug_name) {
+  std::vector<uint32_t> key{uint32_t(spirv.size()), push_constant_bytes, uint32_t(bindings.size()),
+                            uint32_t(specialization.size())};
+  for (const ComputePipeline::Binding& b : bindings) key.insert(key.end(), {b.binding, uint32_t(b.type), b.count});
+  for (const auto& [id, value] : specialization) key.insert(key.end(), {id, value});
+  for (const char* c = debug_name; c && *c; ++c) key.push_back(uint32_t(uint8_t(*c)));
+  key.insert(key.end(), spirv.begin(), spirv.end());
+
+  std::lock_guard lock(mutex_);
+  for (auto it = entries_.begin(); it != entries_.end(); ++it)
+    if (it->key == key) {
+      entries_.splice(entries_.begin(), entries_, it);
+      return entries_.front().pipeline;
+    }
+  auto made = std::make_shared<const ComputePipeline>(ctx, spirv, bindings, push_constant_bytes, specialization,
+                                                      debug_name);
+  entries_.push_front({std::move(key), made});
+  if (entries_.size() > kCapacity) entries_.pop_back();
+  return made;
+}
+
 void ComputePipeline::bind(VkCommandBuffer cmd, VkDescriptorSet set) const {
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.get());
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_.get(), 0, 1, &set, 0, nullptr);

@@ -4,6 +4,9 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <list>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -52,6 +55,34 @@ class ComputePipeline {
   UniqueDescriptorSetLayout set_layout_;
   UniquePipelineLayout layout_;
   UniquePipeline pipeline_;
+};
+
+// The pipelines a device already made, for the sessions that ask again for
+// the same shader, bindings and specialisation: a test or a tool that opens
+// one session per render, a preview that reloads its scene. On lavapipe a
+// megakernel pipeline costs ~0.5 CPU-s (SPIR-V specialisation, then NIR);
+// 83 of the 330 pipelines the Vulkan and hard-case tests made repeated one
+// their process had made before (docs/testing.md "Build and CI time").
+// The most recently used kCapacity stay; a session keeps its own alive.
+class PipelineCache {
+ public:
+  static constexpr size_t kCapacity = 8;
+
+  // The pipeline ComputePipeline(ctx, spirv, bindings, ...) would make,
+  // made once per distinct set of arguments (the debug name included).
+  std::shared_ptr<const ComputePipeline> get(Context& ctx, const std::vector<uint32_t>& spirv,
+                                             const std::vector<ComputePipeline::Binding>& bindings,
+                                             uint32_t push_constant_bytes,
+                                             const std::vector<std::pair<uint32_t, uint32_t>>& specialization,
+                                             const char* debug_name);
+
+ private:
+  struct Entry {
+    std::vector<uint32_t> key;  // every argument, the SPIR-V words whole
+    std::shared_ptr<const ComputePipeline> pipeline;
+  };
+  std::mutex mutex_;
+  std::list<Entry> entries_;  // most recently used first
 };
 
 // Values that change from one dispatch to the next (a pass's samples and

@@ -109,7 +109,7 @@ void RenderSession::create_accumulation() {
 }
 
 void RenderSession::create_pipeline(const std::vector<uint32_t>& code) {
-  pipeline_.emplace(ctx_, code,
+  pipeline_ = ctx_.pipelines().get(ctx_, code,
                     std::vector<vk::ComputePipeline::Binding>{
                         {gpu::BINDING_FRAME, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                         {gpu::BINDING_MEDIA, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
@@ -187,8 +187,8 @@ void RenderSession::warm_up() {
     pipeline_->bind(cmd, set_->set());
     vkCmdDispatch(cmd, 1, 1, 1);
     // The wavefront's stages, on empty queues (the queues are zero).
-    for (const vk::ComputePipeline& stage : wavefront_stages_) {
-      stage.bind(cmd, set_->set());
+    for (const auto& stage : wavefront_stages_) {
+      stage->bind(cmd, set_->set());
       vkCmdDispatch(cmd, 1, 1, 1);
     }
   });

@@ -4,6 +4,7 @@
 // specialised to the scene, and the per-pixel accumulation buffer. `render` and
 // the preview window both drive it, pass by pass.
 #include <atomic>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -163,7 +164,7 @@ class RenderSession {
   vk::Buffer emission_cdf_, emission_cells_, emission_pmf_, emission_clusters_, emission_headers_;
   vk::Buffer analytic_lights_;
   LightSelection light_selection_;
-  std::optional<vk::ComputePipeline> pipeline_;
+  std::shared_ptr<const vk::ComputePipeline> pipeline_;  // from ctx_.pipelines()
   std::optional<vk::DescriptorSet> set_;
   std::vector<std::pair<uint32_t, uint32_t>> spec_;  // the variant pipeline_ was compiled for
   vk::ParameterBuffer pass_constants_;  // PassConstants of the dispatch recorded last (record_band)
@@ -189,7 +190,7 @@ class RenderSession {
   void record_wavefront_iterations(VkCommandBuffer cmd, int iterations);
   uint32_t wavefront_paths_left() const;
   static constexpr int kWavefrontIterations = 32;  // track + event rounds per submission
-  std::vector<vk::ComputePipeline> wavefront_stages_;
+  std::vector<std::shared_ptr<const vk::ComputePipeline>> wavefront_stages_;
   vk::Buffer wavefront_paths_, wavefront_queues_;
   vk::UniqueBufferView wavefront_paths_view_;
   // Every sparse grid's NanoVDB tree and leaf table (GpuScene::sparse_blocks), read as a

@@ -125,8 +125,8 @@ void RenderSession::create_wavefront(const std::vector<uint32_t>& code) {
     for (auto& [id, value] : spec)
       if (id == gpu::SPEC_EARLY_EVENT_EXIT)
         value = stage == gpu::WAVEFRONT_TRACK && ctx_.features().subgroup_ballot ? 1u : 0u;
-    wavefront_stages_.emplace_back(ctx_, code, pipeline_->bindings(), /*push_constant_bytes=*/0, spec,
-                                   "render wavefront stage");
+    wavefront_stages_.push_back(ctx_.pipelines().get(ctx_, code, pipeline_->bindings(), /*push_constant_bytes=*/0,
+                                                     spec, "render wavefront stage"));
   }
 }
 
@@ -136,7 +136,7 @@ void RenderSession::record_wavefront_start(VkCommandBuffer cmd, const gpu::PassC
   vkCmdUpdateBuffer(cmd, wavefront_queues_.buffer(), 0, sizeof start, &start);
   vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-  const vk::ComputePipeline& start_stage = wavefront_stages_[gpu::WAVEFRONT_START - 1];
+  const vk::ComputePipeline& start_stage = *wavefront_stages_[gpu::WAVEFRONT_START - 1];
   start_stage.bind(cmd, set_->set());
   const uint32_t groups_x = (uint32_t(settings_.width) + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X;
   const uint32_t groups_y = (pass.row_end - pass.row_begin + gpu::WORKGROUP_SIZE_Y - 1) / gpu::WORKGROUP_SIZE_Y;
@@ -150,7 +150,7 @@ void RenderSession::record_wavefront_iterations(VkCommandBuffer cmd, int iterati
                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
                        VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
   };
-  auto stage = [&](uint32_t s) -> const vk::ComputePipeline& { return wavefront_stages_[s - 1]; };
+  auto stage = [&](uint32_t s) -> const vk::ComputePipeline& { return *wavefront_stages_[s - 1]; };
   // The stages' layouts are identically defined, so the set stays bound
   // across their pipelines: bound once. The pass's constants stay in their
   // buffer (record_band wrote them).
