@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "color/Blackbody.h"
 #include "color/ColorSpace.h"
@@ -38,6 +40,24 @@ BlackbodyLut::BlackbodyLut(BlackbodyMode mode, int observer, std::optional<doubl
     rgba_[4 * i + 2] = float(rgb.b);
     rgba_[4 * i + 3] = float(srgb_luminance(rgb));
   }
+}
+
+BlackbodyLut BlackbodyLut::baked(BlackbodyMode mode, int observer, std::optional<double> adapt_to_k) {
+  // A few modes, two observers and the scenes' adaptation whites: a short
+  // list, trimmed to the latest kKept in case a process sees many whites.
+  constexpr size_t kKept = 16;
+  static std::mutex mutex;
+  static std::vector<BlackbodyLut> luts;
+  {
+    std::lock_guard lock(mutex);
+    for (const BlackbodyLut& lut : luts)
+      if (lut.mode() == mode && lut.observer() == observer && lut.adapt_to_k() == adapt_to_k) return lut;
+  }
+  BlackbodyLut made(mode, observer, adapt_to_k);  // throws before anything is kept
+  std::lock_guard lock(mutex);
+  if (luts.size() >= kKept) luts.erase(luts.begin());
+  luts.push_back(made);
+  return made;
 }
 
 double BlackbodyLut::temperature_at(uint32_t i) const {

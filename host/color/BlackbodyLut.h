@@ -46,6 +46,11 @@ class BlackbodyLut {
   BlackbodyLut(BlackbodyMode mode, int observer = 2, std::optional<double> adapt_to_k = std::nullopt,
                uint32_t size = kDefaultSize, double t_min_k = kDefaultMinK, double t_max_k = kDefaultMaxK);
 
+  // The default-size LUT of (mode, observer, adapt_to_k), baked once per
+  // process and copied out: its 8192 Planck integrals took ~0.1 CPU-s of
+  // every render session (a test process or a tool opens several).
+  static BlackbodyLut baked(BlackbodyMode mode, int observer = 2, std::optional<double> adapt_to_k = std::nullopt);
+
   // 4 floats per texel (r, g, b, luminance), `size` texels, ready for upload.
   const std::vector<float>& rgba() const { return rgba_; }
   const BlackbodyLutParams& params() const { return params_; }

@@ -101,3 +101,19 @@ TEST(BlackbodyLut, RangeBehaviour) {
   EXPECT_THROW(BlackbodyLut(BlackbodyMode::Seed, 2, std::nullopt, 64, 1000.0, 500.0), std::invalid_argument);
   EXPECT_THROW(BlackbodyLut(BlackbodyMode::Seed, 7), std::invalid_argument);
 }
+
+TEST(BlackbodyLut, BakedOnceEqualsAFreshBake) {
+  // The per-process copy (BlackbodyLut::baked) holds what a fresh bake of the
+  // same mode, observer and adaptation holds, and tells them apart.
+  const BlackbodyLut fresh(BlackbodyMode::Peak, 10, 3000.0);
+  const BlackbodyLut first = BlackbodyLut::baked(BlackbodyMode::Peak, 10, 3000.0);
+  const BlackbodyLut again = BlackbodyLut::baked(BlackbodyMode::Peak, 10, 3000.0);
+  EXPECT_EQ(first.rgba(), fresh.rgba());
+  EXPECT_EQ(again.rgba(), fresh.rgba());
+  EXPECT_EQ(again.params().log_scale, fresh.params().log_scale);
+  const BlackbodyLut other = BlackbodyLut::baked(BlackbodyMode::Peak, 10, 4000.0);
+  EXPECT_EQ(other.adapt_to_k(), std::optional<double>(4000.0));
+  EXPECT_NE(other.rgba(), fresh.rgba());
+  EXPECT_EQ(BlackbodyLut::baked(BlackbodyMode::Physical).rgba(), BlackbodyLut(BlackbodyMode::Physical).rgba());
+  EXPECT_THROW(BlackbodyLut::baked(BlackbodyMode::Peak, 7), std::invalid_argument);
+}

@@ -190,7 +190,8 @@ void pack_grid_emission(const Medium& m, const StoredVolume& v, bool with_luts, 
     grid.temperature_offset = float(m.temperature.offset);
     grid.temperature_scale = float(m.temperature.scale);
     grid.cutoff_k = float(m.temperature.cutoff_k);
-    if (with_luts) src.blackbody.emplace(m.emission.blackbody, m.emission.observer, m.emission.adapt_to_k);
+    if (with_luts)
+      src.blackbody = color::BlackbodyLut::baked(m.emission.blackbody, m.emission.observer, m.emission.adapt_to_k);
     set_blackbody_lut(grid, src.blackbody ? src.blackbody->params() : color::BlackbodyLutParams{});
   } else {
     g.emission_mode = gpu::EMIT_NONE;

@@ -57,7 +57,7 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
         src.blackbody = old.blackbody;
         break;
       }
-    if (!src.blackbody) src.blackbody.emplace(e.blackbody, e.observer, e.adapt_to_k);
+    if (!src.blackbody) src.blackbody = color::BlackbodyLut::baked(e.blackbody, e.observer, e.adapt_to_k);
     const color::BlackbodyLutParams& p = src.blackbody->params();
     set_blackbody_lut(gpu_scene.grids[slot], p);
   }
