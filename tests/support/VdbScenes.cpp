@@ -82,6 +82,29 @@ std::filesystem::path write_tiles_vdb(const std::filesystem::path& file, int lev
   return write_grids(file, {g});
 }
 
+std::filesystem::path write_reader_paths_vdb(const std::filesystem::path& file, VdbCompression compression) {
+  ensure_openvdb();
+  auto d = openvdb::FloatGrid::create(0);
+  d->setName("density");
+  d->setTransform(openvdb::math::Transform::createLinearTransform(0.1));
+  for (int i = 0; i < 3; ++i) d->tree().setValue({i, i, 2 * i}, 0.5f + float(i));
+  d->tree().addTile(1, openvdb::Coord(64, 0, 0), 2.0f, true);
+  d->setSaveFloatAsHalf(true);
+  auto t = openvdb::FloatGrid::create(0);
+  t->setName("temperature");
+  t->tree().setValue({1, 1, 1}, 1500.0f);
+  openvdb::MetaMap meta;
+  meta.insertMeta("creator", openvdb::StringMetadata("corrupt_input_test"));
+  openvdb::io::File f(file.string());
+  f.setCompression(compression == VdbCompression::ZipActiveMask ? openvdb::io::COMPRESS_ZIP |
+                                                                       openvdb::io::COMPRESS_ACTIVE_MASK
+                   : compression == VdbCompression::Blosc ? openvdb::io::COMPRESS_BLOSC
+                                                          : openvdb::io::COMPRESS_NONE);
+  f.write({d, t}, meta);
+  f.close();
+  return file;
+}
+
 void write_nanovdb_copy(const std::filesystem::path& vdb, const std::filesystem::path& nvdb, bool fp16) {
   ensure_openvdb();
   openvdb::io::File f(vdb.string());

@@ -113,6 +113,14 @@ std::filesystem::path write_two_voxels_vdb(const std::filesystem::path& file, co
 // n³ · side³ voxels.
 std::filesystem::path write_tiles_vdb(const std::filesystem::path& file, int level, int n);
 
+// How write_reader_paths_vdb compresses its grids (OpenVDB's io flags).
+enum class VdbCompression { ZipActiveMask, Blosc, None };
+
+// "density" (saved as half, 0.1 voxels, three voxels and an active lower-node
+// tile) and "temperature" (float, one voxel), with file metadata ("creator"),
+// compressed as asked: every path of the readers in ~2 KB, for damaging.
+std::filesystem::path write_reader_paths_vdb(const std::filesystem::path& file, VdbCompression compression);
+
 // Converts every grid of a .vdb file to one .nvdb file (NanoVDB, uncompressed).
 // Float grids only (the test scenes write nothing else); others throw. With
 // fp16, as NanoVDB's 16-bit quantised grids (Float16) instead of float.

@@ -17,8 +17,6 @@
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfOutputFile.h>
-#include <openvdb/io/File.h>
-#include <openvdb/openvdb.h>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -35,7 +33,7 @@
 #include "volume/VdbLoader.h"
 
 namespace pyrolume {
-namespace {
+namespace corrupt_input {  // a unity batch shares one translation unit: names of its own
 
 namespace fs = std::filesystem;
 using Bytes = std::vector<char>;
@@ -80,38 +78,14 @@ std::string outcome(const fs::path& p, F&& read) {
 
 // ---- VDB ----
 
-struct OpenVdbInit {
-  OpenVdbInit() {
-    openvdb::initialize();
-    // A damaged root origin can spread the few voxels over a legitimately
-    // huge box: refuse it (InputError) instead of filling gigabytes.
-    set_max_dense_texels(uint64_t(1) << 24);
-  }
-} const init_once;
+// A damaged root origin can spread the few voxels over a legitimately huge
+// box: refuse it (InputError) instead of filling gigabytes.
+struct DenseLimit {
+  DenseLimit() { set_max_dense_texels(uint64_t(1) << 24); }
+} const dense_limit_once;
 
-constexpr uint32_t kZipMask = openvdb::io::COMPRESS_ZIP | openvdb::io::COMPRESS_ACTIVE_MASK;
-constexpr uint32_t kBlosc = openvdb::io::COMPRESS_BLOSC;
-
-// density (half, ZIP + active mask) and temperature (float, Blosc), a few
-// voxels each, an active tile and file metadata: every reader path, ~2 KB.
-fs::path small_vdb(const fs::path& dir, uint32_t compression) {
-  auto d = openvdb::FloatGrid::create(0);
-  d->setName("density");
-  d->setTransform(openvdb::math::Transform::createLinearTransform(0.1));
-  for (int i = 0; i < 3; ++i) d->tree().setValue({i, i, 2 * i}, 0.5f + float(i));
-  d->tree().addTile(1, openvdb::Coord(64, 0, 0), 2.0f, true);
-  d->setSaveFloatAsHalf(true);
-  auto t = openvdb::FloatGrid::create(0);
-  t->setName("temperature");
-  t->tree().setValue({1, 1, 1}, 1500.0f);
-  openvdb::MetaMap meta;
-  meta.insertMeta("creator", openvdb::StringMetadata("corrupt_input_test"));
-  const fs::path p = dir / "small.vdb";
-  openvdb::io::File f(p.string());
-  f.setCompression(compression);
-  f.write({d, t}, meta);
-  f.close();
-  return p;
+fs::path small_vdb(const fs::path& dir, test::VdbCompression compression) {
+  return test::write_reader_paths_vdb(dir / "small.vdb", compression);
 }
 
 std::string vdb_outcome(const fs::path& p) {
@@ -126,15 +100,16 @@ std::string vdb_outcome(const fs::path& p) {
 
 TEST(CorruptVdb, TheUndamagedFileLoads) {
   const auto dir = test::temp_dir("vdbok");
-  for (uint32_t c : {kZipMask, kBlosc, uint32_t(openvdb::io::COMPRESS_NONE)})
-    EXPECT_EQ(vdb_outcome(small_vdb(dir, c)), "") << "compression " << c;
+  for (test::VdbCompression c : {test::VdbCompression::ZipActiveMask, test::VdbCompression::Blosc,
+                                  test::VdbCompression::None})
+    EXPECT_EQ(vdb_outcome(small_vdb(dir, c)), "") << "compression " << int(c);
 }
 
 // Found by fuzz_vdb: OpenVDB sized a string by its 4-byte length field
 // (here the first file metadata name's) and allocated 2 GB for a 500-byte file.
 TEST(CorruptVdb, HugeMetadataStringLengthIsAnInputError) {
   const auto dir = test::temp_dir("vdbstr");
-  const fs::path p = small_vdb(dir, openvdb::io::COMPRESS_NONE);
+  const fs::path p = small_vdb(dir, test::VdbCompression::None);
   Bytes b = read_bytes(p);
   // magic 8, version 4, library version 8, offsets flag 1, UUID 36, count 4
   const size_t at = 8 + 4 + 8 + 1 + 36 + 4;
@@ -147,7 +122,7 @@ TEST(CorruptVdb, HugeMetadataStringLengthIsAnInputError) {
 
 TEST(CorruptVdb, EveryTruncationIsAnInputError) {
   const auto dir = test::temp_dir("vdbcut");
-  for (uint32_t c : {kZipMask, kBlosc}) {
+  for (test::VdbCompression c : {test::VdbCompression::ZipActiveMask, test::VdbCompression::Blosc}) {
     const fs::path good = small_vdb(dir, c);
     const Bytes b = read_bytes(good);
     const fs::path p = dir / "cut.vdb";
@@ -166,7 +141,7 @@ TEST(CorruptVdb, EveryTruncationIsAnInputError) {
 // (three reads a file at ~15 ms each) a byte gets one of the two, in turn.
 TEST(CorruptVdb, EveryDamagedByteIsReadOrRefused) {
   const auto dir = test::temp_dir("vdbflip");
-  for (uint32_t c : {kZipMask, kBlosc}) {
+  for (test::VdbCompression c : {test::VdbCompression::ZipActiveMask, test::VdbCompression::Blosc}) {
     const Bytes good = read_bytes(small_vdb(dir, c));
     const fs::path p = dir / "flip.vdb";
     int refused = 0, tried = 0;
@@ -329,5 +304,5 @@ TEST(CorruptObj, ParseErrorsKeepTheFilesLineNumbers) {
   EXPECT_NE(msg.find("line 7"), std::string::npos) << msg;
 }
 
-}  // namespace
+}  // namespace corrupt_input
 }  // namespace pyrolume
