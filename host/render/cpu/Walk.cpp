@@ -298,7 +298,9 @@ Flight track_media(Walk& w, double t_surf, double w_ray) {
       if (line_rate > 0.0 && w_ray > 0.0)
         for (double t_line = t + sample_free_flight(line_rate, w.rng.uniform()); t_line < std::min(t_flight, b);
              t_line += sample_free_flight(line_rate, w.rng.uniform())) {
-          if (coefficients_at(md, c, w.o + t_line * w.d, s, w.cnt).sigma_a > 0.0) w.L += w.beta * w_ray * emitted_at(md, c, w.o + t_line * w.d, s) / collect_rate;
+          const glm::dvec3 x_line = w.o + t_line * w.d;
+          if (coefficients_at(md, c, x_line, s, w.cnt).sigma_a > 0.0)
+            w.L += w.beta * w_ray * emitted_at(md, c, x_line, s) / collect_rate;
         }
       t = t_flight;
       if (!(t < b)) break;  // memoryless: restart the flight at b

@@ -281,7 +281,7 @@ Context::Context(const Options& options) {
   set_name(pool, "one-shot command pool");
   set_name(command_buffer_, "one-shot command buffer");
   set_name(fence, "one-shot fence");
-  pipelines_ = std::make_unique<PipelineCache>();
+  pipelines_ = std::make_unique<PipelineCache>(*this);
 }
 
 Context::~Context() {

@@ -73,7 +73,7 @@ ComputePipeline::ComputePipeline(Context& ctx, const std::vector<uint32_t>& spir
 }
 
 std::shared_ptr<const ComputePipeline> PipelineCache::get(
-    Context& ctx, const std::vector<uint32_t>& spirv, const std::vector<ComputePipeline::Binding>& bindings,
+    const std::vector<uint32_t>& spirv, const std::vector<ComputePipeline::Binding>& bindings,
     uint32_t push_constant_bytes, const std::vector<std::pair<uint32_t, uint32_t>>& specialization,
     const char* debug_name) {
   std::vector<uint32_t> key{uint32_t(spirv.size()), push_constant_bytes, uint32_t(bindings.size()),
@@ -89,7 +89,7 @@ std::shared_ptr<const ComputePipeline> PipelineCache::get(
       entries_.splice(entries_.begin(), entries_, it);
       return entries_.front().pipeline;
     }
-  auto made = std::make_shared<const ComputePipeline>(ctx, spirv, bindings, push_constant_bytes, specialization,
+  auto made = std::make_shared<const ComputePipeline>(ctx_, spirv, bindings, push_constant_bytes, specialization,
                                                       debug_name);
   entries_.push_front({std::move(key), made});
   if (entries_.size() > kCapacity) entries_.pop_back();

@@ -68,15 +68,18 @@ class PipelineCache {
  public:
   static constexpr size_t kCapacity = 8;
 
+  explicit PipelineCache(Context& ctx) : ctx_(ctx) {}
+
   // The pipeline ComputePipeline(ctx, spirv, bindings, ...) would make,
   // made once per distinct set of arguments (the debug name included).
-  std::shared_ptr<const ComputePipeline> get(Context& ctx, const std::vector<uint32_t>& spirv,
+  std::shared_ptr<const ComputePipeline> get(const std::vector<uint32_t>& spirv,
                                              const std::vector<ComputePipeline::Binding>& bindings,
                                              uint32_t push_constant_bytes,
                                              const std::vector<std::pair<uint32_t, uint32_t>>& specialization,
                                              const char* debug_name);
 
  private:
+  Context& ctx_;
   struct Entry {
     std::vector<uint32_t> key;  // every argument, the SPIR-V words whole
     std::shared_ptr<const ComputePipeline> pipeline;

@@ -125,8 +125,8 @@ void RenderSession::create_wavefront(const std::vector<uint32_t>& code) {
     for (auto& [id, value] : spec)
       if (id == gpu::SPEC_EARLY_EVENT_EXIT)
         value = stage == gpu::WAVEFRONT_TRACK && ctx_.features().subgroup_ballot ? 1u : 0u;
-    wavefront_stages_.push_back(ctx_.pipelines().get(ctx_, code, pipeline_->bindings(), /*push_constant_bytes=*/0,
-                                                     spec, "render wavefront stage"));
+    wavefront_stages_.push_back(
+        ctx_.pipelines().get(code, pipeline_->bindings(), /*push_constant_bytes=*/0, spec, "render wavefront stage"));
   }
 }
 

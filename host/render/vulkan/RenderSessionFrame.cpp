@@ -44,23 +44,9 @@ bool RenderSession::load_frame(const Scene& scene, const RenderSettings& setting
   for (size_t i = 0; i < scene.media.size(); ++i)
     if (scene.media[i].type == Medium::Type::Vdb) volumes[i] = load_stored_volume(scene.media[i], dense_limits());
   check_loaded_media(scene, volumes);
-  // The blackbody LUTs depend only on the emission's mode, observer and
-  // adaptation: bake them once per sequence and reuse them frame after frame.
-  GpuScene gpu_scene = build_gpu_scene(scene, volumes, /*with_luts=*/false, shared_texture_bytes());
-  for (size_t slot = 0; slot < gpu_scene.grid_sources.size(); ++slot) {
-    GpuGridSource& src = gpu_scene.grid_sources[slot];
-    if (!src.temperature) continue;
-    const Emission& e = scene.media[src.medium].emission;
-    for (const GpuGridSource& old : gpu_scene_.grid_sources)
-      if (old.blackbody && old.blackbody->mode() == e.blackbody && old.blackbody->observer() == e.observer &&
-          old.blackbody->adapt_to_k() == e.adapt_to_k) {
-        src.blackbody = old.blackbody;
-        break;
-      }
-    if (!src.blackbody) src.blackbody = color::BlackbodyLut::baked(e.blackbody, e.observer, e.adapt_to_k);
-    const color::BlackbodyLutParams& p = src.blackbody->params();
-    set_blackbody_lut(gpu_scene.grids[slot], p);
-  }
+  // Each frame's blackbody LUTs are the process's baked copies
+  // (BlackbodyLut::baked): a sequence bakes each mode once.
+  GpuScene gpu_scene = build_gpu_scene(scene, volumes, /*with_luts=*/true, shared_texture_bytes());
   EmissionLights lights = build_emission_lights(scene, volumes, gpu_scene);
   if (spec_constants(scene, gpu_scene, settings, lights.selection) != spec_) return false;
 
