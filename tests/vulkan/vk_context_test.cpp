@@ -308,3 +308,65 @@ TEST(VulkanContext, RunsComputeShaderWithImagesUnderValidation) {
   }
   EXPECT_EQ(Context::total_validation_messages(), before) << "validation messages while destroying the context";
 }
+
+// The device's pipeline cache (Pipeline.h PipelineCache): the same shader,
+// bindings, push-constant size, specialisation and name give the same
+// pipeline; any one of them different gives another; past kCapacity the
+// least recently used is made again; and a shared pipeline computes what its
+// own specialisation says (MULTIPLIER 2 and 3 of test_fill.comp).
+TEST(VulkanContext, PipelineCacheSharesOnlyIdenticalPipelines) {
+  const uint64_t before = Context::total_validation_messages();
+  {
+    Context ctx(test::validated());
+    const std::vector<uint32_t> code = load_spirv("test_fill.comp");
+    const std::vector<ComputePipeline::Binding> bindings = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                                                            {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
+                                                            {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
+                                                            {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}};
+    const uint32_t push_bytes = 3 * sizeof(uint32_t);
+    PipelineCache& cache = ctx.pipelines();
+    auto get = [&](uint32_t multiplier, const char* name = "fill") {
+      return cache.get(code, bindings, push_bytes, {{0, multiplier}}, name);
+    };
+    const auto two = get(2);
+    EXPECT_EQ(get(2), two);
+    EXPECT_NE(get(3), two);
+    EXPECT_NE(get(2, "other name"), two);
+    EXPECT_NE(cache.get(code, bindings, push_bytes + 4, {{0, 2u}}, "fill"), two);
+    auto more = bindings;  // a binding the shader does not use: a valid, different layout
+    more.push_back({4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+    EXPECT_NE(cache.get(code, more, push_bytes, {{0, 2u}}, "fill"), two);
+    EXPECT_EQ(get(2), two);  // still kept: the most recently used
+
+    // Each pipeline runs with its own constant: v[i] = i * MULTIPLIER + offset.
+    const uint32_t count = 64;
+    for (const uint32_t multiplier : {2u, 3u}) {
+      Buffer values(ctx, count * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::Readback, "test values");
+      const std::vector<float> texel(4, 0.0f);
+      Image3D image3d(ctx, 1, 1, 1, VK_FORMAT_R32_SFLOAT, "test grid");
+      image3d.upload(ctx, texel.data(), sizeof(float));
+      Image1D image1d(ctx, 1, VK_FORMAT_R32G32B32A32_SFLOAT, "test table");
+      image1d.upload(ctx, texel.data(), texel.size() * sizeof(float));
+      Buffer samples(ctx, 64, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::HostVisible, "test samples");
+      const auto pipeline = get(multiplier);
+      DescriptorSet set(ctx, *pipeline);
+      set.write_buffer(0, values);
+      set.write_image(1, image3d);
+      set.write_image(2, image1d.view(), image1d.sampler());
+      set.write_buffer(3, samples);
+      struct Push {
+        uint32_t count, offset, sample_count;
+      } push{count, 5, 0};
+      test::dispatch_and_wait(ctx, *pipeline, set, count, push);
+      values.invalidate();
+      const uint32_t* v = values.data<uint32_t>();
+      for (uint32_t i = 0; i < count; ++i) ASSERT_EQ(v[i], i * multiplier + 5) << "multiplier " << multiplier;
+    }
+
+    // Past kCapacity other pipelines, the first is made again.
+    for (uint32_t m = 10; m < 10 + PipelineCache::kCapacity; ++m) get(m);
+    EXPECT_NE(get(2), two);
+    EXPECT_EQ(ctx.validation_messages(), 0u);
+  }
+  EXPECT_EQ(Context::total_validation_messages(), before) << "validation messages while destroying the context";
+}
