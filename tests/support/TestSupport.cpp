@@ -7,9 +7,11 @@
 #include <cstdlib>
 #include <cstdio>
 #include <fstream>
+#include <mutex>
 #include <random>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 // Defined by the AddressSanitizer runtime, absent (null) elsewhere.
 extern "C" void __asan_init() __attribute__((weak));
@@ -44,6 +46,37 @@ CliResult run_cli_with_memory_limit(uint64_t kib, const std::string& args) {
   return run_shell("ulimit -v " + std::to_string(kib) + "; ", args);
 }
 
+namespace {
+// Every folder temp_dir made, removed when the test process exits normally
+// (passed or failed), so a suite run leaves nothing in /tmp; with
+// PYROLUME_KEEP_TEMP=1 they stay, to look at a failure's files.
+class TempDirs {
+ public:
+  void add(const std::filesystem::path& p) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    dirs_.push_back(p);
+  }
+  ~TempDirs() {
+    if (getpid() != owner_) return;  // a forked child that exits normally leaves them to its parent
+    const char* keep = std::getenv("PYROLUME_KEEP_TEMP");
+    if (keep && *keep && std::string(keep) != "0") return;
+    for (const auto& d : dirs_) {
+      std::error_code ignored;
+      std::filesystem::remove_all(d, ignored);
+    }
+  }
+
+ private:
+  const pid_t owner_ = getpid();
+  std::mutex mutex_;
+  std::vector<std::filesystem::path> dirs_;
+};
+TempDirs& temp_dirs() {
+  static TempDirs dirs;
+  return dirs;
+}
+}  // namespace
+
 std::filesystem::path temp_dir(const std::string& tag) {
   static std::atomic<int> counter{0};
   std::random_device rd;
@@ -52,6 +85,7 @@ std::filesystem::path temp_dir(const std::string& tag) {
             std::to_string(rd() % 100000));
   std::filesystem::remove_all(p);
   std::filesystem::create_directories(p);
+  temp_dirs().add(p);
   return p;
 }
 

@@ -29,7 +29,8 @@ CliResult run_cli(const std::string& args);
 // farm limits a job: what a memory check must refuse before allocating.
 CliResult run_cli_with_memory_limit(uint64_t kib, const std::string& args);
 
-// A fresh, empty folder under the system temp dir, unique per test.
+// A fresh, empty folder under the system temp dir, unique per test; removed
+// when the test process exits (kept with PYROLUME_KEEP_TEMP=1).
 std::filesystem::path temp_dir(const std::string& tag);
 
 void write_file(const std::filesystem::path& p, const std::string& text);
