@@ -12,7 +12,7 @@ layout(local_size_x = 64) in;
 layout(push_constant) uniform Push { uint count; } pc;
 
 struct ViewQuery {
-  vec4 exposed;  // xyz: exposed scene-linear sRGB; w: the view (VIEW_AGX or VIEW_STANDARD), as a float
+  vec4 exposed;  // xyz: exposed scene-linear sRGB; w: the view (VIEW_AGX, VIEW_STANDARD, ...), as a float
   vec4 shown;    // out xyz: view_display(exposed, view); w: 0
 };
 layout(std430, binding = 0) buffer QueryBlock { ViewQuery queries[]; };

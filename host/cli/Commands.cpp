@@ -210,8 +210,10 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
 }  // namespace
 
 int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
-  parse_exposure(args.exposure);  // a bad --exposure fails before the scene loads
+  parse_exposure(args.exposure);  // a bad --exposure or --view fails before the scene loads
+  const std::optional<ViewTransform> view = parse_view(args.view);
   Scene scene = load_scene(args.scene);
+  if (view) scene.film.view = *view;
 
   const bool sequence = !args.frames.empty();
   // Source conventions, up axis and framing; a frame pattern's from its whole

@@ -31,6 +31,9 @@ struct RenderArgs {
   // --exposure: stops or "auto", overriding film.exposure for display output
   // (PNG) on every frame; empty = the scene's (docs/view-transform.md).
   std::string exposure;
+  // --view: one of film.view's names, overriding film.view for display output
+  // (PNG); empty = the scene's (docs/view-transform.md).
+  std::string view;
 };
 int run_render(const RenderArgs& args, const std::atomic<bool>& cancel);
 

@@ -69,6 +69,9 @@ const CLI::Validator kPositiveSeconds = positive_finite("seconds");
 const CLI::Validator kExposure(
     [](std::string& text) { return pyrolume::exposure_problem(text); }, "EV|auto");
 
+// --view: one of film.view's names; '' is refused too.
+const CLI::Validator kView([](std::string& text) { return pyrolume::view_problem(text); }, "NAME");
+
 // " (did you mean ...?)" for the first word on the command line that names
 // no subcommand or no flag of its subcommand, "" when there is none.
 std::string flag_suggestion(CLI::App& app, int argc, char** argv) {
@@ -132,6 +135,10 @@ int main(int argc, char** argv) {
                      "PNG: exposure in stops (within ±30), or auto (overrides film.exposure on every frame; EXR stays "
                      "linear)")
       ->check(kExposure);
+  render->add_option("--view", render_args.view,
+                     "PNG: view transform, agx | agx_punchy | filmic | standard (overrides film.view on every frame; "
+                     "EXR stays linear)")
+      ->check(kView);
   render->add_option("--device", render_args.device, "Vulkan device index (see `pyrolume devices`)")->check(CLI::NonNegativeNumber);
   render->add_option("--frames", render_args.frames,
                      "Render frames A-B[:step] (or one frame A); -o and --stats are then patterns: out_####.exr");
@@ -157,6 +164,9 @@ int main(int argc, char** argv) {
   preview->add_option("--height", pv.height, "Window height (overrides film.height)")->check(CLI::Range(16, pyrolume::kMaxFilmSide));
   preview->add_option("--exposure", pv.exposure, "Starting exposure in stops (within ±30), or auto (overrides film.exposure)")
       ->check(kExposure);
+  preview->add_option("--view", pv.view,
+                      "Starting view transform, agx | agx_punchy | filmic | standard (overrides film.view; V cycles)")
+      ->check(kView);
 
   std::string info_file;
   bool info_values = false;

@@ -6,13 +6,16 @@
 
 #include "shared/view_transform.h"
 #include "util/Error.h"
+#include "util/Suggest.h"
 
 namespace pyrolume {
 
 namespace {
 
-display::uint view_id(ViewTransform view) {
-  return view == ViewTransform::Standard ? display::VIEW_STANDARD : display::VIEW_AGX;
+std::vector<std::string> view_names() {
+  std::vector<std::string> names;
+  for (ViewTransform v : kViewTransforms) names.push_back(to_string(v));
+  return names;
 }
 
 // BT.709 / sRGB relative luminance of linear RGB.
@@ -33,11 +36,23 @@ double grey_for_display_level(double level, ViewTransform view) {
 
 }  // namespace
 
-glm::vec3 display_encode(glm::vec3 exposed, ViewTransform view) { return display::view_display(exposed, view_id(view)); }
+static_assert(std::size(kViewTransforms) == display::VIEW_COUNT, "every film.view name has a shader view, and back");
+
+uint32_t view_shader_id(ViewTransform view) {
+  switch (view) {
+    case ViewTransform::Standard: return display::VIEW_STANDARD;
+    case ViewTransform::AgXPunchy: return display::VIEW_AGX_PUNCHY;
+    case ViewTransform::Filmic: return display::VIEW_FILMIC;
+    case ViewTransform::AgX: break;
+  }
+  return display::VIEW_AGX;
+}
+
+glm::vec3 display_encode(glm::vec3 exposed, ViewTransform view) { return display::view_display(exposed, view_shader_id(view)); }
 
 std::vector<unsigned char> display_rgb8(const Image& img, double exposure_stops, ViewTransform view) {
   const double scale = std::exp2(exposure_stops);
-  const display::uint id = view_id(view);
+  const display::uint id = view_shader_id(view);
   std::vector<unsigned char> bytes(img.rgb.size());
   for (size_t i = 0; i + 2 < img.rgb.size(); i += 3) {
     // Scaled in double, rounded once to float: the arithmetic PNG output always had.
@@ -121,6 +136,20 @@ std::string exposure_problem(const std::string& text) {
   if (std::abs(v) > kMaxExposureStops)
     return "must be within ±" + std::to_string(int(kMaxExposureStops)) + " stops, got " + text;
   return "";
+}
+
+std::string view_problem(const std::string& text) {
+  const std::vector<std::string> names = view_names();
+  if (std::find(names.begin(), names.end(), text) != names.end()) return "";
+  return not_one_of(text, names, /*suggest=*/true);
+}
+
+std::optional<ViewTransform> parse_view(const std::string& text, const std::string& flag) {
+  if (text.empty()) return std::nullopt;  // not given
+  if (const std::string why = view_problem(text); !why.empty()) throw input_error(flag, "", why);
+  for (ViewTransform v : kViewTransforms)
+    if (text == to_string(v)) return v;
+  return std::nullopt;  // unreachable: view_problem accepted it
 }
 
 ExposureOverride parse_exposure(const std::string& text, const std::string& flag) {

@@ -4,6 +4,7 @@
 // shader runs too), and auto exposure. PNG output goes through display_rgb8;
 // so should anything that judges what a user will see (docs/view-transform.md).
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -15,6 +16,10 @@
 #include "scene/Scene.h"
 
 namespace pyrolume {
+
+// The view's VIEW_* number in shaders/shared/view_transform.h (what the
+// preview's display shader is given).
+uint32_t view_shader_id(ViewTransform view);
 
 // One colour: sRGB-encoded display values in [0, 1] of linear sRGB radiance
 // that is already scaled by 2^exposure.
@@ -49,6 +54,13 @@ ExposureOverride parse_exposure(const std::string& text, const std::string& flag
 // Why `text` is no exposure value, "" when it is one: "auto", or a finite
 // number of stops within ±kMaxExposureStops (the empty text is none).
 std::string exposure_problem(const std::string& text);
+
+// A `--view` value (render, preview): one of film.view's names, overriding
+// film.view on every frame. Empty text: no override (nullopt). Anything else:
+// InputError naming `flag`, with a "did you mean" for a near miss.
+std::optional<ViewTransform> parse_view(const std::string& text, const std::string& flag = "--view");
+// Why `text` is no view name, "" when it is one (the empty text is none).
+std::string view_problem(const std::string& text);
 
 // The exposure display output uses, frame after frame: the override's, else
 // film.exposure (evaluated at the frame by the caller); "auto" from either is

@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "shared/preview_types.h"
-#include "shared/view_transform.h"
+#include "image/DisplayTransform.h"
 #include "render/vulkan/Spirv.h"
+#include "shared/preview_types.h"
 
 namespace pyrolume::preview {
 
@@ -46,7 +46,7 @@ void DisplayPass::record(VkCommandBuffer cmd, int spp, double exposure_stops, Vi
   dc.border = gpu::vec3(border);
   dc.radiance_scale = spp > 0 ? float(std::exp2(exposure_stops) / spp) : 0.0f;
   dc.swap_red_blue = bgra_ ? 1u : 0u;
-  dc.view = view == ViewTransform::Standard ? display::VIEW_STANDARD : display::VIEW_AGX;
+  dc.view = view_shader_id(view);
   pipeline_.bind(cmd, set_.set());
   pipeline_.push(cmd, dc);
   const uint32_t g = gpu::PREVIEW_WORKGROUP_SIZE;

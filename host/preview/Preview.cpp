@@ -71,8 +71,8 @@ constexpr double kTemperatureStep = 1.05;   // factor per key press
 constexpr int kAutoExposureSpp = 16;
 
 const char* kControls =
-    "left drag: orbit, right/middle drag: pan, wheel: zoom, +/-: exposure, [ ]: temperature scale, R: reset, S: save, "
-    "Esc: quit";
+    "left drag: orbit, right/middle drag: pan, wheel: zoom, +/-: exposure, V: view, [ ]: temperature scale, R: reset, "
+    "S: save, Esc: quit";
 
 std::string render_hint(const std::string& scene) {
   return "use `pyrolume render " + scene + " -o out.png` instead";
@@ -299,6 +299,13 @@ void PreviewWindow::apply_input() {
     exposure_ += kExposureStep * in.exposure_steps;  // display only: no restart
     auto_exposure_held_ = true;                      // the user's choice from here on
   }
+  if (in.view_steps != 0) {
+    // The next view in kViewTransforms' order: display only, no restart.
+    const int n = int(std::size(kViewTransforms));
+    int at = 0;
+    while (at < n && kViewTransforms[at] != scene_.film.view) ++at;
+    scene_.film.view = kViewTransforms[((at + in.view_steps) % n + n) % n];
+  }
   if (in.temperature_steps != 0) {
     const int i = first_grid_medium();
     if (i < 0) {
@@ -310,7 +317,7 @@ void PreviewWindow::apply_input() {
     }
   }
   const bool save = in.save;
-  const bool exposure_changed = in.exposure_steps != 0;
+  const bool exposure_changed = in.exposure_steps != 0 || in.view_steps != 0;
   const bool resized = in.framebuffer_resized;
   in = Input{in.last_x, in.last_y, in.have_last};
   in.framebuffer_resized = resized;
@@ -472,9 +479,9 @@ void PreviewWindow::update_title(bool force) {
   last_title_ = now;
   if (!note_.empty() && now > note_until_) note_.clear();
   char head[256];
-  std::snprintf(head, sizeof head, "pyrolume preview: %d spp%s | %.1f Msamples/s | %s | exposure %+.1f",
+  std::snprintf(head, sizeof head, "pyrolume preview: %d spp%s | %.1f Msamples/s | %s | exposure %+.1f | view %s",
                 session_->spp_done(), session_->spp_done() >= kPreviewStopSpp ? " (done)" : "", msamples_per_s_,
-                ctx_->info().name.c_str(), exposure_);
+                ctx_->info().name.c_str(), exposure_, to_string(scene_.film.view));
   std::string title = head;
   if (int i = first_grid_medium(); i >= 0) {
     char t[64];
@@ -541,7 +548,9 @@ int run_preview_command(const PreviewArgs& args) {
     }
   }
   parse_exposure(args.exposure);         // InputError (a bad --exposure): exit 2
+  const std::optional<ViewTransform> view = parse_view(args.view);  // and a bad --view
   Scene scene = load_scene(args.scene);  // InputError: the CLI prints it, exit 2
+  if (view) scene.film.view = *view;
   // Source conventions, up axis and framing, as `render` settles them.
   const SceneSetup setup = complete_scene(scene, args.width || args.height || scene.film.size_given);
   for (const std::string& note : setup.notes) std::cerr << "pyrolume: note: " << note << "\n";

@@ -13,6 +13,7 @@ struct PreviewArgs {
   int device = -1;
   std::optional<int> width, height;
   std::string exposure;  // stops or "auto", overriding film.exposure; empty = the scene's
+  std::string view;      // one of film.view's names, overriding film.view; empty = the scene's
 };
 
 // Returns the exit status. Without a display, without GLFW at build time, or

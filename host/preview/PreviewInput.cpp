@@ -32,6 +32,7 @@ void on_char(GLFWwindow* w, unsigned int c) {
   switch (c) {
     case '+': case '=': in.exposure_steps++; break;  // '=' is unshifted '+' on US layouts
     case '-': case '_': in.exposure_steps--; break;
+    case 'v': case 'V': in.view_steps++; break;
     case ']': in.temperature_steps++; break;
     case '[': in.temperature_steps--; break;
     case 'r': case 'R': in.reset = true; break;

@@ -1,7 +1,7 @@
 #pragma once
 // The preview window's input (Preview.cpp): what the GLFW callbacks gather
 // between two display frames, which the next frame applies (orbit, pan, zoom,
-// exposure, temperature scale, reset, save; Esc closes the window).
+// exposure, view, temperature scale, reset, save; Esc closes the window).
 #include <GLFW/glfw3.h>
 
 namespace pyrolume {
@@ -14,6 +14,7 @@ struct Input {
   double pan_x = 0, pan_y = 0;      // pixels dragged with the right or middle button
   double zoom = 0;                  // wheel steps
   int exposure_steps = 0;
+  int view_steps = 0;  // V: the next view transform
   int temperature_steps = 0;
   bool reset = false, save = false;
   bool framebuffer_resized = false;

@@ -65,7 +65,20 @@ struct Camera {
 
 // film.view: how display output (PNG, the preview) shows the linear render
 // (docs/view-transform.md). EXR output is never transformed.
-enum class ViewTransform { AgX, Standard };
+enum class ViewTransform { AgX, Standard, AgXPunchy, Filmic };
+// The views as the scene file, --view and errors name them, in that order.
+inline constexpr ViewTransform kViewTransforms[] = {ViewTransform::AgX, ViewTransform::AgXPunchy,
+                                                    ViewTransform::Filmic, ViewTransform::Standard};
+inline constexpr ViewTransform kDefaultView = ViewTransform::AgX;
+inline const char* to_string(ViewTransform v) {
+  switch (v) {
+    case ViewTransform::AgX: return "agx";
+    case ViewTransform::Standard: return "standard";
+    case ViewTransform::AgXPunchy: return "agx_punchy";
+    case ViewTransform::Filmic: return "filmic";
+  }
+  return "agx";
+}
 
 // Samples per pixel are 1 to 2^24 (16 777 216) everywhere (film.spp, --spp,
 // both backends, a checkpoint's count): per-pixel counts and the GPU's uint
@@ -93,7 +106,7 @@ struct Film {
   double exposure = 0.0;  // stops, applied to display output (PNG, preview) only
   Keyframes<double> exposure_keys;
   bool exposure_auto = false;  // "exposure": "auto": chosen from the rendered image (docs/view-transform.md)
-  ViewTransform view = ViewTransform::AgX;
+  ViewTransform view = kDefaultView;
   uint32_t seed = 1;
   // Camera rays that leave the scene add no radiance (the background or sky
   // still lights it), so RGB over A composites over a plate; PNG then has

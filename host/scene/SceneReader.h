@@ -77,13 +77,13 @@ class Reader {
     if (!v.is_string()) fail(key, "expected a string, got " + type_name(v));
     return v.get<std::string>();
   }
-  std::string choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed) {
+  // One of `allowed`; with `suggest`, the error names the nearest one too.
+  std::string choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed,
+                     bool suggest = false) {
     std::string s = string(key, fallback);
     for (const auto& a : allowed)
       if (s == a) return s;
-    std::string list;
-    for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + ("\"" + a + "\"");
-    fail(key, "must be one of " + list + ", got \"" + s + "\"");
+    fail(key, not_one_of(s, allowed, suggest));
   }
   // One of `values`, spelled in the file as its to_string names it.
   template <typename E>

@@ -45,4 +45,10 @@ std::string did_you_mean(const std::string& word, const std::vector<std::string>
   return c.empty() ? std::string() : " (did you mean \"" + c + "\"?)";
 }
 
+std::string not_one_of(const std::string& word, const std::vector<std::string>& allowed, bool suggest) {
+  std::string list;
+  for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + ("\"" + a + "\"");
+  return "must be one of " + list + ", got \"" + word + "\"" + (suggest ? did_you_mean(word, allowed) : "");
+}
+
 }  // namespace pyrolume

@@ -1,6 +1,6 @@
 #pragma once
 // "Did you mean": the known name closest to a misspelt one, for the one-line
-// errors of unknown scene keys and command-line flags.
+// errors of unknown scene keys, command-line flags and some values (film.view).
 #include <string>
 #include <vector>
 
@@ -17,5 +17,9 @@ std::string closest_name(const std::string& word, const std::vector<std::string>
 
 // " (did you mean \"NAME\"?)" for closest_name, or "" when none is near.
 std::string did_you_mean(const std::string& word, const std::vector<std::string>& known);
+
+// The reason an unknown value is refused: `must be one of "a", "b", got "x"`,
+// and with `suggest` the " (did you mean ...?)" of the nearest allowed name.
+std::string not_one_of(const std::string& word, const std::vector<std::string>& allowed, bool suggest = false);
 
 }  // namespace pyrolume

@@ -22,7 +22,7 @@ struct DisplayConstants {
   vec3 border;             // colour of the bars around the image (sRGB, 0..1)
   float radiance_scale;    // 2^exposure / spp: accumulated sum -> displayed linear radiance
   uint swap_red_blue;      // 1: the target stores B,G,R,A in memory
-  uint view;               // VIEW_AGX or VIEW_STANDARD (shared/view_transform.h)
+  uint view;               // VIEW_AGX, VIEW_STANDARD, ... (shared/view_transform.h)
   uint unused0, unused1;
 };
 

@@ -1,4 +1,4 @@
-// The view transform: scene-linear radiance (already scaled by 2^exposure) ->
+// The view transforms: scene-linear radiance (already scaled by 2^exposure) ->
 // sRGB-encoded display values in [0, 1]. One implementation, included by the
 // PNG writer (host/image/DisplayTransform.cpp) and the preview's display shader
 // (shaders/preview_display.comp), written in the common subset of GLSL and C++
@@ -15,6 +15,8 @@ using vec3 = glm::vec3;
 using mat3 = glm::mat3;
 using uint = uint32_t;
 using glm::clamp;
+using glm::dot;
+using glm::exp2;
 using glm::log2;
 using glm::max;
 using glm::min;
@@ -25,9 +27,14 @@ using glm::transpose;
 #define VIEW_FN
 #endif
 
-// film.view: which transform (DisplayConstants.flags.y in the preview).
-PYRO_CONST uint VIEW_AGX = 0u;       // AgX, base contrast, sRGB display (the default)
-PYRO_CONST uint VIEW_STANDARD = 1u;  // clip to [0, 1], sRGB OETF: the output before views existed
+// film.view: which transform (DisplayConstants.view in the preview). The
+// numbers are only this header's and the preview's; scene files use the names
+// of host/scene/Scene.h (to_string(ViewTransform)).
+PYRO_CONST uint VIEW_AGX = 0u;         // AgX, base contrast, sRGB display
+PYRO_CONST uint VIEW_STANDARD = 1u;    // clip to [0, 1], sRGB OETF: the output before views existed
+PYRO_CONST uint VIEW_AGX_PUNCHY = 2u;  // AgX with the "punchy" look (an ASC CDL on the sigmoid's output)
+PYRO_CONST uint VIEW_FILMIC = 3u;      // a fit of Blender 3.4's Filmic, look None, sRGB display
+PYRO_CONST uint VIEW_COUNT = 4u;
 
 // AgX's log2 encoding spans AGX_EV_BELOW stops below to AGX_EV_ABOVE stops above
 // middle grey (Blender 4's AgX: -10 to +6.5 EV around 0.18).
@@ -98,8 +105,9 @@ VIEW_FN vec3 view_agx_sigmoid(vec3 x) {
 // non-finite samples are recorded as 0.)
 VIEW_FN float view_sanitize(float v) { return v > 0.0f ? min(v, 1.0e30f) : 0.0f; }
 
-// AgX: scene-linear sRGB -> display-linear sRGB in [0, 1].
-VIEW_FN vec3 view_agx(vec3 rgb) {
+// AgX up to its sigmoid: scene-linear sRGB -> the sigmoid's display-encoded
+// output, per channel of the inset BT.2020 space.
+VIEW_FN vec3 view_agx_encoded(vec3 rgb) {
   vec3 c = vec3(view_sanitize(rgb.x), view_sanitize(rgb.y), view_sanitize(rgb.z));
   c = view_agx_inset() * (view_bt709_to_bt2020() * c);
   // log2 over [grey - EV_BELOW, grey + EV_ABOVE], normalised to [0, 1]; the
@@ -107,15 +115,93 @@ VIEW_FN vec3 view_agx(vec3 rgb) {
   const float lo = log2(AGX_MIDDLE_GREY) - AGX_EV_BELOW;
   const float range = AGX_EV_BELOW + AGX_EV_ABOVE;
   vec3 x = clamp((log2(max(c, 1.0e-10f)) - lo) / range, 0.0f, 1.0f);
-  // Sigmoid (display-encoded), decode to linear, then the outset and back to BT.709.
-  vec3 y = pow(max(view_agx_sigmoid(x), 0.0f), vec3(AGX_DISPLAY_GAMMA));
+  return view_agx_sigmoid(x);
+}
+
+// AgX after its sigmoid (or a look on the sigmoid's output): decode to linear,
+// then the outset and back to BT.709 -> display-linear sRGB in [0, 1].
+VIEW_FN vec3 view_agx_decode(vec3 encoded) {
+  vec3 y = pow(max(encoded, 0.0f), vec3(AGX_DISPLAY_GAMMA));
   y = view_bt2020_to_bt709() * (view_agx_outset() * y);
   return clamp(y, 0.0f, 1.0f);  // the few out-of-gamut colours: clipped
 }
 
+// AgX: scene-linear sRGB -> display-linear sRGB in [0, 1].
+VIEW_FN vec3 view_agx(vec3 rgb) { return view_agx_decode(view_agx_encoded(rgb)); }
+
+// AgX's "punchy" look, as B. Wrensch's "Minimal AgX implementation" (iolite
+// engine blog, 2023) gives it: an ASC CDL on the sigmoid's display-encoded
+// output, before the decode. Slope 1 and offset 0, so only the power; then the
+// CDL's saturation about the Rec.709-weighted luma of the powered value (the
+// CDL's order: greys stay greys and go to g^1.35 exactly). Negative results
+// of the saturation are clipped by view_agx_decode.
+PYRO_CONST float AGX_PUNCHY_POWER = 1.35f;
+PYRO_CONST float AGX_PUNCHY_SATURATION = 1.4f;
+VIEW_FN vec3 view_agx_punchy_look(vec3 encoded) {
+  vec3 v = pow(max(encoded, 0.0f), vec3(AGX_PUNCHY_POWER));
+  float luma = dot(v, vec3(0.2126f, 0.7152f, 0.0722f));
+  return vec3(luma) + AGX_PUNCHY_SATURATION * (v - vec3(luma));
+}
+
+// AgX with the punchy look: scene-linear sRGB -> display-linear sRGB in [0, 1].
+VIEW_FN vec3 view_agx_punchy(vec3 rgb) { return view_agx_decode(view_agx_punchy_look(view_agx_encoded(rgb))); }
+
+// Filmic: a formula fitted to what Blender 3.4's "Filmic" view (look None,
+// sRGB display, exposure 0, gamma 1) writes through Image.save_render
+// (docs/view-transform.md "Filmic": how it was measured, and its error: within
+// 0.26 8-bit steps on greys, 1.41 on fire colours). Three stages:
+// 1. highlight desaturation: once the largest channel passes about 11.5
+//    (+6 stops over 0.18), the same linear amount is added to every channel,
+//    a growing push towards white (Blender does this with a 3D LUT);
+// 2. per channel, log2 over the 16.5 stops from 0.18 * 2^-10 to 0.18 * 2^6.5,
+//    normalised to [0, 1] and clamped;
+// 3. per channel, the base contrast curve: a degree-8 polynomial through
+//    (0, 0) and (1, 1) whose output is already sRGB-encoded.
+PYRO_CONST float FILMIC_LO = -12.473931188f;     // log2(0.18) - 10: the window's bottom
+PYRO_CONST float FILMIC_HI = 4.026068812f;       // log2(0.18) + 6.5: display white
+PYRO_CONST float FILMIC_BLACK = 0.00017578125f;  // 2^FILMIC_LO = 0.18 / 1024
+PYRO_CONST float FILMIC_U_MAX = 12.526068812f;   // FILMIC_LO + 25: Blender's desaturation stage clips log2(max) here
+// The desaturation's amount, in the log domain: d = log2(max channel) - U0
+// (from max ~ 11.46 on), s = A d / (d + C) + B d, added = BLACK (2^s - 1).
+PYRO_CONST float FILMIC_DESAT_U0 = 3.5180113f;
+PYRO_CONST float FILMIC_DESAT_A = 6.5156213f;
+PYRO_CONST float FILMIC_DESAT_C = 0.303063161f;
+PYRO_CONST float FILMIC_DESAT_B = 2.08404467f;
+
+// The base contrast curve on the normalised log2 value x in [0, 1] (Horner
+// form; coefficients of x^1 .. x^8, which sum to 1): sRGB-encoded output,
+// increasing on [0, 1].
+VIEW_FN vec3 view_filmic_curve(vec3 x) {
+  vec3 y = x * -85.5315807f + 342.530608f;
+  y = y * x - 532.767131f;
+  y = y * x + 403.987543f;
+  y = y * x - 157.537002f;
+  y = y * x + 33.039028f;
+  y = y * x - 2.87575954f;
+  y = y * x + 0.154294485f;
+  return y * x;
+}
+
+// Filmic: scene-linear sRGB -> sRGB-ENCODED display values in [0, 1] (unlike
+// view_agx, whose output is display-linear).
+VIEW_FN vec3 view_filmic(vec3 rgb) {
+  vec3 c = vec3(view_sanitize(rgb.x), view_sanitize(rgb.y), view_sanitize(rgb.z));
+  // 1. Desaturation: depends on the largest channel only; 0 below the onset.
+  float u = min(log2(max(max(max(c.x, c.y), c.z), 1.0e-10f)), FILMIC_U_MAX);
+  float d = max(u - FILMIC_DESAT_U0, 0.0f);
+  float s = FILMIC_DESAT_A * d / (d + FILMIC_DESAT_C) + FILMIC_DESAT_B * d;
+  c = c + vec3(FILMIC_BLACK * (exp2(s) - 1.0f));
+  // 2. The log window; 3. the curve.
+  vec3 x = clamp((log2(max(c, 1.0e-10f)) - FILMIC_LO) / (FILMIC_HI - FILMIC_LO), 0.0f, 1.0f);
+  return clamp(view_filmic_curve(x), 0.0f, 1.0f);
+}
+
 // The whole view: exposed scene-linear sRGB -> sRGB-encoded display values in [0, 1].
 VIEW_FN vec3 view_display(vec3 exposed, uint view) {
-  vec3 d = view == VIEW_STANDARD ? exposed : view_agx(exposed);
+  if (view == VIEW_FILMIC) return view_filmic(exposed);  // encoded already
+  vec3 d = view == VIEW_STANDARD     ? exposed
+           : view == VIEW_AGX_PUNCHY ? view_agx_punchy(exposed)
+                                     : view_agx(exposed);
   return vec3(view_srgb_oetf(d.x), view_srgb_oetf(d.y), view_srgb_oetf(d.z));
 }
 

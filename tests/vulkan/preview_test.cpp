@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "image/DisplayTransform.h"
 #include "image/ImageIo.h"
 #include "scene/Scene.h"
 #include "shared/view_transform.h"
@@ -54,17 +55,27 @@ CliResult run_wrapped(const std::string& prefix, const std::string& args) {
 
 size_t count_lines(const std::string& s) { return size_t(std::count(s.begin(), s.end(), '\n')); }
 
+// What a view shows of exposed linear radiance, display-linear (the sRGB
+// encode undone), as PNG output computes it.
+glm::vec3 shown_linear(glm::vec3 exposed, ViewTransform view) {
+  const glm::vec3 e = display::view_display(exposed, view_shader_id(view));
+  return {srgb_decode(e.x), srgb_decode(e.y), srgb_decode(e.z)};
+}
+
 // The window shows N frames, the screenshot is what it showed, and that agrees
 // with `render` at the same total spp, seen through the same view and exposure.
-void check_screenshot_matches_render(ViewTransform view, double exposure) {
+// The view is the scene's film.view, or with `by_flag` preview's --view.
+void check_screenshot_matches_render(ViewTransform view, double exposure, bool by_flag = false) {
   if (!on_path("xvfb-run")) GTEST_SKIP() << "xvfb-run is not installed (Debian package xvfb): no display to test on";
   auto dir = temp_dir("preview");
   const fs::path shot = dir / "shot.png", ref = dir / "ref.exr", scene = dir / "spheres.json";
   const std::string size = " --width 96 --height 54";
   std::string text = read_file(kSpheres);
-  if (view == ViewTransform::Standard) text.replace(text.find("\"film\": {"), 9, "\"film\": {\"view\": \"standard\", ");
+  if (!by_flag)
+    text.replace(text.find("\"film\": {"), 9, "\"film\": {\"view\": \"" + std::string(to_string(view)) + "\", ");
   write_file(scene, text);
-  const std::string flags = exposure != 0.0 ? " --exposure " + std::to_string(exposure) : "";
+  std::string flags = exposure != 0.0 ? " --exposure " + std::to_string(exposure) : "";
+  if (by_flag) flags += " --view " + std::string(to_string(view));
 
   // Validation on even when run outside ctest: the preview must raise no messages.
   CliResult p = run_wrapped("PYROLUME_VALIDATION=1 xvfb-run -a",
@@ -92,13 +103,13 @@ void check_screenshot_matches_render(ViewTransform view, double exposure) {
   const double n = double(shown.pixel_count());
 
   // What the window should show, display-linear: the view of mean · 2^exposure
-  // (standard: clamp(·, 0, 1); AgX: view_agx), per pixel.
+  // (standard: clamp(·, 0, 1); the others: shown_linear), per pixel.
   const float scale = float(std::exp2(exposure));
   Image shown_want = want;
   for (int y = 0; y < want.height; ++y)
     for (int x = 0; x < want.width; ++x) {
       const glm::vec3 L(want.at(x, y, 0) * scale, want.at(x, y, 1) * scale, want.at(x, y, 2) * scale);
-      const glm::vec3 d = view == ViewTransform::Standard ? glm::clamp(L, 0.0f, 1.0f) : display::view_agx(L);
+      const glm::vec3 d = view == ViewTransform::Standard ? glm::clamp(L, 0.0f, 1.0f) : shown_linear(L, view);
       for (int c = 0; c < 3; ++c) shown_want.at(x, y, c) = d[c];
     }
   // The render's per-pixel variance of the mean, through the exposure.
@@ -112,7 +123,7 @@ void check_screenshot_matches_render(ViewTransform view, double exposure) {
   // correlation. Clamping is 1-Lipschitz, so it cannot raise the SE.
   // q bounds the 8-bit rounding: ≤ 0.5/255 in the encoded value, times the
   // steepest slope of the sRGB decode (2.4/1.055 at V = 1) in linear units.
-  // AgX is not linear, so only the per-pixel test below applies to it.
+  // The other views are not linear, so only the per-pixel test below applies to them.
   const double q = 0.5 / 255.0 * 2.4 / 1.055;
   double brightest = 0.0;
   for (int c = 0; c < 3; ++c) {
@@ -135,7 +146,7 @@ void check_screenshot_matches_render(ViewTransform view, double exposure) {
   // each pixel within 4 · 2 · sigma + q, sigma² pooled over the 3×3
   // neighbourhood (a per-pixel variance from a few dozen samples can be far
   // too small, e.g. 0 where no sample happened to hit a rare bright path).
-  // Through AgX, which mixes the channels, the band is where the view takes
+  // Through the other views, which mix the channels, the band is where the view takes
   // the corners of the box mean ± 8·sigma (per channel): q plus the largest
   // change of the channel over those 8 corners, plus the GLSL-vs-C++
   // difference that view_transform_gpu_test allows (1e-3 encoded).
@@ -157,12 +168,12 @@ void check_screenshot_matches_render(ViewTransform view, double exposure) {
         const glm::vec3 L(want.at(x, y, 0) * scale, want.at(x, y, 1) * scale, want.at(x, y, 2) * scale);
         const glm::vec3 d(8.0 * std::sqrt(pooled_var(x, y, 0)), 8.0 * std::sqrt(pooled_var(x, y, 1)),
                           8.0 * std::sqrt(pooled_var(x, y, 2)));
-        const glm::vec3 centre = display::view_agx(L);
+        const glm::vec3 centre = shown_linear(L, view);
         band = glm::vec3(float(q + 1e-3 * 2.4 / 1.055));
         glm::vec3 spread(0.0f);
         for (int corner = 0; corner < 8; ++corner) {
           const glm::vec3 s(corner & 1 ? 1.0f : -1.0f, corner & 2 ? 1.0f : -1.0f, corner & 4 ? 1.0f : -1.0f);
-          spread = glm::max(spread, glm::abs(display::view_agx(L + s * d) - centre));
+          spread = glm::max(spread, glm::abs(shown_linear(L + s * d, view) - centre));
         }
         band += spread;
       }
@@ -178,8 +189,12 @@ void check_screenshot_matches_render(ViewTransform view, double exposure) {
 // The standard view, with --exposure: the window shows clamp(mean · 2^EV, 0, 1).
 TEST(Preview, ScreenshotUnderXvfbMatchesRender) { check_screenshot_matches_render(ViewTransform::Standard, -1.0); }
 
-// The default view: the window shows AgX of the mean.
+// AgX: the window shows AgX of the mean.
 TEST(Preview, AgxScreenshotMatchesRender) { check_screenshot_matches_render(ViewTransform::AgX, 0.0); }
+
+// Filmic, chosen by --view (whose output is sRGB-encoded already, unlike the
+// other views': the shader must not encode it twice).
+TEST(Preview, FilmicByFlagScreenshotMatchesRender) { check_screenshot_matches_render(ViewTransform::Filmic, 0.5, true); }
 
 TEST(Preview, NoDisplayIsOneLineAndStatus2) {
   // Without a display the window cannot open: one line that points at `render`
