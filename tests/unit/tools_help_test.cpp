@@ -20,7 +20,8 @@ TEST(ToolsHelp, EveryToolAnswersHelpWritesNothingAndExitsZero) {
   std::vector<fs::path> list = {tools / "demo",     tools / "test",   tools / "fuzz",
                                 tools / "sanitize", tools / "encode", tools / "gen_cie_tables",
                                 tools / "gen_explosion_sequence",     tools / "bench",
-                                tools / "readme_images",              tools / "cycles/compare_blender_fire"};
+                                tools / "readme_images",              tools / "cycles/compare_blender_fire",
+                                tools / "cycles/compare_views"};
   int built = 0;
   for (const char* name : {"gen_sky", "gen_fire_vdb", "gen_terrain", "bench_mis", "bench_lookup"})
     if (fs::exists(bin / name)) list.push_back(bin / name), ++built;
