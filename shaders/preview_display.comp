@@ -1,6 +1,6 @@
 #version 460
 // The preview's display pass: the progressive render's mean (Σ L / spp), scaled
-// by the exposure, through the view transform (AgX or standard, with its sRGB
+// by the exposure, through the view transform (film.view, with its sRGB
 // encode: shared/view_transform.h, the code PNG output runs too) and packed to
 // 8 bits per channel in the byte order of the swapchain image, letterboxed
 // into the window. The host copies the result into the swapchain image with

@@ -69,7 +69,10 @@ enum class ViewTransform { AgX, Standard, AgXPunchy, Filmic };
 // The views as the scene file, --view and errors name them, in that order.
 inline constexpr ViewTransform kViewTransforms[] = {ViewTransform::AgX, ViewTransform::AgXPunchy,
                                                     ViewTransform::Filmic, ViewTransform::Standard};
-inline constexpr ViewTransform kDefaultView = ViewTransform::AgX;
+// The default: Filmic, the view closest to Blender 3.4's default view (its
+// Filmic) in core and edge hue and luminance range on two Blender fires
+// (docs/view-transform.md "Choosing the default"; tools/cycles/compare_views).
+inline constexpr ViewTransform kDefaultView = ViewTransform::Filmic;
 inline const char* to_string(ViewTransform v) {
   switch (v) {
     case ViewTransform::AgX: return "agx";

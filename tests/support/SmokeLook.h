@@ -3,7 +3,7 @@
 // names only a smoke export renders smoke that is
 //  - visible: the fraction of pixels with alpha (EXR A = 1 − T) above 0.05;
 //  - shaded: among those, the 90th percentile of display luminance (Rec. 709
-//    weights on the PNG's bytes / 255, exposure 0, AgX) over the 10th;
+//    weights on the PNG's bytes / 255, exposure 0, the default view) over the 10th;
 //  - not glowing: the image mean equals that of the same scene with
 //    emission.scale 0 within 4 standard errors (each from --variance),
 //    rendered with the same seed (common random numbers: where nothing
@@ -72,11 +72,11 @@ inline void image_mean(const Image& img, double& mean, double& se) {
 }
 
 // Measures a render read from EXR (with A and variance), its display bytes
-// as the PNG a render writes at the defaults (exposure 0, AgX).
+// as the PNG a render writes at the defaults (exposure 0, the default view).
 inline SmokeLook smoke_look(const Image& img) {
   SmokeLook look;
   if (img.alpha.size() != img.pixel_count() || img.pixel_count() == 0) return look;
-  const std::vector<unsigned char> bytes = display_rgb8(img, 0.0, ViewTransform::AgX);
+  const std::vector<unsigned char> bytes = display_rgb8(img, 0.0, kDefaultView);
   const unsigned char* px = bytes.data();
   look.width = img.width;
   look.height = img.height;

@@ -71,7 +71,7 @@ TEST_P(CliRender, WritesExrWithVarianceStatsAndSummary) {
 TEST_P(CliRender, PngIsSrgbWithExposure) {
   const std::string backend = GetParam();
   auto dir = temp_dir("png");
-  // The standard view: exposure, clip, sRGB (AgX, the default, has its own tests:
+  // The standard view: exposure, clip, sRGB (the other views have their own tests:
   // tests/unit/image_view_transform_test.cpp).
   std::string standard = kCliScene;
   standard.replace(standard.find("\"seed\": 3"), 9, "\"seed\": 3, \"view\": \"standard\"");
