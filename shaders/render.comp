@@ -38,26 +38,16 @@ void main() {
   }
   uvec2 pixel = gl_GlobalInvocationID.xy + uvec2(0u, pass_constants.row_begin);
   uint width = frame.width, height = frame.height;
-  const bool in_image = pixel.x < width && pixel.y < min(height, pass_constants.row_end);
-  const uint first = pass_constants.sample_offset, last = first + pass_constants.spp;
-  // The guide, once per render and before the paths, so that a SIMD group's
-  // lanes march together (inside the regenerating loop below, a lane would
-  // march while the rest of its group waited); before the invocations past
-  // the image leave, as the workgroup shares its corner marches (a barrier).
-  vec4 guide = vec4(0.0);
-  if (AOVS && DEBUG_MODE == DEBUG_NONE && first == 0u)
-    guide = pixel_guide(gl_WorkGroupID.xy * uvec2(WORKGROUP_SIZE_X, WORKGROUP_SIZE_Y) + uvec2(0u, pass_constants.row_begin), in_image);
-  if (!in_image) return;
+  if (pixel.x >= width || pixel.y >= min(height, pass_constants.row_end)) return;
   uint pixel_index = pixel.y * width + pixel.x;
 
   vec3 pass_sum = vec3(0.0), pass_sq = vec3(0.0);
   vec3 pass_sum_c = vec3(0.0), pass_sq_c = vec3(0.0);  // their Kahan compensations
   vec2 pass_alpha = vec2(0.0);                          // Σα, Σα²
   AovSums aovs = no_aovs();
-  aovs.guide = guide.rgb;
-  aovs.guide_alpha = guide.a;
   PathStats stats = PathStats(0.0, 0.0);
   float nonfinite = 0.0;
+  const uint first = pass_constants.sample_offset, last = first + pass_constants.spp;
   uint k = first;  // the next sample: k < last after the loops means llvmpipe's loop budget ran out
   if (DEBUG_MODE != DEBUG_NONE) {
     for (; k < last; ++k) {
@@ -80,6 +70,10 @@ void main() {
     // unfinished samples are reported below and the host redoes the pass in
     // smaller ones. (The nested loops are from when the limit was thought to
     // be per loop; they cost nothing.)
+    // The guide, before the paths so that the SIMD group's lanes march
+    // together (inside the regenerating loop below, a lane would march while
+    // the rest of its group waited).
+    if (AOVS && first == 0u) add_pixel_guide(pixel, aovs);
     uint rng;
     PathState p;
     camera_path(pixel, k, rng, p);

@@ -285,7 +285,7 @@ struct AovLightTexel {
 
 // film.aovs: sums of the camera ray's first-event features over the samples
 // that have one (hits counts them), and the pixel's denoiser guide (written
-// once, by the first pass: accumulation.glsl pixel_guide; guide.glsl: the
+// once, by the first pass: accumulation.glsl add_pixel_guide; guide.glsl: the
 // media's emission along the camera ray, and its alpha, by a deterministic
 // ray march).
 struct AovFeatureTexel {
