@@ -36,6 +36,18 @@ import bpy
 import mathutils
 
 
+def set_display_view(scene, view):
+    """Display sRGB through `view`, look None, exposure 0, gamma 1, no curves: how PNGs
+    here are written (tools/cycles/view_exr_blender.py shares it)."""
+    scene.display_settings.display_device = "sRGB"
+    vs = scene.view_settings
+    vs.view_transform = view
+    vs.look = "None"
+    vs.exposure = 0.0
+    vs.gamma = 1.0
+    vs.use_curve_mapping = False
+
+
 def parse_args():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     p = argparse.ArgumentParser(prog="render_vdb_cycles.py",
@@ -161,13 +173,7 @@ def main():
     c.film_exposure = 1.0
     scene.view_layers[0].cycles.use_denoising = False
 
-    scene.display_settings.display_device = "sRGB"
-    vs = scene.view_settings
-    vs.view_transform = a.view
-    vs.look = "None"
-    vs.exposure = 0.0
-    vs.gamma = 1.0
-    vs.use_curve_mapping = False
+    set_display_view(scene, a.view)
 
     t0 = time.time()
     bpy.ops.render.render(write_still=False)

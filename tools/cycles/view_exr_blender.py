@@ -22,6 +22,9 @@ import sys
 import bpy
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from render_vdb_cycles import set_display_view  # noqa: E402  (the same view settings as Cycles' PNGs)
+
 
 def parse_args():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
@@ -54,13 +57,7 @@ def main():
         scene.render.dither_intensity = 0.0
         s = scene.render.image_settings
         s.file_format, s.color_mode, s.color_depth = "PNG", "RGB", "8"
-        scene.display_settings.display_device = "sRGB"
-        vs = scene.view_settings
-        vs.view_transform = a.view
-        vs.look = "None"
-        vs.exposure = 0.0
-        vs.gamma = 1.0
-        vs.use_curve_mapping = False
+        set_display_view(scene, a.view)
         img.save_render(os.path.abspath(a.png), scene=scene)
         print("wrote", a.png, "through", a.view)
 
