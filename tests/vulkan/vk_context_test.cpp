@@ -57,6 +57,22 @@ DeviceInfo fake(uint32_t index, VkPhysicalDeviceType type) {
   return d;
 }
 
+// shaders/test_fill.comp's interface: its bindings, its push constants
+// (count, offset, sample_count) and the set that binds them.
+const std::vector<ComputePipeline::Binding> kTestFillBindings = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                                                                 {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
+                                                                 {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
+                                                                 {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}};
+struct TestFillPush {
+  uint32_t count, offset, sample_count;
+};
+void bind_test_fill(DescriptorSet& set, Buffer& values, Image3D& grid, Image1D& table, Buffer& samples) {
+  set.write_buffer(0, values);
+  set.write_image(1, grid);
+  set.write_image(2, table.view(), table.sampler());
+  set.write_buffer(3, samples);
+}
+
 }  // namespace
 
 TEST(VkCheck, ReportsExpressionResultAndPlace) {
@@ -276,21 +292,12 @@ TEST(VulkanContext, RunsComputeShaderWithImagesUnderValidation) {
     const uint32_t count = 1000;
     Buffer values(ctx, count * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::Readback, "test values");
 
-    ComputePipeline pipeline(ctx, load_spirv("test_fill.comp"),
-                             {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                              {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                              {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                              {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
-                             3 * sizeof(uint32_t), {{0, 2u}}, "test_fill");
+    ComputePipeline pipeline(ctx, load_spirv("test_fill.comp"), kTestFillBindings, sizeof(TestFillPush), {{0, 2u}},
+                             "test_fill");
     DescriptorSet set(ctx, pipeline);
-    set.write_buffer(0, values);
-    set.write_image(1, image3d);
-    set.write_image(2, image1d.view(), image1d.sampler());
-    set.write_buffer(3, sample_buf);
+    bind_test_fill(set, values, image3d, image1d, sample_buf);
 
-    struct Push {
-      uint32_t count, offset, sample_count;
-    } push{count, 7, uint32_t(samples.size())};
+    const TestFillPush push{count, 7, uint32_t(samples.size())};
     test::dispatch_and_wait(ctx, pipeline, set, count, push);
 
     values.invalidate();
@@ -319,11 +326,8 @@ TEST(VulkanContext, PipelineCacheSharesOnlyIdenticalPipelines) {
   {
     Context ctx(test::validated());
     const std::vector<uint32_t> code = load_spirv("test_fill.comp");
-    const std::vector<ComputePipeline::Binding> bindings = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                                                            {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                                                            {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                                                            {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}};
-    const uint32_t push_bytes = 3 * sizeof(uint32_t);
+    const std::vector<ComputePipeline::Binding>& bindings = kTestFillBindings;
+    const uint32_t push_bytes = sizeof(TestFillPush);
     PipelineCache& cache = ctx.pipelines();
     auto get = [&](uint32_t multiplier, const char* name = "fill") {
       return cache.get(code, bindings, push_bytes, {{0, multiplier}}, name);
@@ -350,13 +354,8 @@ TEST(VulkanContext, PipelineCacheSharesOnlyIdenticalPipelines) {
       Buffer samples(ctx, 64, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::HostVisible, "test samples");
       const auto pipeline = get(multiplier);
       DescriptorSet set(ctx, *pipeline);
-      set.write_buffer(0, values);
-      set.write_image(1, image3d);
-      set.write_image(2, image1d.view(), image1d.sampler());
-      set.write_buffer(3, samples);
-      struct Push {
-        uint32_t count, offset, sample_count;
-      } push{count, 5, 0};
+      bind_test_fill(set, values, image3d, image1d, samples);
+      const TestFillPush push{count, 5, 0};
       test::dispatch_and_wait(ctx, *pipeline, set, count, push);
       values.invalidate();
       const uint32_t* v = values.data<uint32_t>();
