@@ -12,12 +12,6 @@ namespace pyrolume {
 
 namespace {
 
-std::vector<std::string> view_names() {
-  std::vector<std::string> names;
-  for (ViewTransform v : kViewTransforms) names.push_back(to_string(v));
-  return names;
-}
-
 // BT.709 / sRGB relative luminance of linear RGB.
 double luminance(const float* rgb) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }
 
@@ -139,17 +133,14 @@ std::string exposure_problem(const std::string& text) {
 }
 
 std::string view_problem(const std::string& text) {
-  const std::vector<std::string> names = view_names();
-  if (std::find(names.begin(), names.end(), text) != names.end()) return "";
-  return not_one_of(text, names, /*suggest=*/true);
+  return view_from_name(text) ? "" : not_one_of(text, view_names(), /*suggest=*/true);
 }
 
 std::optional<ViewTransform> parse_view(const std::string& text, const std::string& flag) {
   if (text.empty()) return std::nullopt;  // not given
-  if (const std::string why = view_problem(text); !why.empty()) throw input_error(flag, "", why);
-  for (ViewTransform v : kViewTransforms)
-    if (text == to_string(v)) return v;
-  return std::nullopt;  // unreachable: view_problem accepted it
+  const std::optional<ViewTransform> view = view_from_name(text);
+  if (!view) throw input_error(flag, "", view_problem(text));
+  return view;
 }
 
 ExposureOverride parse_exposure(const std::string& text, const std::string& flag) {

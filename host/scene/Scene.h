@@ -82,6 +82,18 @@ inline const char* to_string(ViewTransform v) {
   }
   return "agx";
 }
+// The names of kViewTransforms, in its order (the scene file, --view, errors).
+inline std::vector<std::string> view_names() {
+  std::vector<std::string> names;
+  for (ViewTransform v : kViewTransforms) names.push_back(to_string(v));
+  return names;
+}
+// The view a name stands for; nullopt for no view's name.
+inline std::optional<ViewTransform> view_from_name(const std::string& name) {
+  for (ViewTransform v : kViewTransforms)
+    if (name == to_string(v)) return v;
+  return std::nullopt;
+}
 
 // Samples per pixel are 1 to 2^24 (16 777 216) everywhere (film.spp, --spp,
 // both backends, a checkpoint's count): per-pixel counts and the GPU's uint

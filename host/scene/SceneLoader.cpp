@@ -375,11 +375,7 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& fil
         if (std::abs(s.film.exposure_keys.values[n]) > kMaxExposureStops)
           f.fail("exposure.keys[" + std::to_string(n) + "]", limit + ", got " + json(s.film.exposure_keys.values[n]).dump());
     }
-    std::vector<std::string> views;
-    for (ViewTransform v : kViewTransforms) views.push_back(to_string(v));
-    const std::string view = f.choice("view", to_string(kDefaultView), views, /*suggest=*/true);
-    for (ViewTransform v : kViewTransforms)
-      if (view == to_string(v)) s.film.view = v;
+    s.film.view = *view_from_name(f.choice("view", to_string(kDefaultView), view_names(), /*suggest=*/true));
     s.film.seed = static_cast<uint32_t>(f.integer("seed", static_cast<int>(s.film.seed), 0, 2147483647));
     s.film.transparent = f.boolean("transparent", false);
     s.film.aovs = f.boolean("aovs", false);
