@@ -19,6 +19,45 @@ const uint GUIDE_MAX_STEPS = 4096u;
 // adds at most this fraction of its own light (docs/compositing.md "The guide").
 const float GUIDE_MIN_TRANSMITTANCE = 1e-6;
 
+// One march step over [t, t + dt) at its midpoint, exact for constant
+// coefficients.
+void guide_step(vec3 E, vec3 sigma_t, float dt, inout vec3 L, inout vec3 T) {
+  const vec3 tr = exp(-sigma_t * dt);
+  // E·Δt where σt·Δt is too small for (1 − e^(−σt·Δt))/σt to keep its digits.
+  L += T * mix(E * dt, E * (1.0 - tr) / max(sigma_t, vec3(1e-30)), greaterThan(sigma_t * dt, vec3(1e-4)));
+  T *= tr;
+}
+
+// One dense grid, the common case: the medium, its texel mapping and its
+// majorant cells' DDA are set up once per ray, and the march walks the cells
+// with it (what guide_media does for any media, the same steps and values).
+void guide_one_grid(vec3 o, vec3 d, float t, float t1, float h, inout vec3 L, inout vec3 T) {
+  const GpuMedium m = media[0];
+  const uint slot = m.grid_slot;
+  const vec3 u0 = density_texel(slot, o), du = density_texel_dir(slot, d);
+  float nudge;
+  CellWalk w = cell_walk(slot, o, d, t, nudge);
+  uint n = 0u;  // steps and cells taken
+  while (n < GUIDE_MAX_STEPS && t < t1 && max3(T) >= GUIDE_MIN_TRANSMITTANCE) {
+    const float t_next = min(min3(w.t_axis), t1);
+    if (cell_majorant(slot, w, false) > 0.0 && t_next > t) {
+      const uint steps = uint(clamp(ceil((t_next - t) / h), 1.0, float(GUIDE_MAX_STEPS)));
+      const float dt = (t_next - t) / float(steps);
+      for (uint j = 0u; j < steps && n < GUIDE_MAX_STEPS; ++j, ++n) {
+        const float tm = t + (float(j) + 0.5) * dt;
+        const vec2 v = density_at(slot, u0 + tm * du);
+        const float r = grids[slot].density_scale * v.x;
+        const vec3 E = r > 0.0 ? r * m.sigma_a * grid_le(m, slot, o + tm * d, v.y) : vec3(0.0);
+        guide_step(E, r * (m.sigma_a + m.sigma_s), dt, L, T);
+      }
+    } else {
+      ++n;
+    }
+    t = max(t, t_next);
+    if (!cell_step(w)) break;
+  }
+}
+
 // The media part of the guide: emission and transmittance from the media
 // entry to t_end (the surface or sphere light, or INF).
 void guide_media(vec3 o, vec3 d, float t_end, vec2 span[MEDIA_N], inout vec3 L, inout vec3 T) {
@@ -31,6 +70,10 @@ void guide_media(vec3 o, vec3 d, float t_end, vec2 span[MEDIA_N], inout vec3 L, 
     if (is_grid(m)) h = min(h, 1.0 / max(length(density_texel_dir(m.grid_slot, d)), 1e-30));
   }
   t1 = min(t1, t_end);
+  if (MEDIUM_COUNT == 1u && is_grid(media[0]) && !(SPARSE_GRIDS && grids[media[0].grid_slot].density.tree != 0u)) {
+    guide_one_grid(o, d, t0, t1, h, L, T);
+    return;
+  }
   PathStats stats = PathStats(0.0, 0.0);
   float t = t0;
   uint n = 0u;  // steps taken
@@ -56,12 +99,7 @@ void guide_media(vec3 o, vec3 d, float t_end, vec2 span[MEDIA_N], inout vec3 L, 
       uint no_rng = 0u;  // the guide's march reads the trilinear density
       MediumPoint mp;
       coefficients_at(x, tm, span, false, mp, stats, no_rng);
-      const vec3 E = emission_at(x, tm, span, mp);
-      const vec3 sigma_t = mp.sigma_a + mp.sigma_s;
-      const vec3 tr = exp(-sigma_t * dt);
-      // E·Δt where σt·Δt is too small for (1 − e^(−σt·Δt))/σt to keep its digits.
-      L += T * mix(E * dt, E * (1.0 - tr) / max(sigma_t, vec3(1e-30)), greaterThan(sigma_t * dt, vec3(1e-4)));
-      T *= tr;
+      guide_step(emission_at(x, tm, span, mp), mp.sigma_a + mp.sigma_s, dt, L, T);
     }
     t = t_next;
   }

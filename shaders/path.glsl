@@ -126,15 +126,6 @@ bool path_step(inout PathState p, inout vec2 span[MEDIA_N], inout uint rng, inou
   return path_event(p, span, event, c, mp, rng, stats);
 }
 
-// The camera ray's direction through film point pixel + jitter (jitter in [0,1)²).
-vec3 camera_direction(uvec2 pixel, vec2 jitter) {
-  vec2 ndc = vec2(2.0 * (float(pixel.x) + jitter.x) / float(frame.width) - 1.0,
-                  1.0 - 2.0 * (float(pixel.y) + jitter.y) / float(frame.height));
-  float tan_half = frame.tan_half_fov, aspect = frame.aspect;
-  return normalize(frame.camera_forward + ndc.x * tan_half * aspect * frame.camera_right +
-                   ndc.y * tan_half * frame.camera_up);
-}
-
 // Start p as a camera ray through pixel `pixel` for sample `k`, with that
 // sample's random stream (p is filled in place: PathState holds arrays sized
 // by a specialisation constant, which GLSL cannot copy).

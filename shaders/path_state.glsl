@@ -97,13 +97,6 @@ vec3 collision_albedo(vec3 sigma_a, vec3 sigma_s) {
   return mix(vec3(0.0), sigma_s / max(sigma_t, vec3(1e-30)), greaterThan(sigma_t, vec3(0.0)));
 }
 
-// Radiance of a ray that leaves the scene: the environment map (+Z up,
-// docs/lights.md), or the constant background.
-vec3 escaped_radiance(vec3 d) {
-  const vec3 sky = HAS_ENVIRONMENT ? env_radiance(environment, d) : frame.background;
-  return LIGHT_COUNT > 0u ? sky + disc_lights_radiance(d) : sky;
-}
-
 // The ray leaves the scene: add what it sees, MIS-weighted. A light ray
 // toward a delta distant light has reached it.
 void escape(inout PathState p) {

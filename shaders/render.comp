@@ -22,11 +22,12 @@ layout(local_size_x = WORKGROUP_SIZE_X, local_size_y = WORKGROUP_SIZE_Y) in;
 #include "majorant_walk.glsl"
 #include "surface_textures.glsl"
 #include "light_sampling.glsl"
+#include "camera.glsl"
+#include "background.glsl"
 #include "path_state.glsl"
 #include "vertex.glsl"
 #include "tracking.glsl"
 #include "path.glsl"
-#include "guide.glsl"
 #include "accumulation.glsl"
 
 #include "wavefront.glsl"
@@ -70,9 +71,7 @@ void main() {
     // unfinished samples are reported below and the host redoes the pass in
     // smaller ones. (The nested loops are from when the limit was thought to
     // be per loop; they cost nothing.)
-    // The guide, before the paths so that the SIMD group's lanes march
-    // together (inside the regenerating loop below, a lane would march while
-    // the rest of its group waited).
+    // The guide, from the points its own dispatch marched before this pass.
     if (AOVS && first == 0u) add_pixel_guide(pixel, aovs);
     uint rng;
     PathState p;

@@ -49,6 +49,7 @@ layout(std430, set = 0, binding = BINDING_ACCUM) buffer AccumBlock { AccumTexel 
 layout(std430, set = 0, binding = BINDING_ALPHA) buffer AlphaBlock { AlphaTexel alpha_accum[]; };
 layout(std430, set = 0, binding = BINDING_AOV_LIGHTS) buffer AovLightBlock { AovLightTexel aov_lights[]; };
 layout(std430, set = 0, binding = BINDING_AOV_FEATURES) buffer AovFeatureBlock { AovFeatureTexel aov_features[]; };
+layout(std430, set = 0, binding = BINDING_GUIDE_POINTS) buffer GuidePointBlock { vec4 guide_points[]; };
 // The grids stay a uniform block: the free-flight loop reads them every step,
 // where a uniform load is one scalar read and a storage buffer's a per-lane
 // gather (as a storage buffer they made assets/scenes/fire.json render 1.8×

@@ -137,6 +137,7 @@ void write_stats(const std::filesystem::path& file, const RenderArgs& args, cons
   j["total_samples"] = total_samples(result.width, result.height, result.spp);
   j["seconds"] = result.seconds;
   j["load_seconds"] = result.load_seconds;
+  j["guide_seconds"] = result.guide_seconds;
   j["samples_per_second"] = result.seconds > 0 ? new_samples / result.seconds : 0.0;
   j["peak_rss_mb"] = peak_rss_mb();
   const double lookups_per_ray = samples > 0 ? result.density_lookups / samples : 0.0;

@@ -96,6 +96,9 @@ struct RenderResult {
   std::vector<std::array<int, 3>> majorant_grids;
   double seconds = 0.0;       // first dispatch to finished readback
   double load_seconds = 0.0;  // device/pipeline creation, uploads, bakes
+  // Of `seconds`, the denoiser guide's marches (settings.aovs; the Vulkan
+  // backend's guide dispatch; 0 on the CPU, which marches within its passes).
+  double guide_seconds = 0.0;
   // Counters summed over all camera samples.
   double density_lookups = 0.0;  // trilinear density samples
   double events = 0.0;           // real collisions (absorption + scattering)

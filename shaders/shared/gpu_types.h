@@ -59,7 +59,8 @@ PYRO_CONST uint BINDING_AOV_FEATURES = 28;  // buffer AovFeatureTexel[] (one per
 PYRO_CONST uint BINDING_SPARSE = 29;  // usamplerBuffer (rgba32ui): every sparse grid's NanoVDB tree and leaf table (shaders/sparse.glsl)
 PYRO_CONST uint BINDING_DENSITY_TEXELS = 30;  // samplerBuffer[MAX_GRIDS] (r16f or r32f): each dense grid's density texels, for stochastic lookups
 PYRO_CONST uint BINDING_PASS = 31;  // readonly buffer PassConstants: this dispatch's samples and rows (not push constants: vk::ParameterBuffer)
-PYRO_CONST uint SPARSE_ZERO_LEAF = 32;  // byte offset of 512 zero floats in that buffer: the values of every absent leaf
+PYRO_CONST uint BINDING_GUIDE_POINTS = 32;  // buffer vec4[(width + 1)·(height + 1) + width·height]: the guide at the pixels' corners, then centres (film.aovs; guide.comp)
+PYRO_CONST uint SPARSE_ZERO_LEAF = 32;  // (not a binding) byte offset of 512 zero floats in the BINDING_SPARSE buffer: the values of every absent leaf
 
 // Specialisation constants of render.comp: a scene pays only for what it uses.
 PYRO_CONST uint SPEC_HAS_GRIDS = 0;

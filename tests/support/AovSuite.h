@@ -222,8 +222,8 @@ TEST_P(Aovs, GuideHasTheSphereLightsTheCameraSees) {
   EXPECT_NEAR(img.aovs.guide_alpha[p], 1.0, 1e-6);
 }
 
-// The guide is a fixed quadrature of each pixel (four marches through the
-// centres of its quarters), computed once per render, so its cost does not
+// The guide is a fixed quadrature of each pixel (marches through its centre
+// and corners), computed once per render, so its cost does not
 // grow with the sample count: a 1-spp render and a 9-spp one (three passes
 // on the CPU, whose later passes must carry it through) hold the same guide,
 // value for value. A guide averaged over per-sample film points would differ.
@@ -251,6 +251,7 @@ TEST_P(Aovs, NoneWhenNotAsked) {
   s.film.aovs = false;
   const RenderResult r = render(s);
   EXPECT_TRUE(r.aov_sum.empty());
+  EXPECT_EQ(r.guide_seconds, 0.0);  // no guide was marched
   EXPECT_FALSE(image_from_render(r, false).has_aovs());
 }
 

@@ -273,20 +273,28 @@ TEST_F(VulkanVdb, SparseGridMatchesDenseAndTheCpu) {
 
 // The denoiser's guide (film.aovs), GPU (shaders/guide.glsl) against the
 // CPU's independent march, on the procedural fire: both are deterministic
-// for the same film points (the centres of each pixel's 2×2 quarters), so
+// for the same film points (each pixel's centre and corners, weighted 2/3
+// and 1/12; the GPU marches a corner once for the four pixels around it), so
 // they differ only by the march's steps (the GPU takes equal steps of at most
-// a density texel in each majorant cell, the CPU in each media segment) and
-// float against double. Those differences are per ray and not alike from ray
-// to ray: each pixel is within 3 % of the image's brightest guide pixel
-// (2.7 % measured; with 16 rays a pixel, before, 2.2 %), and the image sums
-// within 0.5 % (0.13 % measured). Both are deterministic: no seed can fail
-// them.
+// a density texel through each run of non-empty majorant cells, the CPU
+// through each media segment) and float against double. Those differences
+// are per ray and not alike from ray to ray: each pixel is within 5 % of the
+// image's brightest guide pixel (4.1 % measured; with the four quarter
+// centres weighted 1/4 each, before, 2.7 % against a bound of 3 %: the
+// centre's weight of 2/3 averages the per-ray differences less, √(Σw²) 0.69
+// against 0.5), and the image sums within 0.5 % (0.12 % measured). A corner
+// taken from the neighbouring column fails the first (9.9 % measured). Both
+// are deterministic: no
+// seed can fail them.
 TEST_F(VulkanVdb, GuideAgreesWithCpuOnProceduralFire) {
   Scene s = shipped_fire(24, 16, 16);
   s.film.aovs = true;
   const RenderResult gpu = render(s);
   CpuRenderer cpu;
   const RenderResult ref = cpu.render(s, settings_for(s), {});
+  // The guide's own dispatch is timed, within the render's seconds.
+  EXPECT_GT(gpu.guide_seconds, 0.0);
+  EXPECT_LE(gpu.guide_seconds, gpu.seconds);
   const Image g = image_from_render(gpu, false), cg = image_from_render(ref, false);
   ASSERT_TRUE(g.aovs.has_guide());
   ASSERT_TRUE(cg.aovs.has_guide());
@@ -297,7 +305,7 @@ TEST_F(VulkanVdb, GuideAgreesWithCpuOnProceduralFire) {
     sum_g += g.aovs.guide[k];
     sum_c += cg.aovs.guide[k];
     worst = std::max(worst, std::abs(double(g.aovs.guide[k]) - cg.aovs.guide[k]) / peak);
-    EXPECT_LE(std::abs(double(g.aovs.guide[k]) - cg.aovs.guide[k]), 0.03 * peak) << "value " << k;
+    EXPECT_LE(std::abs(double(g.aovs.guide[k]) - cg.aovs.guide[k]), 0.05 * peak) << "value " << k;
   }
   for (size_t i = 0; i < g.aovs.guide_alpha.size(); ++i)
     EXPECT_NEAR(g.aovs.guide_alpha[i], cg.aovs.guide_alpha[i], 0.01) << "pixel " << i;

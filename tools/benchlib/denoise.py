@@ -6,9 +6,11 @@ For each scene: render it at --resolution (default 1920x1080 in this mode) and
 --aovs (the render's own "seconds" from --stats). `render --denoise` renders
 with the AOVs, as the guided filter reads them and their guide, so the render
 with AOVs is what the denoiser's time is set against, and the one without shows
-what the AOVs and the guide cost. Then time `pyrolume denoise` on the EXR with
-AOVs --reps times (the process's wall time: EXR read and write and the Vulkan
-device included; and the filter alone, as the command prints it). Medians go
+what the AOVs and the guide cost; the guide's own dispatch ("guide_seconds" in
+--stats, part of the render with AOVs) is set against the render without (issue
+46: at most 20 %). Then time `pyrolume denoise` on the EXR with AOVs --reps
+times (the process's wall time: EXR read and write and the Vulkan device
+included; and the filter alone, as the command prints it). Medians go
 into the part of benchmarks.md between <!-- denoise:begin --> and
 <!-- denoise:end --> (at 1920x1080; other sizes have their own markers,
 <!-- denoise 320x180:begin --> and so on).
@@ -69,7 +71,7 @@ def run(args, argv):
             return 2
         exr = os.path.join(work, f"{name}_{args.width}x{args.height}_{args.denoise_spp}spp.exr")
         plain = os.path.join(work, f"{name}_{args.width}x{args.height}_{args.denoise_spp}spp_plain.exr")
-        render_s, plain_s = [], []
+        render_s, plain_s, guide_s = [], [], []
         for rep in range(args.render_reps):
             stats = render(args, scene, plain, plain + ".stats.json", "vulkan", args.denoise_spp, 1 + rep,
                            variance=True)
@@ -77,6 +79,7 @@ def run(args, argv):
             stats = render(args, scene, exr, exr + ".stats.json", "vulkan", args.denoise_spp, 1 + rep, variance=True,
                            aovs=True)
             render_s.append(stats["seconds"])
+            guide_s.append(stats.get("guide_seconds", 0.0))
             log(f"bench: {name}: render {rep + 1}/{args.render_reps}: {plain_s[-1]:.1f} s, "
                 f"{stats['seconds']:.1f} s with --aovs")
         walls, filters = [], []
@@ -86,8 +89,8 @@ def run(args, argv):
             filters.append(filt)
             log(f"bench: {name}: denoise {rep + 1}/{args.reps}: {wall:.2f} s ({filt:.2f} s filtering)")
         r, w, f = statistics.median(render_s), statistics.median(walls), statistics.median(filters)
-        p = statistics.median(plain_s)
-        rows.append((name, p, plain_s, r, render_s, w, walls, f, 100.0 * w / r, 100.0 * (r / p - 1.0)))
+        p, g = statistics.median(plain_s), statistics.median(guide_s)
+        rows.append((name, p, plain_s, r, render_s, w, walls, f, 100.0 * w / r, 100.0 * (r / p - 1.0), g, guide_s))
     mi = machine_info(args.pyrolume)
     BEGIN, END = markers(args.width, args.height)
     lines = [BEGIN, "",
@@ -95,12 +98,14 @@ def run(args, argv):
              f"{mi['cpu']}, {mi['nproc']} cores, {mi['devices'] or 'device unknown'}; "
              f"load {' / '.join(f'{x:.2f}' for x in os.getloadavg())} at the end; medians (every run in brackets).", "",
              "| scene | render, s | render with --aovs, s | `pyrolume denoise`, s (wall) | filter alone, s "
-             "| denoise / render with --aovs | what the AOVs and guide add to the render |",
-             "|---|---|---|---|---|---|---|"]
-    for name, p, ps, r, rs, w, ws, f, pct, extra in rows:
+             "| denoise / render with --aovs | what the AOVs and guide add to the render "
+             "| the guide, s | the guide / render |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for name, p, ps, r, rs, w, ws, f, pct, extra, g, gs in rows:
         lines.append(f"| {name} | {p:.3g} [{', '.join(f'{x:.3g}' for x in ps)}] | "
                      f"{r:.3g} [{', '.join(f'{x:.3g}' for x in rs)}] | "
-                     f"{w:.2f} [{', '.join(f'{x:.2f}' for x in ws)}] | {f:.2f} | {pct:.1f} % | {extra:+.0f} % |")
+                     f"{w:.2f} [{', '.join(f'{x:.2f}' for x in ws)}] | {f:.2f} | {pct:.1f} % | {extra:+.0f} % | "
+                     f"{g:.3g} [{', '.join(f'{x:.3g}' for x in gs)}] | {100.0 * g / p:.1f} % |")
     lines += ["", END]
     block = "\n".join(lines)
     print(block)

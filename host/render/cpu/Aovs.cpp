@@ -113,17 +113,22 @@ void guide_march(const WalkScene& ws, const glm::dvec3& o, const glm::dvec3& d, 
 
 void pixel_guide(const WalkScene& ws, const Camera& camera, int W, int H, int x, int y, Scratch& s,
                  double* aov_sum) {
+  // 2D Simpson-like rule over the pixel's box (docs/compositing.md "The
+  // guide"): 2/3 of the centre's value and 1/12 of each corner's. The GPU
+  // shares each corner between four pixels; here every pixel marches its own.
   glm::dvec3 sum_L(0.0);
   double sum_alpha = 0.0;
-  for (int j = 0; j < 4; ++j) {
-    const double fx = x + 0.25 + 0.5 * (j & 1), fy = y + 0.25 + 0.5 * (j >> 1);
+  for (int j = 0; j < 5; ++j) {
+    const bool centre = j == 4;
+    const double w = centre ? 2.0 / 3.0 : 1.0 / 12.0;
+    const double fx = x + (centre ? 0.5 : double(j & 1)), fy = y + (centre ? 0.5 : double(j >> 1));
     glm::dvec3 L, T;
     guide_march(ws, camera.position, camera_ray_direction(camera, W, H, fx, fy), s, L, T);
-    sum_L += L;
-    sum_alpha += 1.0 - (T.x + T.y + T.z) / 3.0;
+    sum_L += w * L;
+    sum_alpha += w * (1.0 - (T.x + T.y + T.z) / 3.0);
   }
-  for (int c = 0; c < 3; ++c) aov_sum[kAovGuide + c] = sum_L[c] / 4.0;
-  aov_sum[kAovGuideAlpha] = sum_alpha / 4.0;
+  for (int c = 0; c < 3; ++c) aov_sum[kAovGuide + c] = sum_L[c];
+  aov_sum[kAovGuideAlpha] = sum_alpha;
 }
 
 }  // namespace pyrolume::cpu

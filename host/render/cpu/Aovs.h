@@ -14,9 +14,9 @@ namespace pyrolume::cpu {
 // it was not finite and was recorded as 0: then every layer adds 0.
 void add_sample_aovs(const glm::dvec3& L, bool recorded, const WalkAov aov[3], double* sum);
 
-// The pixel (x, y)'s guide into aov_sum at kAovGuide, kAovGuideAlpha: the
-// mean of four marches through the centres of the pixel's 2×2 quarters, once
-// per render (docs/compositing.md "The guide").
+// The pixel (x, y)'s guide into aov_sum at kAovGuide, kAovGuideAlpha: a
+// quadrature of the pixel's box filter from five marches (its centre and
+// corners), once per render (docs/compositing.md "The guide").
 void pixel_guide(const WalkScene& ws, const Camera& camera, int W, int H, int x, int y, Scratch& s, double* aov_sum);
 
 }  // namespace pyrolume::cpu

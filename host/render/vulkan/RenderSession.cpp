@@ -78,9 +78,11 @@ void RenderSession::check_sizes(const Scene& scene) const {
   check_accumulation_size(scene.file.string(), settings_.width, settings_.height,
                           sizeof(gpu::AccumTexel) + sizeof(gpu::AlphaTexel) + aov_bytes, ctx_.max_allocation_size(),
                           "this device's maxMemoryAllocationSize");
+  // With the AOVs, the guide's points too: about two vec4s a pixel (guide_points_).
+  const size_t guide_bytes = settings_.aovs ? 8 * sizeof(float) : 0;
   check_accumulation_fits_memory(scene.file.string(), settings_.width, settings_.height,
-                                 sizeof(gpu::AccumTexel) + sizeof(gpu::AlphaTexel) + aov_bytes + 8 * sizeof(double) +
-                                     aov_host_bytes);
+                                 sizeof(gpu::AccumTexel) + sizeof(gpu::AlphaTexel) + aov_bytes + guide_bytes +
+                                     8 * sizeof(double) + aov_host_bytes);
 }
 
 // The accumulation buffer: AccumTexels, then AlphaTexels and (settings.aovs)
@@ -103,6 +105,10 @@ void RenderSession::create_accumulation() {
                       vk::MemoryKind::DeviceLocal, "accumulation");
   accum_backup_ = vk::Buffer(ctx_, accum_.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                              vk::MemoryKind::DeviceLocal, "accumulation before the pass");
+  const VkDeviceSize guide_points =
+      settings_.aovs ? (VkDeviceSize(settings_.width) + 1) * (VkDeviceSize(settings_.height) + 1) + pixels : 1;
+  guide_points_ = vk::Buffer(ctx_, guide_points * 4 * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                             vk::MemoryKind::DeviceLocal, "guide points");
   pass_constants_ = vk::ParameterBuffer(ctx_, sizeof(gpu::PassConstants), "pass constants");
   pass_status_ = vk::Buffer(ctx_, sizeof(gpu::PassStatus), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                             vk::MemoryKind::HostVisible, "pass status");
@@ -141,8 +147,13 @@ void RenderSession::create_pipeline(const std::vector<uint32_t>& code) {
       {gpu::BINDING_PATHS, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER},
       {gpu::BINDING_SPARSE, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER},
       {gpu::BINDING_QUEUES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-      {gpu::BINDING_PASS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}};
+      {gpu::BINDING_PASS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+      {gpu::BINDING_GUIDE_POINTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}};
   pipeline_ = ctx_.pipelines().get(code, bindings, /*push_constant_bytes=*/0, spec_, "render");
+  // film.aovs: the guide's marches, a pipeline of their own (shaders/guide.comp).
+  if (settings_.aovs)
+    guide_pipeline_ = ctx_.pipelines().get(vk::load_spirv("guide.comp"), bindings, /*push_constant_bytes=*/0, spec_,
+                                           "guide");
   set_.emplace(ctx_, *pipeline_, "render set");
 }
 
@@ -162,6 +173,7 @@ void RenderSession::write_descriptors() {
   }
   set_->write_buffer(gpu::BINDING_PASS_STATUS, pass_status_);
   set_->write_buffer(gpu::BINDING_PASS, pass_constants_.buffer());
+  set_->write_buffer(gpu::BINDING_GUIDE_POINTS, guide_points_);
   set_->write_buffer(gpu::BINDING_GRIDS, grid_buffer_);
   write_grid_descriptors();
   set_->write_buffer(gpu::BINDING_BVH_NODES, bvh_nodes_);
@@ -183,6 +195,12 @@ void RenderSession::warm_up() {
   // (docs/benchmarks.md: `seconds` starts at the first real pass).
   ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
     pass_constants_.record(cmd, gpu::PassConstants{0u, 0u, 0u, 0u});
+    if (guide_pipeline_) {  // (it writes guide points that the first pass's march replaces)
+      guide_pipeline_->bind(cmd, set_->set());
+      vkCmdDispatch(cmd, 1, 1, 1);
+      vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+    }
     pipeline_->bind(cmd, set_->set());
     vkCmdDispatch(cmd, 1, 1, 1);
     // The wavefront's stages, on empty queues (the queues are zero).

@@ -55,6 +55,9 @@ class RenderSession {
   // fails (VulkanError), spp_done() stays as it was: the accumulation holds
   // the passes before this one.
   bool run_pass(int spp, const std::atomic<bool>* cancel = nullptr);
+  // The seconds the guide's dispatches took (settings.aovs), summed over the
+  // passes run so far.
+  double guide_seconds() const { return guide_seconds_; }
   // The rows one dispatch covers now: starts small, grows while dispatches
   // take under kBandFastSeconds and shrinks when one takes over kBandSlowSeconds.
   int band_rows() const { return band_rows_; }
@@ -173,6 +176,14 @@ class RenderSession {
   // settings.aovs: where accum_'s AovLightTexels and AovFeatureTexels start
   // (0: no AOVs, their bindings then show the AlphaTexels, unread).
   VkDeviceSize aov_lights_offset_ = 0, aov_features_offset_ = 0;
+  // settings.aovs: the denoiser's guide at the pixels' corners ((width + 1) ×
+  // (height + 1) vec4s), then at their centres, marched before the first pass
+  // (march_guide_points), which reads them (accumulation.glsl
+  // add_pixel_guide). Without AOVs a buffer of one vec4, unread.
+  vk::Buffer guide_points_;
+  double guide_seconds_ = 0.0;  // march_guide_points' wall time, summed over this session's renders
+  std::shared_ptr<const vk::ComputePipeline> guide_pipeline_;  // settings.aovs: shaders/guide.comp
+  void march_guide_points();
   int max_pass_spp_ = 1 << 30;
   int band_rows_ = 0;  // 0: not measured yet (first_band_rows)
   // Rows for one dispatch of `spp` samples per pixel before anything is measured.

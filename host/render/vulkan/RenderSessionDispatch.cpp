@@ -80,6 +80,25 @@ void RenderSession::record_band(VkCommandBuffer cmd, int spp, int row_begin, int
                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT);
 }
 
+// The guide's marches (shaders/guide.comp), one dispatch
+// over the (width + 1) × (height + 1) pixel corners, submitted before the
+// first pass, which reads them. Each lane marches at most two rays (of at
+// most GUIDE_MAX_STEPS steps), within llvmpipe's loop budget.
+void RenderSession::march_guide_points() {
+  const auto t0 = std::chrono::steady_clock::now();
+  ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
+    // After the reads of the passes before (a kept session's earlier frame).
+    vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
+    guide_pipeline_->bind(cmd, set_->set());
+    vkCmdDispatch(cmd, (uint32_t(settings_.width) + gpu::WORKGROUP_SIZE_X) / gpu::WORKGROUP_SIZE_X,
+                  (uint32_t(settings_.height) + gpu::WORKGROUP_SIZE_Y) / gpu::WORKGROUP_SIZE_Y, 1);
+    vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+  });
+  guide_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 // The wavefront integrator (shaders/wavefront.glsl), a benchmark and test
 // hook (no scene key or flag): PYROLUME_WAVEFRONT=1 renders with its track
 // and event stages, =2 with the event stage split in two (event, begin).
@@ -220,6 +239,8 @@ bool RenderSession::run_pass(int spp, const std::atomic<bool>* cancel) {
     // the result is the same as with passes that fit, and as with one dispatch
     // for the whole image: the bands below only split the pixels.
     const bool wavefront = !wavefront_stages_.empty();
+    // The guide is marched in a pass's first samples (sample_offset 0).
+    if (settings_.aovs && spp_done_ == 0) march_guide_points();
     for (int remaining = spp; remaining > 0;) {
       const int n = std::min(remaining, max_pass_spp_);
       const bool clears = needs_clear_;

@@ -107,6 +107,7 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
   // the readbacks cost under 5 %: it is what a lost device still lets us save.
   auto render_start = Clock::now();
   const uint64_t dropped_before = session.dropped_samples();  // a kept session counts across frames
+  const double guide_before = session.guide_seconds();
   const int per_pass =
       spp_per_pass(settings.width, settings.height, settings.spp, session.rays_per_vertex());
   AccumulationState saved;
@@ -144,6 +145,7 @@ RenderResult VulkanRenderer::render(const Scene& scene, const RenderSettings& se
     RenderSession::result_from_state(final_state, result);
     session.read_aovs(result);
     result.dropped_samples = session.dropped_samples() - dropped_before;
+    result.guide_seconds = session.guide_seconds() - guide_before;
     if (result.dropped_samples > 0)
       result.warnings.push_back(std::to_string(result.dropped_samples) +
                                 " samples did not finish even at 1 spp per pass (the driver's loop limit: llvmpipe runs "
