@@ -226,19 +226,27 @@ void Buffer::upload(Context& ctx, const void* src, VkDeviceSize bytes, VkDeviceS
   }
 }
 
+const void* Buffer::read_in_place(Context& ctx, VkDeviceSize bytes, VkDeviceSize offset) {
+  if (offset + bytes > size_)
+    throw VulkanError("Buffer::read_in_place: " + std::to_string(bytes) + " bytes at offset " +
+                      std::to_string(offset) + " overrun a buffer of " + std::to_string(size_));
+  if (!mapped_) return nullptr;
+  // An empty submission orders all earlier work before the host read.
+  ctx.submit_and_wait([](VkCommandBuffer cmd) {
+    memory_barrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+                   VK_ACCESS_HOST_READ_BIT);
+  });
+  if (bytes > 0) invalidate(offset, bytes);
+  return static_cast<const char*>(mapped_) + offset;
+}
+
 void Buffer::download(Context& ctx, void* dst, VkDeviceSize bytes, VkDeviceSize offset) {
   if (offset + bytes > size_)
     throw VulkanError("Buffer::download: " + std::to_string(bytes) + " bytes at offset " + std::to_string(offset) +
                       " overrun a buffer of " + std::to_string(size_));
   if (bytes == 0) return;
-  if (mapped_) {
-    // An empty submission orders all earlier work before the host read.
-    ctx.submit_and_wait([](VkCommandBuffer cmd) {
-      memory_barrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
-                     VK_ACCESS_HOST_READ_BIT);
-    });
-    invalidate(offset, bytes);
-    std::memcpy(dst, static_cast<const char*>(mapped_) + offset, bytes);
+  if (const void* src = read_in_place(ctx, bytes, offset)) {
+    std::memcpy(dst, src, bytes);
     return;
   }
   Buffer staging(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::Readback, "staging readback");

@@ -57,6 +57,11 @@ class Buffer {
   // Buffer -> host, waiting for all earlier submitted work. Unmapped buffers go
   // through a staging buffer (needs TRANSFER_SRC usage).
   void download(Context& ctx, void* dst, VkDeviceSize bytes, VkDeviceSize offset = 0);
+  // A host-visible buffer's bytes [offset, offset + bytes) where the host can
+  // read them in place, after all earlier submitted work; nullptr for a buffer
+  // that is not host-visible (then download). Saves a copy where device
+  // memory is host memory (lavapipe, integrated GPUs).
+  const void* read_in_place(Context& ctx, VkDeviceSize bytes, VkDeviceSize offset = 0);
 
  private:
   VkDevice device_ = VK_NULL_HANDLE;

@@ -64,14 +64,23 @@ void RenderSession::read_aovs(RenderResult& result) {
   const size_t pixels = size_t(settings_.width) * size_t(settings_.height);
   result.aov_sum.assign(pixels * kAovValues, 0.0);
   if (spp_done_ <= 0 || needs_clear_) return;
-  std::vector<gpu::AovLightTexel> lights(pixels);
-  std::vector<gpu::AovFeatureTexel> features(pixels);
-  accum_.download(ctx_, lights.data(), pixels * sizeof(gpu::AovLightTexel), aov_lights_offset_);
-  accum_.download(ctx_, features.data(), pixels * sizeof(gpu::AovFeatureTexel), aov_features_offset_);
+  // Both layers, read in place where the buffer is host memory (no copy of
+  // ~100 bytes a pixel), else copied out.
+  const VkDeviceSize aov_bytes = aov_features_offset_ + pixels * sizeof(gpu::AovFeatureTexel) - aov_lights_offset_;
+  std::vector<unsigned char> copy;
+  const unsigned char* aovs = static_cast<const unsigned char*>(accum_.read_in_place(ctx_, aov_bytes, aov_lights_offset_));
+  if (!aovs) {
+    copy.resize(aov_bytes);
+    accum_.download(ctx_, copy.data(), aov_bytes, aov_lights_offset_);
+    aovs = copy.data();
+  }
+  const unsigned char* features_at = aovs + (aov_features_offset_ - aov_lights_offset_);
   for (size_t i = 0; i < pixels; ++i) {
     double* s = result.aov_sum.data() + i * kAovValues;
-    const gpu::AovLightTexel& l = lights[i];
-    const gpu::AovFeatureTexel& f = features[i];
+    gpu::AovLightTexel l;
+    gpu::AovFeatureTexel f;
+    std::memcpy(&l, aovs + i * sizeof l, sizeof l);
+    std::memcpy(&f, features_at + i * sizeof f, sizeof f);
     for (int c = 0; c < 3; ++c) {
       s[kAovEmission + c] = l.emission[c];
       s[kAovScatter + c] = l.scatter[c];
