@@ -70,14 +70,14 @@ AovSums no_aovs() {
   return AovSums(vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0.0, vec3(0.0), 0.0);
 }
 
-// The pixel's guide (guide.glsl), once per render, in its first pass: a
-// quadrature of the pixel's box filter whose cost does not grow with the
-// sample count (docs/compositing.md "The guide"). The 2D Simpson-like rule
+// The pixel's guide (guide.glsl's march), once per render, in its first
+// pass: a quadrature of the pixel's box filter whose cost does not grow with
+// the sample count (docs/compositing.md "The guide"). The 2D Simpson-like rule
 //   G = 2/3·g(centre) + 1/12·Σ g(corners)
 // cancels the second-order error terms of both the midpoint rule and the
 // four-corner trapezoid rule (−(g_xx + g_yy)/24 and +(g_xx + g_yy)/12 of the
-// pixel's area): as accurate as four quarter centres (denoised error measured
-// equal), and a corner is shared by four pixels. A pipeline of its own
+// pixel's area): the denoised error within 4 % of four quarter centres'
+// (measured), and a corner is shared by four pixels. A pipeline of its own
 // (guide.comp) marches every corner and centre once before the first pass, so
 // a pixel costs about two marches, no lane waits at a barrier, and the paths'
 // pipeline holds no march.
