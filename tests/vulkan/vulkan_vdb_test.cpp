@@ -18,6 +18,7 @@
 #include "render/RenderImage.h"
 #include "render/cpu/CpuRenderer.h"
 #include "scene/MediumVolume.h"
+#include "support/GuideChecks.h"
 #include "support/Stats.h"
 #include "support/VdbSuite.h"
 #include "render/vulkan/GpuScene.h"
@@ -311,6 +312,19 @@ TEST_F(VulkanVdb, GuideAgreesWithCpuOnProceduralFire) {
     EXPECT_NEAR(g.aovs.guide_alpha[i], cg.aovs.guide_alpha[i], 0.01) << "pixel " << i;
   EXPECT_NEAR(sum_g / sum_c, 1.0, 0.005);
   std::printf("guide GPU vs CPU: worst pixel %.3g of the peak, sums GPU/CPU %.5f\n", worst, sum_g / sum_c);
+}
+
+// The guide's march runs in bands of corner rows (RenderSession::
+// march_guide_points): one row of corners per dispatch, 17 of them, gives the
+// same guide, value for value, as the default single band; a band that
+// marched the wrong rows would leave others at 0 or march them twice.
+TEST_F(VulkanVdb, GuideIsTheSameMarchedInBands) {
+  Scene s = shipped_fire(24, 16, 16);
+  s.film.aovs = true;
+  VulkanHooks banded;
+  banded.guide_band_corners = 25;  // 25 corners a row: one row a dispatch
+  const Image whole = image_from_render(render(s), false), bands = image_from_render(render_with(s, banded), false);
+  test::expect_same_guide(whole, bands);
 }
 
 // The free-flight loop's early exit (render.comp EARLY_EVENT_EXIT: the SIMD

@@ -195,7 +195,7 @@ void RenderSession::warm_up() {
   // (docs/benchmarks.md: `seconds` starts at the first real pass).
   ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
     pass_constants_.record(cmd, gpu::PassConstants{0u, 0u, 0u, 0u});
-    if (guide_pipeline_) {  // (it writes guide points that the first pass's march replaces)
+    if (guide_pipeline_) {  // (rows 0..0 of corners: it marches nothing)
       guide_pipeline_->bind(cmd, set_->set());
       vkCmdDispatch(cmd, 1, 1, 1);
       vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,

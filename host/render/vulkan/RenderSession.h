@@ -183,7 +183,8 @@ class RenderSession {
   vk::Buffer guide_points_;
   double guide_seconds_ = 0.0;  // march_guide_points' wall time, summed over this session's renders
   std::shared_ptr<const vk::ComputePipeline> guide_pipeline_;  // settings.aovs: shaders/guide.comp
-  void march_guide_points();
+  bool march_guide_points(const std::atomic<bool>* cancel);
+  static constexpr uint32_t kGuideBandCorners = 1u << 16;  // pixel corners per guide dispatch
   int max_pass_spp_ = 1 << 30;
   int band_rows_ = 0;  // 0: not measured yet (first_band_rows)
   // Rows for one dispatch of `spp` samples per pixel before anything is measured.

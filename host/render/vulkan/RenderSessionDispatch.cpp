@@ -80,23 +80,39 @@ void RenderSession::record_band(VkCommandBuffer cmd, int spp, int row_begin, int
                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT);
 }
 
-// The guide's marches (shaders/guide.comp), one dispatch
-// over the (width + 1) × (height + 1) pixel corners, submitted before the
-// first pass, which reads them. Each lane marches at most two rays (of at
-// most GUIDE_MAX_STEPS steps), within llvmpipe's loop budget.
-void RenderSession::march_guide_points() {
+// The guide's marches (shaders/guide.comp) over the (width + 1) × (height +
+// 1) pixel corners, submitted before the first pass, which reads them. In
+// bands of whole corner rows, about kGuideBandCorners corners each (tens of
+// milliseconds on lavapipe), so that a signal is answered between bands and
+// no dispatch runs long; each lane marches at most two rays (of at most
+// GUIDE_MAX_STEPS steps), within llvmpipe's loop budget. False: cancelled
+// between bands (the first pass then has not begun).
+bool RenderSession::march_guide_points(const std::atomic<bool>* cancel) {
   const auto t0 = std::chrono::steady_clock::now();
-  ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
-    // After the reads of the passes before (a kept session's earlier frame).
-    vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT,
-                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
-    guide_pipeline_->bind(cmd, set_->set());
-    vkCmdDispatch(cmd, (uint32_t(settings_.width) + gpu::WORKGROUP_SIZE_X) / gpu::WORKGROUP_SIZE_X,
-                  (uint32_t(settings_.height) + gpu::WORKGROUP_SIZE_Y) / gpu::WORKGROUP_SIZE_Y, 1);
-    vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
-  });
+  const uint32_t corners_x = uint32_t(settings_.width) + 1, rows = uint32_t(settings_.height) + 1;
+  const uint32_t per_band = hooks_.guide_band_corners > 0 ? hooks_.guide_band_corners : kGuideBandCorners;
+  const uint32_t band = std::max<uint32_t>(1, per_band / corners_x);
+  bool done = true;
+  for (uint32_t row = 0; row < rows; row += band) {
+    if (row > 0 && cancel && cancel->load()) {
+      done = false;
+      break;
+    }
+    const uint32_t row_end = std::min(rows, row + band);
+    ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
+      pass_constants_.record(cmd, gpu::PassConstants{0u, 0u, row, row_end});
+      // After the reads of the passes before (a kept session's earlier frame).
+      vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT,
+                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
+      guide_pipeline_->bind(cmd, set_->set());
+      vkCmdDispatch(cmd, (corners_x + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X,
+                    (row_end - row + gpu::WORKGROUP_SIZE_Y - 1) / gpu::WORKGROUP_SIZE_Y, 1);
+      vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+    });
+  }
   guide_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return done;
 }
 
 // The wavefront integrator (shaders/wavefront.glsl), a benchmark and test
@@ -240,7 +256,7 @@ bool RenderSession::run_pass(int spp, const std::atomic<bool>* cancel) {
     // for the whole image: the bands below only split the pixels.
     const bool wavefront = !wavefront_stages_.empty();
     // The guide is marched in a pass's first samples (sample_offset 0).
-    if (settings_.aovs && spp_done_ == 0) march_guide_points();
+    if (settings_.aovs && spp_done_ == 0 && !march_guide_points(cancel)) return false;
     for (int remaining = spp; remaining > 0;) {
       const int n = std::min(remaining, max_pass_spp_);
       const bool clears = needs_clear_;

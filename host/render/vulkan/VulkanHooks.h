@@ -22,6 +22,9 @@ struct VulkanHooks {
   // false keeps the temperature in a texture of its own even where it could
   // be the density texture's second channel (GpuScene::temperature_in_density).
   bool temperature_in_density = true;
+  // Pixel corners per dispatch of the denoiser guide's march (film.aovs;
+  // RenderSession::march_guide_points), in bands of whole rows; 0: the default.
+  uint32_t guide_band_corners = 0;
 };
 
 }  // namespace pyrolume
