@@ -82,9 +82,10 @@ AovSums no_aovs() {
 // a pixel costs about two marches, no lane waits at a barrier, and the paths'
 // pipeline holds no march.
 void add_pixel_guide(uvec2 pixel, inout AovSums a) {
-  const uint w1 = frame.width + 1u, i = pixel.y * w1 + pixel.x;
-  const vec4 corners = guide_points[i] + guide_points[i + 1u] + guide_points[i + w1] + guide_points[i + w1 + 1u];
-  const vec4 centre = guide_points[w1 * (frame.height + 1u) + pixel.y * frame.width + pixel.x];
+  const vec4 corners = guide_points[guide_corner_index(pixel)] + guide_points[guide_corner_index(pixel + uvec2(1u, 0u))] +
+                       guide_points[guide_corner_index(pixel + uvec2(0u, 1u))] +
+                       guide_points[guide_corner_index(pixel + uvec2(1u, 1u))];
+  const vec4 centre = guide_points[guide_centre_index(pixel)];
   const vec4 g = (2.0 / 3.0) * centre + (1.0 / 12.0) * corners;
   a.guide += g.rgb;
   a.guide_alpha += g.a;

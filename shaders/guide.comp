@@ -32,13 +32,13 @@ vec4 guide_ray(uvec2 pixel, vec2 film) {
 
 // One lane per corner, the corner (x, y) being pixel (x, y)'s top-left one,
 // x ≤ width, y ≤ height; a lane whose corner is a pixel's also marches that
-// pixel's centre. guide_points holds the corners, then the centres. A
-// dispatch marches the corner rows row_begin ≤ y < row_end (PassConstants).
+// pixel's centre (where each goes: render_bindings.glsl guide_corner_index,
+// guide_centre_index). A dispatch marches the corner rows row_begin ≤ y <
+// row_end (PassConstants).
 void main() {
   const uvec2 corner = gl_GlobalInvocationID.xy + uvec2(0u, pass_constants.row_begin);
   const uint width = frame.width, height = frame.height;
   if (corner.x > width || corner.y > height || corner.y >= pass_constants.row_end) return;
-  guide_points[corner.y * (width + 1u) + corner.x] = guide_ray(corner, vec2(0.0));
-  if (corner.x < width && corner.y < height)
-    guide_points[(width + 1u) * (height + 1u) + corner.y * width + corner.x] = guide_ray(corner, vec2(0.5));
+  guide_points[guide_corner_index(corner)] = guide_ray(corner, vec2(0.0));
+  if (corner.x < width && corner.y < height) guide_points[guide_centre_index(corner)] = guide_ray(corner, vec2(0.5));
 }

@@ -28,6 +28,10 @@ void guide_step(vec3 E, vec3 sigma_t, float dt, inout vec3 L, inout vec3 T) {
   T *= tr;
 }
 
+// Equal steps of at most h over a piece of the ray `length` long (at least
+// one, at most GUIDE_MAX_STEPS).
+uint guide_steps(float length, float h) { return uint(clamp(ceil(length / h), 1.0, float(GUIDE_MAX_STEPS))); }
+
 // One dense grid, the common case: the medium, its texel mapping and its
 // majorant cells' DDA are set up once per ray, and the march walks the cells
 // with it (what guide_media does for any media, the same steps and values).
@@ -41,7 +45,7 @@ void guide_one_grid(vec3 o, vec3 d, float t, float t1, float h, inout vec3 L, in
   while (n < GUIDE_MAX_STEPS && t < t1 && max3(T) >= GUIDE_MIN_TRANSMITTANCE) {
     const float t_next = min(min3(w.t_axis), t1);
     if (cell_majorant(slot, w, false) > 0.0 && t_next > t) {
-      const uint steps = uint(clamp(ceil((t_next - t) / h), 1.0, float(GUIDE_MAX_STEPS)));
+      const uint steps = guide_steps(t_next - t, h);
       const float dt = (t_next - t) / float(steps);
       for (uint j = 0u; j < steps && n < GUIDE_MAX_STEPS; ++j, ++n) {
         const float tm = t + (float(j) + 0.5) * dt;
@@ -91,7 +95,7 @@ void guide_media(vec3 o, vec3 d, float t_end, vec2 span[MEDIA_N], inout vec3 L, 
       continue;
     }
     // Equal steps of at most h through the cell, each at its midpoint.
-    const uint steps = uint(clamp(ceil((t_next - t) / h), 1.0, float(GUIDE_MAX_STEPS)));
+    const uint steps = guide_steps(t_next - t, h);
     const float dt = (t_next - t) / float(steps);
     for (uint j = 0u; j < steps && n < GUIDE_MAX_STEPS; ++j, ++n) {
       const float tm = t + (float(j) + 0.5) * dt;

@@ -50,6 +50,12 @@ layout(std430, set = 0, binding = BINDING_ALPHA) buffer AlphaBlock { AlphaTexel 
 layout(std430, set = 0, binding = BINDING_AOV_LIGHTS) buffer AovLightBlock { AovLightTexel aov_lights[]; };
 layout(std430, set = 0, binding = BINDING_AOV_FEATURES) buffer AovFeatureBlock { AovFeatureTexel aov_features[]; };
 layout(std430, set = 0, binding = BINDING_GUIDE_POINTS) buffer GuidePointBlock { vec4 guide_points[]; };
+// Where guide_points holds the guide at pixel corner c (pixel c's top-left
+// corner; c.x ≤ width, c.y ≤ height) and at pixel p's centre: the corners
+// row by row, then the centres (guide.comp writes them, accumulation.glsl
+// add_pixel_guide reads them).
+uint guide_corner_index(uvec2 c) { return c.y * (frame.width + 1u) + c.x; }
+uint guide_centre_index(uvec2 p) { return (frame.width + 1u) * (frame.height + 1u) + p.y * frame.width + p.x; }
 // The grids stay a uniform block: the free-flight loop reads them every step,
 // where a uniform load is one scalar read and a storage buffer's a per-lane
 // gather (as a storage buffer they made assets/scenes/fire.json render 1.8×
