@@ -76,6 +76,16 @@ class RealRender : public ::testing::Test {
     return s;
   }
 
+  // The Houdini smoke plume (density only, max 5.71, y up), emitting
+  // nothing, seen along −z at 24 × 32 with four bounces, before `background`.
+  Scene houdini_plume(Medium m, const glm::dvec3& background) {
+    m.emission.scale = 0.0;
+    Scene s = framed(m, {0, 0, 1}, {0, 1, 0}, 24, 32);
+    s.background = background;
+    s.integrator.max_depth = 4;
+    return s;
+  }
+
   // GPU at gpu_spp vs CPU at cpu_spp (independent seeds). informative: the
   // image-mean bias test must have an SE below half its tolerance.
   void compare(Scene s, int gpu_spp, int cpu_spp, const char* what, bool informative = true) {
@@ -126,15 +136,11 @@ void emit_blackbody(Medium& m, const char* temperature_grid, double scale, doubl
   m.temperature.cutoff_k = 600.0;
 }
 
-// Houdini smoke plume: density only (max 5.71), y up. No temperature grid, so
-// it is lit by the background (rgb 1) through scattering.
+// The plume has no temperature grid, so it is lit by the background (rgb 1)
+// through scattering.
 TEST_F(RealRender, HoudiniSmokeLitByBackground) {
   Medium m = vdb(dir / "openvdb_smoke1_houdini.vdb", {0.15, 0.2, 0.25}, {0.45, 0.45, 0.45}, 0.3);
-  m.emission.scale = 0.0;
-  Scene s = framed(m, {0, 0, 1}, {0, 1, 0}, 24, 32);
-  s.background = {1.0, 1.0, 1.0};
-  s.integrator.max_depth = 4;
-  compare(s, 1024, 96, "houdini smoke");
+  compare(houdini_plume(m, {1.0, 1.0, 1.0}), 1024, 96, "houdini smoke");
 }
 
 // The same plume kept sparse (texture_format "sparse", issue 26): the GPU
@@ -142,12 +148,8 @@ TEST_F(RealRender, HoudiniSmokeLitByBackground) {
 // accessor, and the two agree.
 TEST_F(RealRender, HoudiniSmokeKeptSparse) {
   Medium m = vdb(dir / "openvdb_smoke1_houdini.vdb", {0.15, 0.2, 0.25}, {0.45, 0.45, 0.45}, 0.3);
-  m.emission.scale = 0.0;
   m.texture_format = TextureFormat::Sparse;
-  Scene s = framed(m, {0, 0, 1}, {0, 1, 0}, 24, 32);
-  s.background = {1.0, 1.0, 1.0};
-  s.integrator.max_depth = 4;
-  compare(s, 1024, 96, "houdini smoke, sparse");
+  compare(houdini_plume(m, {1.0, 1.0, 1.0}), 1024, 96, "houdini smoke, sparse");
 }
 
 // The same plume lit by a low sun (issue 24): a disc of 0.53° and irradiance
@@ -156,10 +158,7 @@ TEST_F(RealRender, HoudiniSmokeKeptSparse) {
 // escape inside its disc add its radiance, MIS-weighted.
 TEST_F(RealRender, HoudiniSmokeLitBySun) {
   Medium m = vdb(dir / "openvdb_smoke1_houdini.vdb", {0.1, 0.1, 0.1}, {1.2, 1.2, 1.2}, 0.4);
-  m.emission.scale = 0.0;
-  Scene s = framed(m, {0, 0, 1}, {0, 1, 0}, 24, 32);
-  s.background = {0.05, 0.07, 0.1};
-  s.integrator.max_depth = 4;
+  Scene s = houdini_plume(m, {0.05, 0.07, 0.1});
   s.lights.push_back(test::distant_light({-1.0, 0.3, 0.5}, {3.0, 2.8, 2.5}, 0.53));
   // The per-pixel criterion at 32 spp (issue 24); the image mean's bias
   // needs more samples to say anything (SE 0.4 % at 32 spp).
