@@ -72,3 +72,33 @@ TEST(BenchScript, TinyCpuRunWritesCsvAndKeepsHandWrittenMarkdown) {
   EXPECT_NE(md.find("### Efficiency at a fixed spp"), std::string::npos);
   fs::remove_all(dir);
 }
+
+// An --out-dir that cannot be made is refused at the start, in one line that
+// names it, exit 2, before any render (it used to fail only when the report
+// was written, after all the runs; a folder that did not exist yet failed
+// the same way in --denoise mode).
+TEST(BenchScript, AnOutDirThatCannotBeMadeIsRefusedBeforeTheRuns) {
+  if (!fs::exists(kPython)) GTEST_SKIP() << kPython << " not found";
+  const fs::path script = fs::path(PYROLUME_SOURCE_DIR) / "tools" / "bench";
+  const fs::path dir = temp_dir("bench-out");
+  write_file(dir / "a-file", "not a folder\n");
+  const fs::path out = dir / "a-file" / "report";
+  for (const char* mode : {"", " --denoise"}) {
+    const std::string cmd = std::string(kPython) + " " + script.string() + " --pyrolume " +
+                            pyrolume::test::pyrolume_bin() + mode + " --scenes fire --configs 'cpu*' --quick" +
+                            " --out-dir " + out.string() + " --work-dir " + (dir / "work").string() + " >" +
+                            (dir / "log.txt").string() + " 2>&1";
+    const int raw = std::system(cmd.c_str());
+    const std::string log = read_file(dir / "log.txt");
+    ASSERT_TRUE(WIFEXITED(raw)) << log;
+    EXPECT_EQ(WEXITSTATUS(raw), 2) << mode << ": " << log;
+    EXPECT_NE(log.find("bench: --out-dir " + out.string() + ": cannot make the folder"), std::string::npos) << log;
+    EXPECT_EQ(split(log, '\n').size(), 1u) << log;
+    // Nothing rendered: the work folder holds no file.
+    size_t files = 0;
+    for (const auto& e : fs::recursive_directory_iterator(dir / "work"))
+      if (e.is_regular_file()) ++files;
+    EXPECT_EQ(files, 0u) << mode;
+  }
+  fs::remove_all(dir);
+}

@@ -131,7 +131,14 @@ def main(argv):
             f"or pass --pyrolume PATH")
         return 2
     work = os.path.abspath(args.work_dir)
-    os.makedirs(work, exist_ok=True)
+    # Both folders are made now, so a path that cannot be one fails before
+    # the runs, not after them when the report is written.
+    for what, folder in (("--work-dir", work), ("--out-dir", os.path.abspath(args.out_dir))):
+        try:
+            os.makedirs(folder, exist_ok=True)
+        except OSError as e:
+            log(f"bench: {what} {folder}: cannot make the folder: {e.strerror}")
+            return 2
     if args.denoise:
         return denoise.run(args, argv)
     if args.cycles:
