@@ -84,8 +84,9 @@ void RenderSession::record_band(VkCommandBuffer cmd, int spp, int row_begin, int
 // 1) pixel corners, submitted before the first pass, which reads them. In
 // bands of whole corner rows, about kGuideBandCorners corners each (tens of
 // milliseconds on lavapipe), so that a signal is answered between bands and
-// no dispatch runs long; each lane marches at most two rays (of at most
-// GUIDE_MAX_STEPS steps), within llvmpipe's loop budget. False: cancelled
+// no dispatch runs long; each lane marches at most two rays (each at most
+// GUIDE_MAX_STEPS majorant cells walked and as many steps: 4 × 4096 loop
+// iterations), within llvmpipe's loop budget of 65535. False: cancelled
 // between bands (the first pass then has not begun).
 bool RenderSession::march_guide_points(const std::atomic<bool>* cancel) {
   const auto t0 = std::chrono::steady_clock::now();
