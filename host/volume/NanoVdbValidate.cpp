@@ -136,8 +136,9 @@ class GridChecker {
       fail("unknown grid class " + std::to_string(uint32_t(g.mGridClass)));
     // The affine index-to-world map: finite and invertible as OpenVDB
     // requires of every affine map (|det| >= 3e-15, AffineMap); NanoVDB's
-    // grids come from those, and nanoToOpenVDB builds one from this matrix
-    // (a singular one threw out of the loader: found by fuzz_nvdb).
+    // grids come from those, and the loader inverts this matrix (a singular
+    // one threw out of the loader's former NanoVDB-to-OpenVDB conversion:
+    // found by fuzz_nvdb).
     const double* a = g.mMap.mMatD;
     const double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
                        a[2] * (a[3] * a[7] - a[4] * a[6]);
@@ -147,8 +148,9 @@ class GridChecker {
       fail("its index-to-world map is singular or not finite (determinant " + std::to_string(det) + ")");
     // Its translation within 1e15 voxels of the origin: further out, double
     // arithmetic loses the voxel (2^53 ≈ 9e15), and OpenVDB, recovering the
-    // scale as (1 + t) − t, throws "Non-zero scale values required" out of
-    // nanoToOpenVDB (a translation of 4e304: found by fuzz_nvdb).
+    // scale as (1 + t) − t, threw "Non-zero scale values required" out of
+    // the former NanoVDB-to-OpenVDB conversion (a translation of 4e304: found
+    // by fuzz_nvdb).
     double voxel = INFINITY, offset = 0.0;
     for (int c = 0; c < 3; ++c) {
       voxel = std::min(voxel, std::sqrt(a[c] * a[c] + a[3 + c] * a[3 + c] + a[6 + c] * a[6 + c]));
@@ -331,7 +333,7 @@ class TreeChecker : public GridChecker {
     // origin() is the min of the node's bounding box, which GridStats leaves
     // empty in a node without active values (a leaf whose voxels were all
     // turned off): such a node has no origin to check, and must stay empty
-    // (nanoToOpenVDB places nodes by origin()).
+    // (the sparse loader places nodes by origin()).
     const bool unplaced = node.origin() != expected;
     if (unplaced && !node.bbox().empty())
       fail(std::string(kLevelNames[level]) + " node at byte " + std::to_string(at_byte) + " has origin " + text(node.origin()) +

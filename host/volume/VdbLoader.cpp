@@ -24,7 +24,6 @@
 
 #include <nanovdb/NanoVDB.h>
 #include <nanovdb/util/IO.h>
-#include <nanovdb/util/NanoToOpenVDB.h>
 #include <nanovdb/util/OpenToNanoVDB.h>
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
@@ -180,21 +179,14 @@ bool keep_sparse(const VolumeOptions& m, const glm::i64vec3& bbox_dims, uint64_t
 constexpr uint64_t kSparseLeafBytes =
     sizeof(openvdb::FloatTree::LeafNodeType) + 512 * sizeof(float) + sizeof(nanovdb::NanoLeaf<float>);
 
-// Before sparse_from_openvdb allocates: every active tile becomes leaves of
+// Before a sparse tree is built: every active tile becomes leaves of
 // voxels, so a few bytes of tiles (one active 4096³ root tile: 2^27 leaves,
 // over 500 GiB) can describe more than any host holds. The leaves it would
 // build, against what this process can still allocate; past it, one line
 // naming the file and grid instead of allocating into std::bad_alloc.
-template <class GridT>
-void require_sparse_memory(const GridT& grid, const std::string& file, Role role, const std::string& name) {
-  uint64_t tile_voxels = 0;
-  auto it = grid.tree().cbeginValueOn();
-  it.setMaxDepth(GridT::TreeType::ValueOnCIter::LEAF_DEPTH - 1);  // tiles only, not voxels
-  for (; it; ++it) {
-    const uint64_t n = it.getVoxelCount();
-    tile_voxels = tile_voxels > UINT64_MAX - n ? UINT64_MAX : tile_voxels + n;
-  }
-  const uint64_t leaves = uint64_t(grid.tree().leafCount()) + tile_voxels / 512;
+void require_sparse_memory(uint64_t leaf_count, uint64_t tile_voxels, const std::string& file, Role role,
+                           const std::string& name) {
+  const uint64_t leaves = leaf_count + tile_voxels / 512;
   std::ostringstream what;
   what << "keeping it sparse (" << leaves << " leaves of 8^3 voxels";
   if (tile_voxels) what << ", " << tile_voxels << " voxels of them in active tiles";
@@ -206,10 +198,53 @@ void require_sparse_memory(const GridT& grid, const std::string& file, Role role
   require_memory(file, role_key(role, name), what.str(), leaves * kSparseLeafBytes, hint);
 }
 
+uint64_t saturating_add(uint64_t a, uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
+
+// The active box of a grid about to be kept sparse, within the index range
+// the sparse walk can step through (one voxel of padding each side).
+void require_sparse_box(const glm::i64vec3& lo, const glm::i64vec3& hi, const std::string& file, Role role,
+                        const std::string& name) {
+  const glm::i64vec3 dims = hi - lo + int64_t(3);
+  if (dims.x > (1 << 30) || dims.y > (1 << 30) || dims.z > (1 << 30) || lo.x <= INT32_MIN + 1 || lo.y <= INT32_MIN + 1 ||
+      lo.z <= INT32_MIN + 1 || hi.x >= INT32_MAX - 1 || hi.y >= INT32_MAX - 1 || hi.z >= INT32_MAX - 1)
+    throw input_error(file, role_key(role, name), "active bounding box reaches the end of the index range");
+}
+
 // The same values as DenseBuilder stores (NaN/Inf -> 0, negative density -> 0,
 // inactive -> 0), kept in a NanoVDB float tree instead of a dense array: only
 // the nonzero active voxels are written, into a tree with background 0, and
-// active tiles become voxels (the GPU and CPU walk leaves).
+// active tiles become voxels (the GPU and CPU walk leaves). The source's
+// active values go in through voxel() and tile(), in any order (voxels and
+// tiles never overlap), into an OpenVDB float tree that OpenToNanoVDB then
+// writes out.
+class SparseTreeBuilder {
+ public:
+  explicit SparseTreeBuilder(Role role) : rules_{role == Role::Density} {}
+
+  void voxel(const openvdb::Coord& c, double v) {
+    const float f = rules_.apply(v);
+    if (f != 0.0f) acc_.setValue(c, f);
+  }
+  void tile(const openvdb::CoordBBox& box, double v) {
+    const float f = rules_.apply(v, box.volume());
+    if (f != 0.0f) tree_->tree().fill(box, f, true);
+  }
+
+  DenseGrid finish(DenseGrid& out, const glm::i64vec3& lo, const glm::i64vec3& hi, const glm::dmat4& grid_to_world,
+                   const VolumeOptions& m, Role role, const std::string& file, std::vector<std::string>& warnings) {
+    tree_->tree().voxelizeActiveTiles();
+    auto sparse = std::make_shared<SparseGrid>();
+    sparse->handle = nanovdb::openToNanoVDB(*tree_);
+    tree_.reset();
+    return finish_sparse(out, std::move(sparse), lo, hi, rules_, grid_to_world, m, role, file, warnings);
+  }
+
+ private:
+  openvdb::FloatGrid::Ptr tree_ = openvdb::FloatGrid::create(0.0f);
+  openvdb::FloatGrid::Accessor acc_ = tree_->getAccessor();
+  ValueRules rules_;
+};
+
 template <class GridT>
 DenseGrid sparse_from_openvdb(const GridT& grid, const VolumeOptions& m, Role role, const std::string& file,
                               std::vector<std::string>& warnings) {
@@ -219,30 +254,23 @@ DenseGrid sparse_from_openvdb(const GridT& grid, const VolumeOptions& m, Role ro
   const openvdb::CoordBBox bbox = grid.evalActiveVoxelBoundingBox();
   if (grid.activeVoxelCount() == 0 || bbox.empty()) return empty_grid(out.name, grid_to_world, m, role, file, warnings);
   const glm::i64vec3 lo(bbox.min().x(), bbox.min().y(), bbox.min().z()), hi(bbox.max().x(), bbox.max().y(), bbox.max().z());
-  const glm::i64vec3 dims = hi - lo + int64_t(3);
-  if (dims.x > (1 << 30) || dims.y > (1 << 30) || dims.z > (1 << 30) || lo.x <= INT32_MIN + 1 || lo.y <= INT32_MIN + 1 ||
-      lo.z <= INT32_MIN + 1 || hi.x >= INT32_MAX - 1 || hi.y >= INT32_MAX - 1 || hi.z >= INT32_MAX - 1)
-    throw input_error(file, role_key(role, out.name), "active bounding box reaches the end of the index range");
-  require_sparse_memory(grid, file, role, out.name);
-  openvdb::FloatGrid::Ptr tree_grid = openvdb::FloatGrid::create(0.0f);
-  auto acc = tree_grid->getAccessor();
-  ValueRules rules{role == Role::Density};
+  require_sparse_box(lo, hi, file, role, out.name);
+  uint64_t tile_voxels = 0;
+  auto tiles = grid.tree().cbeginValueOn();
+  tiles.setMaxDepth(GridT::TreeType::ValueOnCIter::LEAF_DEPTH - 1);  // tiles only, not voxels
+  for (; tiles; ++tiles) tile_voxels = saturating_add(tile_voxels, tiles.getVoxelCount());
+  require_sparse_memory(grid.tree().leafCount(), tile_voxels, file, role, out.name);
+  SparseTreeBuilder b(role);
   for (auto it = grid.tree().cbeginValueOn(); it; ++it) {
     if (it.isVoxelValue()) {
-      const float f = rules.apply(double(*it));
-      if (f != 0.0f) acc.setValue(it.getCoord(), f);
+      b.voxel(it.getCoord(), double(*it));
     } else {
       openvdb::CoordBBox box;
       it.getBoundingBox(box);
-      const float f = rules.apply(double(*it), box.volume());
-      if (f != 0.0f) tree_grid->tree().fill(box, f, true);
+      b.tile(box, double(*it));
     }
   }
-  tree_grid->tree().voxelizeActiveTiles();
-  auto sparse = std::make_shared<SparseGrid>();
-  sparse->handle = nanovdb::openToNanoVDB(*tree_grid);
-  tree_grid.reset();
-  return finish_sparse(out, std::move(sparse), lo, hi, rules, grid_to_world, m, role, file, warnings);
+  return b.finish(out, lo, hi, grid_to_world, m, role, file, warnings);
 }
 
 std::vector<GridEntry> openvdb_grid_entries(openvdb::io::File& f) {
@@ -414,6 +442,69 @@ std::optional<DenseGrid> sparse_in_place(nanovdb::GridHandle<nanovdb::HostBuffer
                        warnings);
 }
 
+// voxel(coord, v) for each active voxel of a NanoVDB grid and tile(box, v)
+// for each active tile, through the child pointers from the root (FpN leaves
+// differ in size, so a level's nodes are not an array). Nodes are placed by
+// their origin(), as the validator checked them.
+template <class BuildT, class Voxel, class Tile>
+void for_each_active_value(const nanovdb::NanoGrid<BuildT>& grid, Voxel&& voxel, Tile&& tile) {
+  using Root = typename nanovdb::NanoGrid<BuildT>::TreeType::RootType;
+  auto box = [](const nanovdb::Coord& o, int dim) {
+    return openvdb::CoordBBox(openvdb::Coord(o[0], o[1], o[2]), openvdb::Coord(o[0] + dim - 1, o[1] + dim - 1, o[2] + dim - 1));
+  };
+  auto leaf = [&](const auto& node) {
+    const nanovdb::Coord o = node.origin();
+    for (uint32_t n = 0; n < 512; ++n)
+      if (node.valueMask().isOn(n))
+        voxel(openvdb::Coord(o[0] + int(n >> 6), o[1] + int((n >> 3) & 7), o[2] + int(n & 7)), double(node.getValue(n)));
+  };
+  auto internal = [&](const auto& node, auto&& child) {
+    using Node = std::remove_cvref_t<decltype(node)>;
+    for (uint32_t n = 0; n < Node::SIZE; ++n) {
+      if (node.data()->isChild(n)) child(*node.data()->getChild(n));
+      else if (node.valueMask().isOn(n))
+        tile(box(node.offsetToGlobalCoord(n), int(Node::ChildNodeType::DIM)), double(node.data()->getValue(n)));
+    }
+  };
+  auto lower = [&](const auto& node) { internal(node, leaf); };
+  const auto* root = grid.tree().root().data();
+  for (uint32_t t = 0; t < root->mTableSize; ++t) {
+    const auto* rt = root->tile(t);
+    if (rt->isChild()) internal(*root->getChild(rt), lower);
+    else if (rt->state) tile(box(rt->origin(), int(Root::ChildNodeType::DIM)), double(rt->value));
+  }
+}
+
+// A NanoVDB grid kept sparse through an OpenVDB float tree: other value
+// types than float, and float grids with an active root tile (which
+// sparse_in_place leaves to this). Two walks: the active box, leaves and tile
+// voxels first, for the checks before anything is allocated.
+template <class BuildT>
+DenseGrid sparse_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const VolumeOptions& m, Role role,
+                              const std::string& file, std::vector<std::string>& warnings) {
+  DenseGrid out;
+  out.name = grid.gridName();
+  const glm::dmat4 grid_to_world = nanovdb_index_to_world(grid);
+  glm::i64vec3 lo(INT64_MAX), hi(INT64_MIN);
+  uint64_t voxels = 0, tile_voxels = 0;
+  auto extend = [&](const openvdb::Coord& a, const openvdb::Coord& b) {
+    lo = glm::min(lo, glm::i64vec3(a.x(), a.y(), a.z()));
+    hi = glm::max(hi, glm::i64vec3(b.x(), b.y(), b.z()));
+  };
+  for_each_active_value(
+      grid, [&](const openvdb::Coord& c, double) { ++voxels, extend(c, c); },
+      [&](const openvdb::CoordBBox& box, double) { tile_voxels = saturating_add(tile_voxels, box.volume()), extend(box.min(), box.max()); });
+  if (voxels == 0 && tile_voxels == 0) return empty_grid(out.name, grid_to_world, m, role, file, warnings);
+  require_sparse_box(lo, hi, file, role, out.name);
+  require_sparse_memory(grid.tree().nodeCount(0), tile_voxels, file, role, out.name);
+  ensure_openvdb_initialized();
+  SparseTreeBuilder b(role);
+  for_each_active_value(
+      grid, [&](const openvdb::Coord& c, double v) { b.voxel(c, v); },
+      [&](const openvdb::CoordBBox& box, double v) { b.tile(box, v); });
+  return b.finish(out, lo, hi, grid_to_world, m, role, file, warnings);
+}
+
 VolumeGrids load_nanovdb(const VolumeOptions& m, bool need_temperature, const DenseLimits& limits) {
   const std::string file = m.file.string();
   VolumeGrids out;
@@ -456,20 +547,10 @@ VolumeGrids load_nanovdb(const VolumeOptions& m, bool need_temperature, const De
     if (sparse)
       if (std::optional<DenseGrid> kept = sparse_in_place(h, m, role, file, out.warnings)) return std::move(*kept);
     // Dense, or kept sparse through an OpenVDB tree (other value types than
-    // float, and active root tiles). Both take the grid by its value type:
-    // nanoToOpenVDB's handle overload would instantiate every OpenVDB tree
-    // type NanoVDB knows (minutes of build).
+    // float, and active root tiles).
     auto read = [&](const auto& g) {
-      if (!sparse) return dense_from_nanovdb(g, m, role, file, out.warnings, limits);
-      ensure_openvdb_initialized();
-      const auto converted = [&] {
-        try {
-          return nanovdb::nanoToOpenVDB(g);
-        } catch (const openvdb::Exception& ex) {  // what validate_nanovdb_grid could not foresee
-          throw input_error(file, role_key(role, e.name), std::string("cannot convert it to an OpenVDB tree: ") + ex.what());
-        }
-      }();
-      return sparse_from_openvdb(*converted, m, role, file, out.warnings);
+      return sparse ? sparse_from_nanovdb(g, m, role, file, out.warnings)
+                    : dense_from_nanovdb(g, m, role, file, out.warnings, limits);
     };
     if (std::optional<DenseGrid> g = with_scalar_grid(h, read)) return std::move(*g);
     if (sparse) throw input_error(file, role_key(role, e.name), "NanoVDB grid type " + e.type + " cannot be kept sparse");

@@ -208,6 +208,30 @@ TEST_F(SparseGridTest, AutoKeepsSmallGridsDense) {
   EXPECT_FALSE(load_stored_volume(s.media[0]).density.grid.is_sparse());
 }
 
+// A .vdb's 16-bit NanoVDB copy, loaded kept sparse and dense, and the .vdb
+// itself loaded dense: the same box on the same lattice.
+struct QuantisedLoads {
+  DenseGrid sparse, dense, source;
+};
+
+QuantisedLoads load_quantised_copy(const fs::path& vdb) {
+  const fs::path nvdb = fs::path(vdb).replace_extension(".nvdb");
+  test::write_nanovdb_copy(vdb, nvdb, /*fp16=*/true);
+  Medium m = test::vdb_medium("q", nvdb, {1.0, 1.0, 1.0}, {0.5, 0.5, 0.5}, 0.0, std::nullopt, 1.0, false);
+  m.texture_format = TextureFormat::Sparse;
+  QuantisedLoads q{load_stored_volume(m).density.grid, {}, {}};
+  m.texture_format = TextureFormat::R32F;
+  q.dense = load_stored_volume(m).density.grid;
+  m.file = vdb;
+  q.source = load_stored_volume(m).density.grid;
+  EXPECT_TRUE(q.sparse.is_sparse()) << vdb;
+  EXPECT_FALSE(q.dense.is_sparse()) << vdb;
+  EXPECT_EQ(q.sparse.dims, q.dense.dims) << vdb;
+  EXPECT_EQ(q.sparse.origin, q.dense.origin) << vdb;
+  EXPECT_EQ(q.dense.dims, q.source.dims) << vdb;
+  return q;
+}
+
 // A quantised NanoVDB grid (Float16) kept sparse goes through OpenVDB
 // (VdbLoader converts it by its value type): it must hold the values the
 // dense load decodes from the same file, texel for texel, and those must be
@@ -221,21 +245,9 @@ TEST_F(SparseGridTest, QuantisedNanoVdbKeptSparseHoldsWhatTheDenseLoadDecodes) {
   auto at = [&, box](int i, int j, int k) {
     return values[(size_t(k - box.lo.z) * 17 + size_t(j - box.lo.y)) * 23 + size_t(i - box.lo.x)];
   };
-  const fs::path vdb = test::write_vdb(dir / "q.vdb", {test::make_float_grid("density", {0.07, {0.3, -0.2, 0.1}}, box, at)});
-  const fs::path nvdb = dir / "q.nvdb";
-  test::write_nanovdb_copy(vdb, nvdb, /*fp16=*/true);
-  Medium m = test::vdb_medium("q", nvdb, {1.0, 1.0, 1.0}, {0.5, 0.5, 0.5}, 0.0, std::nullopt, 1.0, false);
-  m.texture_format = TextureFormat::Sparse;
-  const DenseGrid sparse = load_stored_volume(m).density.grid;
-  m.texture_format = TextureFormat::R32F;
-  const DenseGrid dense = load_stored_volume(m).density.grid;
-  m.file = vdb;
-  const DenseGrid source = load_stored_volume(m).density.grid;
-  ASSERT_TRUE(sparse.is_sparse());
-  ASSERT_FALSE(dense.is_sparse());
-  ASSERT_EQ(sparse.dims, dense.dims);
-  ASSERT_EQ(sparse.origin, dense.origin);
-  ASSERT_EQ(dense.dims, source.dims);
+  const auto [sparse, dense, source] =
+      load_quantised_copy(test::write_vdb(dir / "q.vdb", {test::make_float_grid("density", {0.07, {0.3, -0.2, 0.1}}, box, at)}));
+  ASSERT_FALSE(HasFailure());
   int differ = 0;
   for (int k = 0; k < dense.dims.z; ++k)
     for (int j = 0; j < dense.dims.y; ++j)
@@ -245,6 +257,31 @@ TEST_F(SparseGridTest, QuantisedNanoVdbKeptSparseHoldsWhatTheDenseLoadDecodes) {
         differ += dense.texel(i, j, k) != source.texel(i, j, k);
       }
   EXPECT_GT(differ, 100) << "the file must really be quantised";
+}
+
+// A quantised NanoVDB grid with active tiles, kept sparse: the loader walks
+// its tree from the root and turns each tile of a lower node (8³) or an upper
+// node (128³) into voxels. Texel for texel what the dense load of the same
+// file decodes, and what the OpenVDB source loads (its values are exact in
+// 16 bits).
+TEST_F(SparseGridTest, QuantisedNanoVdbTilesKeptSparseHoldWhatTheDenseLoadDecodes) {
+  const std::vector<fs::path> sources = {test::write_reader_paths_vdb(dir / "voxels_and_tile.vdb", test::VdbCompression::None),
+                                         test::write_tiles_vdb(dir / "lower.vdb", 1, 2),
+                                         test::write_tiles_vdb(dir / "upper.vdb", 2, 1)};
+  for (const fs::path& vdb : sources) {
+    const auto [sparse, dense, source] = load_quantised_copy(vdb);
+    ASSERT_FALSE(HasFailure());
+    EXPECT_EQ(sparse.max_value, source.max_value) << vdb;
+    double sum = 0.0;
+    for (int k = 0; k < dense.dims.z; ++k)
+      for (int j = 0; j < dense.dims.y; ++j)
+        for (int i = 0; i < dense.dims.x; ++i) {
+          ASSERT_EQ(sparse.texel(i, j, k), dense.texel(i, j, k)) << vdb << ' ' << i << ' ' << j << ' ' << k;
+          ASSERT_EQ(dense.texel(i, j, k), source.texel(i, j, k)) << vdb << ' ' << i << ' ' << j << ' ' << k;
+          sum += sparse.texel(i, j, k);
+        }
+    EXPECT_GT(sum, 0.0) << vdb;
+  }
 }
 
 // A live edit re-packs the media headers without the leaf tables (they visit
