@@ -30,6 +30,12 @@ struct StoredVolume {
 // R16F holds (|v| > 6e4). A Medium's: scene/MediumVolume.h.
 StoredVolume load_stored_volume(const VolumeOptions& options, const DenseLimits& limits = {});
 
+// "" when the temperature grid's hottest value maps above the cutoff;
+// otherwise the warning (naming the grid, the hottest temperature and a fix
+// that changes the image: a temperature.scale other than the one in use, or,
+// for a constant grid, that there is no fire to show) that load_stored_volume adds.
+std::string cold_temperature_warning(const DenseGrid& temperature, const TemperatureMapping& mapping);
+
 // Rounds every value to the nearest half and fills half_bits.
 void round_to_format(StoredGrid& g);
 

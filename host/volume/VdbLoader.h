@@ -25,12 +25,6 @@ inline constexpr const char* kDefaultDensityGrid = "density";
 // the limit, the "downsample" that would fit) before its dense array exists.
 VolumeGrids load_volume(const VolumeOptions& options, const DenseLimits& limits = {});
 
-// "" when the temperature grid's hottest value maps above the cutoff;
-// otherwise the warning (naming the grid, the hottest temperature and a fix
-// that changes the image: a temperature.scale other than the one in use, or,
-// for a constant grid, that there is no fire to show) that load_stored_volume adds.
-std::string cold_temperature_warning(const DenseGrid& temperature, const TemperatureMapping& mapping);
-
 // The most texels one dense grid may have (default 2^32, 16 GiB as float:
 // past what any host or device here holds); beyond it load_volume throws
 // InputError and suggests "downsample". The fuzz target and the corrupt-input

@@ -12,8 +12,8 @@
 #include "support/VdbScenes.h"
 #include "volume/DenseGrid.h"
 #include "volume/SourceConventions.h"
+#include "volume/StoredVolume.h"
 #include "volume/VdbInfo.h"
-#include "volume/VdbLoader.h"
 
 using namespace pyrolume;
 using namespace pyrolume::test;

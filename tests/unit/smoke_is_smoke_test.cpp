@@ -12,6 +12,7 @@
 #include "support/VdbScenes.h"
 #include "util/Error.h"
 #include "volume/SourceConventions.h"
+#include "volume/StoredVolume.h"
 #include "volume/VdbInfo.h"
 #include "volume/VdbLoader.h"
 
