@@ -49,6 +49,11 @@ class RealRender : public ::testing::Test {
     if (backend_) EXPECT_EQ(backend_->validation_messages(), 0u) << "Vulkan validation reported problems";
   }
 
+  // A medium glowing from its temperature grid (emit_blackbody below),
+  // framed z up from −y at w × h pixels over `background`, max_depth 4.
+  Scene framed_glowing(Medium m, const char* temperature_grid, double scale, double temperature_scale, int w, int h,
+                       glm::dvec3 background);
+
   // A scene that frames the medium's world bounds (from the stored density
   // grid, as the renderers clip rays), seen from −view_axis with `up`.
   Scene framed(const Medium& m, glm::dvec3 view_axis, glm::dvec3 up, int w, int h) {
@@ -136,6 +141,15 @@ void emit_blackbody(Medium& m, const char* temperature_grid, double scale, doubl
   m.temperature.cutoff_k = 600.0;
 }
 
+Scene RealRender::framed_glowing(Medium m, const char* temperature_grid, double scale, double temperature_scale,
+                                 int w, int h, glm::dvec3 background) {
+  emit_blackbody(m, temperature_grid, scale, temperature_scale);
+  Scene s = framed(m, {0, 1, 0}, {0, 0, 1}, w, h);
+  s.background = background;
+  s.integrator.max_depth = 4;
+  return s;
+}
+
 // The plume has no temperature grid, so it is lit by the background (rgb 1)
 // through scattering.
 TEST_F(RealRender, HoudiniSmokeLitByBackground) {
@@ -169,11 +183,8 @@ TEST_F(RealRender, HoudiniSmokeLitBySun) {
 // Blender 2.79 fire: density (max 0.19) and `heat` (dimensionless, max 1.57)
 // mapped to kelvin by scale 1500 with cutoff 600 K; z up, non-uniform voxels.
 TEST_F(RealRender, Blender279FireWithHeat) {
-  Medium m = vdb(dir / "blender279_fire_frame075.vdb", {1.0, 1.0, 1.0}, {0.5, 0.5, 0.5}, 0.2);
-  emit_blackbody(m, "heat", 4.0, 1500.0);
-  Scene s = framed(m, {0, 1, 0}, {0, 0, 1}, 20, 32);
-  s.background = {0.05, 0.05, 0.08};
-  s.integrator.max_depth = 4;
+  Scene s = framed_glowing(vdb(dir / "blender279_fire_frame075.vdb", {1.0, 1.0, 1.0}, {0.5, 0.5, 0.5}, 0.2), "heat", 4.0,
+                           1500.0, 20, 32, {0.05, 0.05, 0.08});
   s.integrator.emission_estimator = EmissionEstimator::Collision;
   compare(s, 4096, 1536, "blender 2.79 fire");
 }
@@ -201,12 +212,9 @@ TEST_F(RealRender, ThinHotBlenderFireWithTheDefaultEstimator) {
 // grids half; its `temperature` is a constant 1.97 at this frame: ×1000 K
 // gives ~1975 K emission.
 TEST_F(RealRender, MantaflowSmokeWithTemperature) {
-  Medium m = vdb(dir / "blender50_mantaflow_smoke_frame0001.vdb", {2.0, 2.0, 2.0}, {1.5, 1.5, 1.5}, 0.0);
-  emit_blackbody(m, "temperature", 3.0, 1000.0);
-  Scene s = framed(m, {0, 1, 0}, {0, 0, 1}, 32, 32);
-  s.background = {0.1, 0.1, 0.15};
-  s.integrator.max_depth = 4;
-  compare(s, 2048, 256, "mantaflow smoke");
+  compare(framed_glowing(vdb(dir / "blender50_mantaflow_smoke_frame0001.vdb", {2.0, 2.0, 2.0}, {1.5, 1.5, 1.5}, 0.0),
+                         "temperature", 3.0, 1000.0, 32, 32, {0.1, 0.1, 0.15}),
+          2048, 256, "mantaflow smoke");
 }
 
 }  // namespace

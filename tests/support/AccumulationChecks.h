@@ -269,6 +269,25 @@ inline void expect_sigterm_ends_a_pathological_pass(const std::string& backend) 
   std::filesystem::remove_all(dir);
 }
 
+// `pyrolume render --stats` of a plane whose texture holds +Inf on
+// `backend`: every sample of the lit 4 × 4 pixels is non-finite; the stats
+// count them, one warning says so, and the image written is finite.
+inline void expect_cli_reports_nonfinite_samples(const std::string& backend) {
+  auto dir = temp_dir("cli-inf-" + backend);
+  const NonfiniteTexturesAllowed allow_inf;
+  inf_texture_scene(dir, 8, 4, 16);  // writes inf.exr
+  write_file(dir / "s.json", inf_texture_scene_json(8, 4, 16));
+  CliResult r = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --backend " + backend +
+                        " --stats " + q(dir / "st.json"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto stats = nlohmann::json::parse(read_file(dir / "st.json"));
+  EXPECT_EQ(stats["nonfinite_samples"], 4 * 4 * 16);
+  EXPECT_NE(r.err.find("256 non-finite samples were recorded as 0"), std::string::npos) << r.err;
+  Image img = read_image(dir / "o.exr");
+  for (float v : img.rgb) EXPECT_TRUE(std::isfinite(v));
+  std::filesystem::remove_all(dir);
+}
+
 // A checkpoint whose sums hold a NaN or an infinity under a valid checksum
 // (forged, or damaged and re-summed): `--resume` refuses it with one line
 // naming the file, exit 2, before a device opens; resumed, the value would

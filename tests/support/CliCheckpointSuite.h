@@ -23,6 +23,8 @@ TEST_P(CliCheckpoint, SigtermSavesAndExits143) { expect_cli_sigterm_saves(GetPar
 
 TEST_P(CliCheckpoint, NonFiniteCheckpointIsRefused) { expect_nonfinite_checkpoint_refused(GetParam()); }
 
+TEST_P(CliCheckpoint, NonFiniteSamplesAreReportedInStats) { expect_cli_reports_nonfinite_samples(GetParam()); }
+
 TEST_P(CliCheckpoint, SigtermEndsAPassThroughAPathologicallyDenseMedium) {
   expect_sigterm_ends_a_pathological_pass(GetParam());
 }

@@ -90,6 +90,17 @@ inline FloatGridSpec make_float_grid(const std::string& name, const Lattice& l, 
   return FloatGridSpec{name, l, box, value};
 }
 
+// A grid of width × width × height voxels from the origin, standing along
+// +z (z_up) or +y: its value at voxel (a, b, h) is f(a, b, h), a and b across
+// the grid, h up its height.
+inline FloatGridSpec upright_grid(const std::string& name, float voxel, int width, int height, bool z_up,
+                                  const std::function<float(int a, int b, int h)>& f) {
+  const VoxelBox box{{0, 0, 0}, z_up ? glm::ivec3(width - 1, width - 1, height - 1)
+                                     : glm::ivec3(width - 1, height - 1, width - 1)};
+  return make_float_grid(name, Lattice{voxel, glm::dvec3(0.0)}, box,
+                         [=](int i, int j, int k) { return z_up ? f(i, j, k) : f(i, k, j); });
+}
+
 // A grid with no active voxels at all.
 inline FloatGridSpec make_empty_grid(const std::string& name, const Lattice& l = {}) {
   return make_float_grid(name, l, VoxelBox{{0, 0, 0}, {-1, -1, -1}}, [](int, int, int) { return 0.0f; });

@@ -58,22 +58,6 @@ TEST(CliCheckpointCpu, MismatchedResumeIsRefused) {
   std::filesystem::remove_all(dir);
 }
 
-TEST(CliCheckpointCpu, NonFiniteSamplesAreReportedInStats) {
-  auto dir = temp_dir("cli-inf");
-  const NonfiniteTexturesAllowed allow_inf;
-  inf_texture_scene(dir, 8, 4, 16);  // writes inf.exr
-  write_file(dir / "s.json", inf_texture_scene_json(8, 4, 16));
-  CliResult r = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --backend cpu --stats " +
-                        q(dir / "st.json"));
-  ASSERT_EQ(r.status, 0) << r.err;
-  auto stats = nlohmann::json::parse(read_file(dir / "st.json"));
-  EXPECT_EQ(stats["nonfinite_samples"], 4 * 4 * 16);
-  EXPECT_NE(r.err.find("256 non-finite samples were recorded as 0"), std::string::npos) << r.err;
-  Image img = read_image(dir / "o.exr");
-  for (float v : img.rgb) EXPECT_TRUE(std::isfinite(v));
-  std::filesystem::remove_all(dir);
-}
-
 // Absurd sizes are one-line errors naming the key, exit 2, and no output.
 TEST(CliLimits, AbsurdSizesAreBadInput) {
   auto dir = temp_dir("cli-limits");

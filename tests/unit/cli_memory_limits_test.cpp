@@ -69,24 +69,33 @@ TEST_F(CliMemoryLimits, ASparseGridRendersUnderTheLimitThatRefusesItsDenseArray)
   fs::remove_all(dir);
 }
 
+// A vdb medium of write_tiles_vdb(level, n) alone, rendered on both backends
+// in a process limited to 1.5 GiB: refused in one line holding `expect`
+// (after the file's name), with no internal error and no image.
+void expect_tiles_refused(const std::string& name, int level, int n, const std::vector<std::string>& expect) {
+  auto dir = temp_dir("mem-" + name);
+  const fs::path vdb = write_tiles_vdb(dir / (name + ".vdb"), level, n);
+  write_file(dir / "s.json", R"({"film": {"width": 8, "height": 8, "spp": 1},
+    "media": [{"type": "vdb", "file": ")" + name + R"(.vdb"}]})");
+  for (const char* backend : {"cpu", "vulkan"}) {
+    CliResult r = run_cli_with_memory_limit(
+        kGiB * 3 / 2, "render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --backend " + backend);
+    std::vector<std::string> parts = expect;
+    parts[0] = "pyrolume: " + vdb.string() + ": " + parts[0];
+    expect_refused(r, backend, parts, dir / "o.exr");
+    EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+  }
+  fs::remove_all(dir);
+}
+
 // Issue 45: a VDB of a few hundred bytes, one active 4096³ root tile. Kept
 // sparse its tile would become 2^27 leaves of voxels: refused before any is
 // allocated, on both backends. Without the check it allocated up to the
 // limit and ended in "out of memory ... std::bad_alloc", exit 1.
 TEST_F(CliMemoryLimits, ARootTileOfA4096CubeIsRefusedBeforeAllocating) {
-  auto dir = temp_dir("mem-root-tile");
-  const fs::path vdb = write_tiles_vdb(dir / "tile.vdb", 3, 1);
-  write_file(dir / "s.json", R"({"film": {"width": 8, "height": 8, "spp": 1},
-    "media": [{"type": "vdb", "file": "tile.vdb"}]})");
-  for (const char* backend : {"cpu", "vulkan"}) {
-    CliResult r = run_cli_with_memory_limit(
-        kGiB * 3 / 2, "render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --backend " + backend);
-    expect_refused(r, backend,
-                   {"pyrolume: " + vdb.string() + ": density grid \"density\": keeping it sparse (134217728 leaves",
-                    "68719476736 voxels of them in active tiles", "this process can still allocate"},
-                   dir / "o.exr");
-  }
-  fs::remove_all(dir);
+  expect_tiles_refused("root-tile", 3, 1,
+                       {"density grid \"density\": keeping it sparse (134217728 leaves",
+                        "68719476736 voxels of them in active tiles", "this process can still allocate"});
 }
 
 // Issue 45: a grid whose dense texture does not fit under the limit, so
@@ -98,20 +107,9 @@ TEST_F(CliMemoryLimits, ARootTileOfA4096CubeIsRefusedBeforeAllocating) {
 // catch of allocation failures, in "memory ran out while reading it", exit 2,
 // after allocating up to the limit.
 TEST_F(CliMemoryLimits, AGridWhoseSparseTreeCannotFitEitherIsRefused) {
-  auto dir = temp_dir("mem-sparse-tree");
-  const fs::path vdb = write_tiles_vdb(dir / "cube.vdb", 2, 8);
-  write_file(dir / "s.json", R"({"film": {"width": 8, "height": 8, "spp": 1},
-    "media": [{"type": "vdb", "file": "cube.vdb"}]})");
-  for (const char* backend : {"cpu", "vulkan"}) {
-    CliResult r = run_cli_with_memory_limit(
-        kGiB * 3 / 2, "render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --backend " + backend);
-    expect_refused(r, backend,
-                   {"pyrolume: " + vdb.string() + ": density grid \"density\": keeping it sparse (2097152 leaves",
-                    "this process can still allocate", "\"downsample\""},
-                   dir / "o.exr");
-    EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
-  }
-  fs::remove_all(dir);
+  expect_tiles_refused("sparse-tree", 2, 8,
+                       {"density grid \"density\": keeping it sparse (2097152 leaves",
+                        "this process can still allocate", "\"downsample\""});
 }
 
 TEST_F(CliMemoryLimits, AnAccumulationThatCannotFitIsRefused) {

@@ -359,6 +359,23 @@ TEST(CliOutputSafety, FrameOutputsAreCheckedAgainstEachFramesInputs) {
   fs::remove_all(dir);
 }
 
+// Writes each (file name, text) in dir as one committed group of outputs.
+void commit_texts(const fs::path& dir, const std::vector<std::pair<std::string, std::string>>& files) {
+  OutputCommit group;
+  for (const auto& [name, text] : files) write_text_atomic(dir / name, text);
+  group.commit();
+}
+
+// dir holds these files (sorted by name), with these texts, and nothing else.
+void expect_only_texts(const fs::path& dir, const std::vector<std::pair<std::string, std::string>>& files) {
+  std::vector<std::string> names;
+  for (const auto& [name, text] : files) {
+    names.push_back(name);
+    EXPECT_EQ(read_file(dir / name), text) << name;
+  }
+  EXPECT_EQ(listing(dir), names);
+}
+
 TEST(OutputCommit, OutputsAppearTogetherOrNotAtAll) {
   auto dir = temp_dir("commit");
   write_file(dir / "b.json", "old b");
@@ -372,15 +389,8 @@ TEST(OutputCommit, OutputsAppearTogetherOrNotAtAll) {
   }
   EXPECT_EQ(listing(dir), std::vector<std::string>{"b.json"});
   EXPECT_EQ(read_file(dir / "b.json"), "old b");
-  {
-    OutputCommit group;
-    write_text_atomic(dir / "a.json", "new a");
-    write_text_atomic(dir / "b.json", "new b");
-    group.commit();
-  }
-  EXPECT_EQ(read_file(dir / "a.json"), "new a");
-  EXPECT_EQ(read_file(dir / "b.json"), "new b");
-  EXPECT_EQ(listing(dir).size(), 2u);
+  commit_texts(dir, {{"a.json", "new a"}, {"b.json", "new b"}});
+  expect_only_texts(dir, {{"a.json", "new a"}, {"b.json", "new b"}});
   fs::remove_all(dir);
 }
 
@@ -399,15 +409,9 @@ TEST(OutputCommit, PendingTempFilesAreRemovedAtOnce) {
     EXPECT_EQ(listing(dir), std::vector<std::string>{"done.json"});
   }  // the group then finds nothing to remove
   EXPECT_EQ(listing(dir), std::vector<std::string>{"done.json"});
-  {
-    OutputCommit group;
-    write_text_atomic(dir / "a.json", "new a");
-    group.commit();
-  }
+  commit_texts(dir, {{"a.json", "new a"}});
   remove_pending_temp_files();  // nothing pending: nothing removed
-  EXPECT_EQ(read_file(dir / "a.json"), "new a");
-  EXPECT_EQ(read_file(dir / "done.json"), "in place");
-  EXPECT_EQ(listing(dir).size(), 2u);
+  expect_only_texts(dir, {{"a.json", "new a"}, {"done.json", "in place"}});
   fs::remove_all(dir);
 }
 

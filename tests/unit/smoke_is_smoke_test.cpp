@@ -24,9 +24,8 @@ namespace {
 
 // A 10×10×14-voxel puff along `up`, densest at its centre.
 FloatGridSpec smoke_puff(const std::string& name, float peak, bool z_up, float voxel = 0.1f) {
-  const VoxelBox box{{0, 0, 0}, z_up ? glm::ivec3(9, 9, 13) : glm::ivec3(9, 13, 9)};
-  return make_float_grid(name, Lattice{voxel, glm::dvec3(0.0)}, box, [=](int i, int j, int k) {
-    const double a = (i - 4.5) / 5.0, b = ((z_up ? j : k) - 4.5) / 5.0, h = ((z_up ? k : j) - 6.5) / 7.0;
+  return upright_grid(name, voxel, 10, 14, z_up, [=](int i, int j, int k) {
+    const double a = (i - 4.5) / 5.0, b = (j - 4.5) / 5.0, h = (k - 6.5) / 7.0;
     return peak * float(std::max(0.0, 1.0 - (a * a + b * b + h * h)));
   });
 }

@@ -139,19 +139,5 @@ TEST(CliLimitsVulkan, GridPastTheDevicesTextureLimitIsBadInput) {
   std::filesystem::remove_all(dir);
 }
 
-TEST(CliCheckpointVulkan, NonFiniteSamplesAreReportedInStats) {
-  auto dir = temp_dir("cli-inf-gpu");
-  const NonfiniteTexturesAllowed allow_inf;
-  inf_texture_scene(dir, 8, 4, 16);  // writes inf.exr
-  write_file(dir / "s.json", inf_texture_scene_json(8, 4, 16));
-  CliResult r = run_cli("render " + q(dir / "s.json") + " -o " + q(dir / "o.exr") + " --stats " + q(dir / "st.json"));
-  ASSERT_EQ(r.status, 0) << r.err;
-  auto stats = nlohmann::json::parse(read_file(dir / "st.json"));
-  EXPECT_EQ(stats["nonfinite_samples"], 4 * 4 * 16);
-  Image img = read_image(dir / "o.exr");
-  for (float v : img.rgb) EXPECT_TRUE(std::isfinite(v));
-  std::filesystem::remove_all(dir);
-}
-
 }  // namespace
 }  // namespace pyrolume

@@ -26,9 +26,7 @@ namespace {
 // A plume 12 voxels wide and 40 tall along `up`: density and heat fall off
 // from the axis and with height, as a rising fire's do.
 FloatGridSpec plume(const std::string& name, float peak, bool z_up, float voxel = 0.1f) {
-  const VoxelBox box{{0, 0, 0}, z_up ? glm::ivec3(11, 11, 39) : glm::ivec3(11, 39, 11)};
-  return make_float_grid(name, Lattice{voxel, glm::dvec3(0.0)}, box, [=](int i, int j, int k) {
-    const int h = z_up ? k : j, a = i, b = z_up ? j : k;
+  return upright_grid(name, voxel, 12, 40, z_up, [=](int a, int b, int h) {
     const float r2 = float((a - 5.5) * (a - 5.5) + (b - 5.5) * (b - 5.5)) / 36.0f;
     return peak * std::max(0.0f, 1.0f - r2) * std::max(0.0f, 1.0f - float(h) / 45.0f);
   });
