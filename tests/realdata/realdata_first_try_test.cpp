@@ -19,10 +19,8 @@ namespace fs = std::filesystem;
 class RealSources : public ::testing::Test {
  protected:
   void SetUp() override {
-    const fs::path data = test::shared_data_dir();
-    if (data.empty() || !fs::exists(data / "vdb"))
-      GTEST_SKIP() << "../shared/data/vdb is absent (set PYROLUME_SHARED_DATA to the data folder to run these)";
-    dir = data / "vdb";
+    dir = test::real_vdb_dir();
+    if (dir.empty()) GTEST_SKIP() << test::kRealVdbAbsent;
   }
   SourceConvention detect(const std::string& name) {
     SourceConvention c = source_convention(read_volume_file_info(dir / name, false), VolumeSource::Auto);

@@ -31,8 +31,7 @@ using test::settings_for;
 class RealRender : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    const fs::path data = test::shared_data_dir();
-    if (data.empty() || !fs::exists(data / "vdb")) return;
+    if (test::real_vdb_dir().empty()) return;
     BackendOptions o;
     o.validation = true;
     backend_ = make_backend("vulkan", o);
@@ -40,10 +39,8 @@ class RealRender : public ::testing::Test {
   static void TearDownTestSuite() { backend_.reset(); }
 
   void SetUp() override {
-    const fs::path data = test::shared_data_dir();
-    if (data.empty() || !fs::exists(data / "vdb"))
-      GTEST_SKIP() << "../shared/data/vdb is absent (set PYROLUME_SHARED_DATA to the data folder to run these)";
-    dir = data / "vdb";
+    dir = test::real_vdb_dir();
+    if (dir.empty()) GTEST_SKIP() << test::kRealVdbAbsent;
   }
   void TearDown() override {
     if (backend_) EXPECT_EQ(backend_->validation_messages(), 0u) << "Vulkan validation reported problems";

@@ -18,10 +18,8 @@ namespace fs = std::filesystem;
 class RealSmoke : public ::testing::Test {
  protected:
   void SetUp() override {
-    const fs::path data = test::shared_data_dir();
-    if (data.empty() || !fs::exists(data / "vdb"))
-      GTEST_SKIP() << "the shared data folder's vdb/ is absent (set PYROLUME_SHARED_DATA to the data folder to run these)";
-    dir = data / "vdb";
+    dir = test::real_vdb_dir();
+    if (dir.empty()) GTEST_SKIP() << test::kRealVdbAbsent;
     out = test::temp_dir("real-smoke");
   }
   void TearDown() override {

@@ -28,10 +28,8 @@ class RealVdb : public ::testing::Test {
  protected:
   fs::path dir;
   void SetUp() override {
-    const fs::path data = test::shared_data_dir();
-    if (data.empty() || !fs::exists(data / "vdb"))
-      GTEST_SKIP() << "../shared/data/vdb is absent (set PYROLUME_SHARED_DATA to the data folder to run these)";
-    dir = data / "vdb";
+    dir = test::real_vdb_dir();
+    if (dir.empty()) GTEST_SKIP() << test::kRealVdbAbsent;
   }
   fs::path file(const std::string& name) {
     fs::path p = dir / name;

@@ -12,6 +12,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -76,27 +77,32 @@ inline Medium homogeneous_box(const std::string& name, glm::dvec3 lo, glm::dvec3
   return m;
 }
 
+// analytic_base_scene with one medium over `background`.
+inline Scene one_medium_scene(int width, int height, int spp, glm::dvec3 background, Medium medium) {
+  Scene s = analytic_base_scene(width, height, spp);
+  s.background = background;
+  s.media.push_back(std::move(medium));
+  return s;
+}
+
 // (a) An absorbing emissive sphere (σs = 0), chromatic σa, nonzero background,
 // placed off-centre (right along cross(forward, up) and up) so that a flipped
 // image axis fails the test. Exact: single_collision_exact().
 inline Scene absorbing_sphere_scene(int width = 40, int height = 32, int spp = 1024) {
-  Scene s = analytic_base_scene(width, height, spp);
-  s.background = {0.05, 0.1, 0.2};
   // Camera looks along +z with up +y: image right = cross(+z, +y) = −x.
-  s.media.push_back(homogeneous_sphere("ball", {-0.5, 0.35, 0.0}, 1.0, {0.4, 1.0, 2.5}, {0, 0, 0}, 0.0,
-                                       glm::dvec3(1.0, 0.55, 0.25), 1.5));
-  return s;
+  return one_medium_scene(width, height, spp, {0.05, 0.1, 0.2},
+                          homogeneous_sphere("ball", {-0.5, 0.35, 0.0}, 1.0, {0.4, 1.0, 2.5}, {0, 0, 0}, 0.0,
+                                             glm::dvec3(1.0, 0.55, 0.25), 1.5));
 }
 
 // (d) The box version of (a): seen obliquely, so three faces and slanted
 // silhouette edges are in view.
 inline Scene absorbing_box_scene(int width = 40, int height = 32, int spp = 1024) {
-  Scene s = analytic_base_scene(width, height, spp);
+  Scene s = one_medium_scene(width, height, spp, {0.15, 0.05, 0.02},
+                             homogeneous_box("block", {-0.8, -0.6, -0.7}, {0.9, 0.7, 0.6}, {0.3, 0.9, 2.0}, {0, 0, 0},
+                                             0.0, glm::dvec3(0.4, 1.0, 1.6), 1.2));
   s.camera.position = {2.5, 1.8, -4.5};
   s.camera.look_at = {0.1, 0.1, 0.0};
-  s.background = {0.15, 0.05, 0.02};
-  s.media.push_back(homogeneous_box("block", {-0.8, -0.6, -0.7}, {0.9, 0.7, 0.6}, {0.3, 0.9, 2.0}, {0, 0, 0}, 0.0,
-                                    glm::dvec3(0.4, 1.0, 1.6), 1.2));
   return s;
 }
 
@@ -105,26 +111,23 @@ inline Scene absorbing_box_scene(int width = 40, int height = 32, int spp = 1024
 // left at "auto", which must pick the line estimator (docs/rendering.md).
 // (e) A sphere, σa·2r = 0.004 … 0.016, chromatic.
 inline Scene thin_sphere_scene(int width = 40, int height = 32, int spp = 256) {
-  Scene s = analytic_base_scene(width, height, spp);
-  s.background = {0.05, 0.1, 0.2};
-  s.media.push_back(homogeneous_sphere("flame", {-0.4, 0.3, 0.0}, 1.0, {0.002, 0.004, 0.008}, {0, 0, 0}, 0.0,
-                                       glm::dvec3(1.0, 0.6, 0.3), 200.0));
-  return s;
+  return one_medium_scene(width, height, spp, {0.05, 0.1, 0.2},
+                          homogeneous_sphere("flame", {-0.4, 0.3, 0.0}, 1.0, {0.002, 0.004, 0.008}, {0, 0, 0}, 0.0,
+                                             glm::dvec3(1.0, 0.6, 0.3), 200.0));
 }
 
 // (f) A slab 0.1 thick across the view, seen a little obliquely (σa·d = 0.002 …
 // 0.005 along the normal); or, with optical_depth, the same slab at σa·d =
 // optical_depth per channel and Le = 1/optical_depth (L ≈ 1).
 inline Scene thin_slab_scene(int width = 40, int height = 32, int spp = 256, double optical_depth = 0.0) {
-  Scene s = analytic_base_scene(width, height, spp);
-  s.camera.position = {0.6, 0.4, -5.0};
-  s.camera.look_at = {0.0, 0.0, 0.0};
-  s.background = {0.15, 0.05, 0.02};
   const double d = 0.1;
   const glm::dvec3 sigma_a = optical_depth > 0.0 ? glm::dvec3(optical_depth / d) : glm::dvec3(0.02, 0.03, 0.05);
   const double scale = optical_depth > 0.0 ? 1.0 / optical_depth : 500.0;
-  s.media.push_back(homogeneous_box("slab", {-1.5, -1.0, -0.5 * d}, {1.2, 1.1, 0.5 * d}, sigma_a, {0, 0, 0}, 0.0,
-                                    glm::dvec3(1.0, 0.8, 0.6), scale));
+  Scene s = one_medium_scene(width, height, spp, {0.15, 0.05, 0.02},
+                             homogeneous_box("slab", {-1.5, -1.0, -0.5 * d}, {1.2, 1.1, 0.5 * d}, sigma_a, {0, 0, 0},
+                                             0.0, glm::dvec3(1.0, 0.8, 0.6), scale));
+  s.camera.position = {0.6, 0.4, -5.0};
+  s.camera.look_at = {0.0, 0.0, 0.0};
   return s;
 }
 
@@ -132,11 +135,10 @@ inline Scene thin_slab_scene(int width = 40, int height = 32, int spp = 256, dou
 // path that would scatter ends with 0, so scattering acts as pure extinction and
 // single_collision_exact() holds with σt = σa + σs.
 inline Scene depth0_sphere_scene(int width = 32, int height = 32, int spp = 1024) {
-  Scene s = analytic_base_scene(width, height, spp);
+  Scene s = one_medium_scene(width, height, spp, {0.2, 0.1, 0.05},
+                             homogeneous_sphere("ball", {0.3, -0.2, 0.0}, 1.2, {0.5, 0.3, 0.2}, {0.6, 1.2, 2.0}, 0.7,
+                                                glm::dvec3(0.8, 1.0, 1.3), 1.0));
   s.integrator.max_depth = 0;
-  s.background = {0.2, 0.1, 0.05};
-  s.media.push_back(homogeneous_sphere("ball", {0.3, -0.2, 0.0}, 1.2, {0.5, 0.3, 0.2}, {0.6, 1.2, 2.0}, 0.7,
-                                       glm::dvec3(0.8, 1.0, 1.3), 1.0));
   return s;
 }
 
@@ -150,13 +152,12 @@ inline Scene depth0_sphere_scene(int width = 32, int height = 32, int spp = 1024
 // needs 65 scatterings before absorption: P = (σs/σt)^65 <= 0.75^65 ≈ 8e-9. Both
 // are far below the 1e-6 relative tolerance the SE = 0 pixels are held to.
 inline Scene equilibrium_sphere_scene(int width = 32, int height = 32, int spp = 64) {
-  Scene s = analytic_base_scene(width, height, spp);
+  Scene s = one_medium_scene(width, height, spp, {0, 0, 0},
+                             homogeneous_sphere("furnace", {0, 0, 0}, 20.0, {1.0, 1.5, 2.0}, {3.0, 2.0, 1.0}, 0.5,
+                                                glm::dvec3(0.9, 0.6, 0.3), 2.0));
   s.camera.position = {1.0, 0.5, -0.5};
   s.camera.look_at = {1.0, 0.5, 1.0};
   s.integrator.max_depth = 64;
-  s.background = {0, 0, 0};
-  s.media.push_back(homogeneous_sphere("furnace", {0, 0, 0}, 20.0, {1.0, 1.5, 2.0}, {3.0, 2.0, 1.0}, 0.5,
-                                       glm::dvec3(0.9, 0.6, 0.3), 2.0));
   return s;
 }
 
@@ -171,10 +172,9 @@ inline glm::dvec3 equilibrium_radiance(const Scene& s) {
 // L = background exactly (energy conservation of the walk and of HG sampling).
 // Optical radius σs·R <= 2: P(more than 1000 scatterings) is astronomically small.
 inline Scene white_furnace_scene(int width = 24, int height = 24, int spp = 64) {
-  Scene s = analytic_base_scene(width, height, spp);
+  Scene s = one_medium_scene(width, height, spp, {0.3, 0.6, 0.9},
+                             homogeneous_sphere("cloud", {0, 0, 0}, 1.0, {0, 0, 0}, {0.5, 1.0, 2.0}, -0.3, std::nullopt));
   s.integrator.max_depth = 1000;
-  s.background = {0.3, 0.6, 0.9};
-  s.media.push_back(homogeneous_sphere("cloud", {0, 0, 0}, 1.0, {0, 0, 0}, {0.5, 1.0, 2.0}, -0.3, std::nullopt));
   return s;
 }
 

@@ -108,4 +108,9 @@ std::filesystem::path shared_data_dir() {
   return std::filesystem::exists(p) ? p : std::filesystem::path();
 }
 
+std::filesystem::path real_vdb_dir() {
+  const std::filesystem::path data = shared_data_dir();
+  return !data.empty() && std::filesystem::exists(data / "vdb") ? data / "vdb" : std::filesystem::path();
+}
+
 }  // namespace pyrolume::test

@@ -39,4 +39,10 @@ std::string read_file(const std::filesystem::path& p);
 // ../shared/data, or empty if absent.
 std::filesystem::path shared_data_dir();
 
+// Its vdb/ folder (the real exports the realdata tests read in place), or
+// empty if absent; a test then skips with kRealVdbAbsent.
+std::filesystem::path real_vdb_dir();
+inline constexpr const char* kRealVdbAbsent =
+    "../shared/data/vdb is absent (set PYROLUME_SHARED_DATA to the data folder to run these)";
+
 }  // namespace pyrolume::test

@@ -109,26 +109,23 @@ TEST(Cli, UnknownBackend) {
   EXPECT_NE(r.err.find("--backend"), std::string::npos) << r.err;
 }
 
-TEST(Cli, UnknownImageType) {
-  auto dir = temp_dir("cliext");
+// `render` of the sphere on the CPU with `flags` into dir/out_name: exit 2, an
+// error holding `expect`, and no file written.
+void expect_output_refused(const std::string& flags, const std::string& out_name, const std::string& expect) {
+  auto dir = temp_dir("cli-out-" + out_name);
   write_file(dir / "s.json", kSphere);
-  CliResult r = run_cli("render " + (dir / "s.json").string() + " --backend cpu -o " + (dir / "x.tiff").string());
+  CliResult r =
+      run_cli("render " + (dir / "s.json").string() + " --backend cpu " + flags + " -o " + (dir / out_name).string());
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("x.tiff: unknown image type"), std::string::npos) << r.err;
-  EXPECT_FALSE(std::filesystem::exists(dir / "x.tiff"));
+  EXPECT_NE(r.err.find(expect), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / out_name));
   std::filesystem::remove_all(dir);
 }
 
+TEST(Cli, UnknownImageType) { expect_output_refused("", "x.tiff", "x.tiff: unknown image type"); }
+
 // AOVs are layers of an EXR: PNG has none.
-TEST(Cli, AovsNeedAnExr) {
-  auto dir = temp_dir("cliaovs");
-  write_file(dir / "s.json", kSphere);
-  CliResult r = run_cli("render " + (dir / "s.json").string() + " --backend cpu --aovs -o " + (dir / "x.png").string());
-  EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("x.png: --aovs needs an .exr output"), std::string::npos) << r.err;
-  EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
-  std::filesystem::remove_all(dir);
-}
+TEST(Cli, AovsNeedAnExr) { expect_output_refused("--aovs", "x.png", "x.png: --aovs needs an .exr output"); }
 
 // Seconds must be positive and finite: --time-limit 0 used to mean "no limit",
 // and nan, inf or a trailing unit slipped past CLI11's number checks. Refused

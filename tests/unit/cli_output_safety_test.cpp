@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <functional>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -359,15 +360,20 @@ TEST(CliOutputSafety, FrameOutputsAreCheckedAgainstEachFramesInputs) {
   fs::remove_all(dir);
 }
 
-// Writes each (file name, text) in dir as one committed group of outputs.
-void commit_texts(const fs::path& dir, const std::vector<std::pair<std::string, std::string>>& files) {
+using Texts = std::vector<std::pair<std::string, std::string>>;
+
+// Writes each (file name, text) in dir as one group of outputs: `staged` runs
+// while they wait, then the group commits, or, without `commit`, ends as if a
+// later output had failed.
+void write_texts(const fs::path& dir, const Texts& files, bool commit, const std::function<void()>& staged = [] {}) {
   OutputCommit group;
   for (const auto& [name, text] : files) write_text_atomic(dir / name, text);
-  group.commit();
+  staged();
+  if (commit) group.commit();
 }
 
 // dir holds these files (sorted by name), with these texts, and nothing else.
-void expect_only_texts(const fs::path& dir, const std::vector<std::pair<std::string, std::string>>& files) {
+void expect_only_texts(const fs::path& dir, const Texts& files) {
   std::vector<std::string> names;
   for (const auto& [name, text] : files) {
     names.push_back(name);
@@ -379,18 +385,14 @@ void expect_only_texts(const fs::path& dir, const std::vector<std::pair<std::str
 TEST(OutputCommit, OutputsAppearTogetherOrNotAtAll) {
   auto dir = temp_dir("commit");
   write_file(dir / "b.json", "old b");
-  {
-    OutputCommit group;
-    write_text_atomic(dir / "a.json", "new a");
-    write_text_atomic(dir / "b.json", "new b");
+  const Texts both = {{"a.json", "new a"}, {"b.json", "new b"}};
+  write_texts(dir, both, /*commit=*/false, [&] {
     EXPECT_FALSE(fs::exists(dir / "a.json"));  // staged, not yet in place
     EXPECT_EQ(read_file(dir / "b.json"), "old b");
-    // Destroyed without commit: as if the second output had failed.
-  }
-  EXPECT_EQ(listing(dir), std::vector<std::string>{"b.json"});
-  EXPECT_EQ(read_file(dir / "b.json"), "old b");
-  commit_texts(dir, {{"a.json", "new a"}, {"b.json", "new b"}});
-  expect_only_texts(dir, {{"a.json", "new a"}, {"b.json", "new b"}});
+  });
+  expect_only_texts(dir, {{"b.json", "old b"}});
+  write_texts(dir, both, /*commit=*/true);
+  expect_only_texts(dir, both);
   fs::remove_all(dir);
 }
 
@@ -400,16 +402,13 @@ TEST(OutputCommit, OutputsAppearTogetherOrNotAtAll) {
 TEST(OutputCommit, PendingTempFilesAreRemovedAtOnce) {
   auto dir = temp_dir("pendingtemps");
   write_text_atomic(dir / "done.json", "in place");
-  {
-    OutputCommit group;
-    write_text_atomic(dir / "a.json", "staged");
-    write_text_atomic(dir / "b.json", "staged");
+  write_texts(dir, {{"a.json", "staged"}, {"b.json", "staged"}}, /*commit=*/false, [&] {
     ASSERT_EQ(listing(dir).size(), 3u) << "two hidden temp files beside done.json";
     remove_pending_temp_files();
-    EXPECT_EQ(listing(dir), std::vector<std::string>{"done.json"});
-  }  // the group then finds nothing to remove
-  EXPECT_EQ(listing(dir), std::vector<std::string>{"done.json"});
-  commit_texts(dir, {{"a.json", "new a"}});
+    expect_only_texts(dir, {{"done.json", "in place"}});
+  });  // the group then finds nothing to remove
+  expect_only_texts(dir, {{"done.json", "in place"}});
+  write_texts(dir, {{"a.json", "new a"}}, /*commit=*/true);
   remove_pending_temp_files();  // nothing pending: nothing removed
   expect_only_texts(dir, {{"a.json", "new a"}, {"done.json", "in place"}});
   fs::remove_all(dir);
