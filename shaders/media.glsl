@@ -3,6 +3,23 @@
 // point. The majorants along a ray are majorant_walk.glsl's.
 // Texture arrays are indexed with constants only (no dependence on
 // dynamically-uniform indexing, which lavapipe and older GPUs handle poorly).
+// `return lookup(i)` for the constant array index i that equals slot: each
+// grid's textures are arrays of MAX_GRIDS (4) indexed with constants only.
+#define RETURN_GRID_SLOT(slot, lookup) \
+  switch (slot) {                      \
+    case 0u: return lookup(0);         \
+    case 1u: return lookup(1);         \
+    case 2u: return lookup(2);         \
+    default: return lookup(3);         \
+  }
+
+// The dense density texture of a grid slot at texture coordinates tc (.y:
+// the temperature, where TEMPERATURE_IN_DENSITY puts it there).
+vec2 density_texture_at(uint slot, vec3 tc) {
+#define DENSITY_LOOKUP(i) textureLod(density_tex[i], tc, 0.0).rg
+  RETURN_GRID_SLOT(slot, DENSITY_LOOKUP)
+#undef DENSITY_LOOKUP
+}
 // u: texel coordinates (density_texel). With TEMPERATURE_IN_DENSITY, .y is the
 // temperature grid's value (else 0). A sparse grid reads its tree instead.
 vec2 density_at(uint slot, vec3 u) {
@@ -12,13 +29,7 @@ vec2 density_at(uint slot, vec3 u) {
                                  grids[slot].density.leaf_dims, u + grids[slot].density.index_origin),
                 0.0);
   const vec3 tc = u / grids[slot].density.dims;
-  vec2 v;
-  switch (slot) {
-    case 0u: v = textureLod(density_tex[0], tc, 0.0).rg; break;
-    case 1u: v = textureLod(density_tex[1], tc, 0.0).rg; break;
-    case 2u: v = textureLod(density_tex[2], tc, 0.0).rg; break;
-    default: v = textureLod(density_tex[3], tc, 0.0).rg; break;
-  }
+  const vec2 v = density_texture_at(slot, tc);
   return TEMPERATURE_IN_DENSITY ? v : vec2(v.x, 0.0);
 }
 // The density at one texel of u's trilinear footprint, texel c + o chosen with
@@ -35,12 +46,9 @@ float stochastic_density(uint slot, vec3 u, inout uint rng) {
   const ivec3 dims = ivec3(grids[slot].density.dims);
   const ivec3 texel = clamp(ivec3(c) + ivec3(lessThan(xi, f)), ivec3(0), dims - 1);
   const int index = (texel.z * dims.y + texel.y) * dims.x + texel.x;
-  switch (slot) {
-    case 0u: return texelFetch(density_texels[0], index).r;
-    case 1u: return texelFetch(density_texels[1], index).r;
-    case 2u: return texelFetch(density_texels[2], index).r;
-    default: return texelFetch(density_texels[3], index).r;
-  }
+#define TEXEL_LOOKUP(i) texelFetch(density_texels[i], index).r
+  RETURN_GRID_SLOT(slot, TEXEL_LOOKUP)
+#undef TEXEL_LOOKUP
 }
 // The temperature grid's stored value at index-space u, before the mapping
 // T = (value - offset) * scale turns it into kelvin (emission_at below).
@@ -50,21 +58,15 @@ float temperature_value_at(uint slot, vec3 u) {
     return sparse_trilinear(grids[slot].temperature.leaf_table, grids[slot].temperature.leaf_origin,
                             grids[slot].temperature.leaf_dims, u + grids[slot].temperature.index_origin);
   const vec3 tc = u / grids[slot].temperature.dims;
-  switch (slot) {
-    case 0u: return textureLod(temperature_tex[0], tc, 0.0).r;
-    case 1u: return textureLod(temperature_tex[1], tc, 0.0).r;
-    case 2u: return textureLod(temperature_tex[2], tc, 0.0).r;
-    default: return textureLod(temperature_tex[3], tc, 0.0).r;
-  }
+#define TEMPERATURE_LOOKUP(i) textureLod(temperature_tex[i], tc, 0.0).r
+  RETURN_GRID_SLOT(slot, TEMPERATURE_LOOKUP)
+#undef TEMPERATURE_LOOKUP
 }
 vec3 blackbody_at(uint slot, float s) {
   if (GRID_COUNT <= 1u) slot = 0u;
-  switch (slot) {
-    case 0u: return textureLod(blackbody_tex[0], s, 0.0).rgb;
-    case 1u: return textureLod(blackbody_tex[1], s, 0.0).rgb;
-    case 2u: return textureLod(blackbody_tex[2], s, 0.0).rgb;
-    default: return textureLod(blackbody_tex[3], s, 0.0).rgb;
-  }
+#define BLACKBODY_LOOKUP(i) textureLod(blackbody_tex[i], s, 0.0).rgb
+  RETURN_GRID_SLOT(slot, BLACKBODY_LOOKUP)
+#undef BLACKBODY_LOOKUP
 }
 
 vec3 density_texel(uint slot, vec3 p) {
