@@ -33,6 +33,19 @@ namespace {
 
 using namespace cli_output;
 
+// A render's control for the command line: each pass prints the scene's
+// remarks above `bar`, then moves it; `cancel` (SIGINT/SIGTERM) stops the
+// render between passes.
+RenderControl bar_control(ProgressBar& bar, SceneRemarks& remarks, const std::atomic<bool>& cancel) {
+  RenderControl control;
+  control.progress = [&bar, &remarks](int done, int target) {
+    remarks.say(&bar);
+    bar.update(done, target);
+  };
+  control.cancel = &cancel;
+  return control;
+}
+
 int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesystem::path& output,
                  const std::atomic<bool>& cancel, SceneRemarks& remarks, std::optional<int> key_frame) {
   if (args.checkpoint > 0.0 || args.resume)
@@ -80,12 +93,7 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
       RenderSettings settings = settings_from(args, key_scene);
       settings.frame = uint32_t(*key_frame);
       ProgressBar bar("key frame " + std::to_string(*key_frame) + " (auto exposure)");
-      RenderControl control;
-      control.progress = [&](int done, int target) {
-        remarks.say(&bar);
-        bar.update(done, target);
-      };
-      control.cancel = &cancel;
+      RenderControl control = bar_control(bar, remarks, cancel);
       RenderResult result = backend->render(key_scene, settings, control);
       remarks.say(&bar);
       bar.finish();
@@ -136,12 +144,7 @@ int run_sequence(const RenderArgs& args, const Scene& scene, const std::filesyst
     settings.frame = uint32_t(frame);
     ProgressBar bar("frame " + std::to_string(frame));
     bar.status("loading its volumes, lights and shaders ...");
-    RenderControl control;
-    control.progress = [&](int done, int target) {
-      remarks.say(&bar);
-      bar.update(done, target);
-    };
-    control.cancel = &cancel;
+    RenderControl control = bar_control(bar, remarks, cancel);
     RenderResult result;
     if (key_render && frame == *key_frame) {
       result = std::move(*key_render);  // rendered above for the exposure, with these settings
@@ -314,12 +317,7 @@ int run_render(const RenderArgs& args, const std::atomic<bool>& cancel) {
 
   ProgressBar bar("rendering");
   bar.status("loading the scene's volumes, lights and shaders ...");
-  RenderControl control;
-  control.progress = [&](int done, int target) {
-    remarks.say(&bar);
-    bar.update(done, target);
-  };
-  control.cancel = &cancel;
+  RenderControl control = bar_control(bar, remarks, cancel);
   if (resumed) control.resume = &resumed->state;
   if (args.checkpoint > 0.0) {
     control.checkpoint_seconds = args.checkpoint;
