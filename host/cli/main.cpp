@@ -96,6 +96,98 @@ std::string flag_suggestion(CLI::App& app, int argc, char** argv) {
   }
   return "";
 }
+// `pyrolume render`: its options fill `args` when the command line is parsed.
+CLI::App* add_render_command(CLI::App& app, pyrolume::RenderArgs& args) {
+  using namespace pyrolume;
+  CLI::App* render = app.add_subcommand("render", "Render a scene to EXR or PNG");
+  render->add_option("scene", args.scene,
+                     "Scene JSON file, or a .vdb/.nvdb file (a #### pattern with --frames) as the shortest scene naming it")
+      ->required();
+  render->add_option("-o,--output", args.output, "Output image (.exr linear float, .png sRGB)");
+  render->add_option("--backend", args.backend, "vulkan (default) or cpu")->check(CLI::IsMember({"vulkan", "cpu"}));
+  render->add_option("--spp", args.spp, "Samples per pixel (overrides film.spp), at most 2^24")
+      ->check(CLI::Range(pyrolume::kMinSpp, pyrolume::kMaxSpp));
+  render->add_option("--width", args.width, "Image width (overrides film.width)")->check(CLI::Range(1, pyrolume::kMaxFilmSide));
+  render->add_option("--height", args.height, "Image height (overrides film.height)")->check(CLI::Range(1, pyrolume::kMaxFilmSide));
+  render->add_option("--seed", args.seed, "Random seed (overrides film.seed)");
+  render->add_option("--time-limit", args.time_limit, "Stop after the pass that crosses SEC seconds (SEC > 0)")
+      ->check(kPositiveSeconds);
+  render->add_option("--stats", args.stats, "Write render statistics as JSON");
+  render->add_flag("--variance", args.variance, "EXR: add the per-pixel variance of the mean (variance.R/G/B)");
+  render->add_flag("--aovs", args.aovs,
+                   "EXR: add the light layers (emission, scatter, surface, background) and the features (albedo, "
+                   "normal, depth), as film.aovs does");
+  render->add_flag("--denoise", args.denoise,
+                   "Also write OUT.denoised.exr (or .png) through the denoiser; OUT itself is left as it is");
+  render->add_option("--exposure", args.exposure,
+                     "PNG: exposure in stops (within ±30), or auto (overrides film.exposure on every frame; EXR stays "
+                     "linear)")
+      ->check(kExposure);
+  render->add_option("--view", args.view,
+                     "PNG: view transform, agx | agx_punchy | filmic | standard (overrides film.view on every frame; "
+                     "EXR stays linear)")
+      ->check(kView);
+  render->add_option("--device", args.device, "Vulkan device index (see `pyrolume devices`)")->check(CLI::NonNegativeNumber);
+  render->add_option("--frames", args.frames,
+                     "Render frames A-B[:step] (or one frame A); -o and --stats are then patterns: out_####.exr");
+  render->add_flag("--skip-existing", args.skip_existing, "With --frames: skip frames whose output exists");
+  render->add_flag("--strict", args.strict, "With --frames: stop (exit 2) at the first missing input frame");
+  render->add_flag("--allow-missing", args.allow_missing,
+                   "With --frames: frames whose input files are missing are skipped and the exit status stays 0 "
+                   "(without it the other frames are rendered and the exit status is 2)");
+  render->add_option("--checkpoint", args.checkpoint,
+                     "Every SEC seconds save the accumulation to OUT.checkpoint (e.g. out.exr.checkpoint; an "
+                     "interrupted render always saves it; a finished one removes it)")
+      ->check(kPositiveSeconds);
+  render->add_flag("--resume", args.resume,
+                   "Continue from OUT.checkpoint (same scene, backend, size, seed; refused otherwise) up to --spp");
+  return render;
+}
+
+// `pyrolume preview`: its options fill `pv`.
+CLI::App* add_preview_command(CLI::App& app, pyrolume::PreviewArgs& pv) {
+  using namespace pyrolume;
+  CLI::App* preview = app.add_subcommand("preview", "Open a window that shows the render converging");
+  preview->add_option("scene", pv.scene, "Scene JSON file, or a .vdb/.nvdb file")->required();
+  preview->add_option("--frames", pv.frames, "Show N display frames, save --screenshot, exit")->check(CLI::PositiveNumber);
+  preview->add_option("--screenshot", pv.screenshot, "PNG of what the window shows (with --frames)");
+  preview->add_option("--device", pv.device, "Vulkan device index")->check(CLI::NonNegativeNumber);
+  preview->add_option("--width", pv.width, "Window width (overrides film.width)")->check(CLI::Range(16, pyrolume::kMaxFilmSide));
+  preview->add_option("--height", pv.height, "Window height (overrides film.height)")->check(CLI::Range(16, pyrolume::kMaxFilmSide));
+  preview->add_option("--exposure", pv.exposure, "Starting exposure in stops (within ±30), or auto (overrides film.exposure)")
+      ->check(kExposure);
+  preview->add_option("--view", pv.view,
+                      "Starting view transform, agx | agx_punchy | filmic | standard (overrides film.view; V cycles)")
+      ->check(kView);
+  return preview;
+}
+
+// `pyrolume denoise`: its options fill `dn`.
+CLI::App* add_denoise_command(CLI::App& app, pyrolume::DenoiseArgs& dn) {
+  using namespace pyrolume;
+  CLI::App* denoise = app.add_subcommand("denoise", "Denoise a render (EXR with variance) into a new image");
+  denoise->add_option("input", dn.input, "EXR written by render --variance (read only)")->required();
+  denoise->add_option("-o,--output", dn.output, "Output image (.exr, or .png)")->required();
+  denoise->add_flag("--no-guide", dn.no_guide,
+                    "Use the plain à-trous filter even where the input has the AOVs and their guide (render --aovs), "
+                    "which otherwise choose the guided filter; implied by the three options below");
+  denoise->add_option("--iterations", dn.iterations,
+                      "Plain filter: à-trous iterations (default 1; n reach ±(2^(n+1) − 2) px)")
+      ->check(CLI::Range(0, 12));
+  // The edge-stopping widths divide differences: NaN, an infinity or 0 would
+  // write NaN (or nothing filtered) into the image; the filter holds them as floats.
+  const CLI::Validator finite_positive =
+      positive_finite("standard deviations (single precision)", double(std::numeric_limits<float>::max()));
+  denoise->add_option("--sigma-l", dn.sigma_l,
+                      "Plain filter: luminance edge-stopping, in standard deviations of the noise (default 1.5)")
+      ->check(finite_positive);
+  denoise->add_flag("--features", dn.features,
+                    "Plain filter: also stop at edges in the albedo, normal and depth AOVs (off: they measured worse "
+                    "on the fires)");
+  denoise->add_option("--device", dn.device, "Vulkan device index")->check(CLI::NonNegativeNumber);
+  return denoise;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -111,62 +203,10 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "pyrolume 0.1.0");
 
   RenderArgs render_args;
-  auto* render = app.add_subcommand("render", "Render a scene to EXR or PNG");
-  render->add_option("scene", render_args.scene,
-                     "Scene JSON file, or a .vdb/.nvdb file (a #### pattern with --frames) as the shortest scene naming it")
-      ->required();
-  render->add_option("-o,--output", render_args.output, "Output image (.exr linear float, .png sRGB)");
-  render->add_option("--backend", render_args.backend, "vulkan (default) or cpu")->check(CLI::IsMember({"vulkan", "cpu"}));
-  render->add_option("--spp", render_args.spp, "Samples per pixel (overrides film.spp), at most 2^24")
-      ->check(CLI::Range(pyrolume::kMinSpp, pyrolume::kMaxSpp));
-  render->add_option("--width", render_args.width, "Image width (overrides film.width)")->check(CLI::Range(1, pyrolume::kMaxFilmSide));
-  render->add_option("--height", render_args.height, "Image height (overrides film.height)")->check(CLI::Range(1, pyrolume::kMaxFilmSide));
-  render->add_option("--seed", render_args.seed, "Random seed (overrides film.seed)");
-  render->add_option("--time-limit", render_args.time_limit, "Stop after the pass that crosses SEC seconds (SEC > 0)")
-      ->check(kPositiveSeconds);
-  render->add_option("--stats", render_args.stats, "Write render statistics as JSON");
-  render->add_flag("--variance", render_args.variance, "EXR: add the per-pixel variance of the mean (variance.R/G/B)");
-  render->add_flag("--aovs", render_args.aovs,
-                   "EXR: add the light layers (emission, scatter, surface, background) and the features (albedo, "
-                   "normal, depth), as film.aovs does");
-  render->add_flag("--denoise", render_args.denoise,
-                   "Also write OUT.denoised.exr (or .png) through the denoiser; OUT itself is left as it is");
-  render->add_option("--exposure", render_args.exposure,
-                     "PNG: exposure in stops (within ±30), or auto (overrides film.exposure on every frame; EXR stays "
-                     "linear)")
-      ->check(kExposure);
-  render->add_option("--view", render_args.view,
-                     "PNG: view transform, agx | agx_punchy | filmic | standard (overrides film.view on every frame; "
-                     "EXR stays linear)")
-      ->check(kView);
-  render->add_option("--device", render_args.device, "Vulkan device index (see `pyrolume devices`)")->check(CLI::NonNegativeNumber);
-  render->add_option("--frames", render_args.frames,
-                     "Render frames A-B[:step] (or one frame A); -o and --stats are then patterns: out_####.exr");
-  render->add_flag("--skip-existing", render_args.skip_existing, "With --frames: skip frames whose output exists");
-  render->add_flag("--strict", render_args.strict, "With --frames: stop (exit 2) at the first missing input frame");
-  render->add_flag("--allow-missing", render_args.allow_missing,
-                   "With --frames: frames whose input files are missing are skipped and the exit status stays 0 "
-                   "(without it the other frames are rendered and the exit status is 2)");
-  render->add_option("--checkpoint", render_args.checkpoint,
-                     "Every SEC seconds save the accumulation to OUT.checkpoint (e.g. out.exr.checkpoint; an "
-                     "interrupted render always saves it; a finished one removes it)")
-      ->check(kPositiveSeconds);
-  render->add_flag("--resume", render_args.resume,
-                   "Continue from OUT.checkpoint (same scene, backend, size, seed; refused otherwise) up to --spp");
+  CLI::App* render = add_render_command(app, render_args);
 
   PreviewArgs pv;
-  auto* preview = app.add_subcommand("preview", "Open a window that shows the render converging");
-  preview->add_option("scene", pv.scene, "Scene JSON file, or a .vdb/.nvdb file")->required();
-  preview->add_option("--frames", pv.frames, "Show N display frames, save --screenshot, exit")->check(CLI::PositiveNumber);
-  preview->add_option("--screenshot", pv.screenshot, "PNG of what the window shows (with --frames)");
-  preview->add_option("--device", pv.device, "Vulkan device index")->check(CLI::NonNegativeNumber);
-  preview->add_option("--width", pv.width, "Window width (overrides film.width)")->check(CLI::Range(16, pyrolume::kMaxFilmSide));
-  preview->add_option("--height", pv.height, "Window height (overrides film.height)")->check(CLI::Range(16, pyrolume::kMaxFilmSide));
-  preview->add_option("--exposure", pv.exposure, "Starting exposure in stops (within ±30), or auto (overrides film.exposure)")
-      ->check(kExposure);
-  preview->add_option("--view", pv.view,
-                      "Starting view transform, agx | agx_punchy | filmic | standard (overrides film.view; V cycles)")
-      ->check(kView);
+  CLI::App* preview = add_preview_command(app, pv);
 
   std::string info_file;
   bool info_values = false;
@@ -196,26 +236,7 @@ int main(int argc, char** argv) {
   compare->add_option("--max-outliers", cmp.max_outliers, "Exit 3 if the fraction beyond 4 sigma exceeds F");
 
   DenoiseArgs dn;
-  auto* denoise = app.add_subcommand("denoise", "Denoise a render (EXR with variance) into a new image");
-  denoise->add_option("input", dn.input, "EXR written by render --variance (read only)")->required();
-  denoise->add_option("-o,--output", dn.output, "Output image (.exr, or .png)")->required();
-  denoise->add_flag("--no-guide", dn.no_guide,
-                    "Use the plain à-trous filter even where the input has the AOVs and their guide (render --aovs), "
-                    "which otherwise choose the guided filter; implied by the three options below");
-  denoise->add_option("--iterations", dn.iterations,
-                      "Plain filter: à-trous iterations (default 1; n reach ±(2^(n+1) − 2) px)")
-      ->check(CLI::Range(0, 12));
-  // The edge-stopping widths divide differences: NaN, an infinity or 0 would
-  // write NaN (or nothing filtered) into the image; the filter holds them as floats.
-  const CLI::Validator finite_positive =
-      positive_finite("standard deviations (single precision)", double(std::numeric_limits<float>::max()));
-  denoise->add_option("--sigma-l", dn.sigma_l,
-                      "Plain filter: luminance edge-stopping, in standard deviations of the noise (default 1.5)")
-      ->check(finite_positive);
-  denoise->add_flag("--features", dn.features,
-                    "Plain filter: also stop at edges in the albedo, normal and depth AOVs (off: they measured worse "
-                    "on the fires)");
-  denoise->add_option("--device", dn.device, "Vulkan device index")->check(CLI::NonNegativeNumber);
+  CLI::App* denoise = add_denoise_command(app, dn);
 
   try {
     app.parse(argc, argv);
