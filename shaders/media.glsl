@@ -3,8 +3,8 @@
 // point. The majorants along a ray are majorant_walk.glsl's.
 // Texture arrays are indexed with constants only (no dependence on
 // dynamically-uniform indexing, which lavapipe and older GPUs handle poorly).
-// `return lookup(i)` for the constant array index i that equals slot: each
-// grid's textures are arrays of MAX_GRIDS (4) indexed with constants only.
+// `return lookup(i)` for the constant index i that equals slot (the grid
+// texture arrays hold MAX_GRIDS = 4).
 #define RETURN_GRID_SLOT(slot, lookup) \
   switch (slot) {                      \
     case 0u: return lookup(0);         \

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
 #include <numbers>
 
 #include <glm/vec3.hpp>
@@ -14,6 +15,9 @@ inline constexpr double kPi = std::numbers::pi;
 
 // The largest component: a colour's or a coefficient's bound.
 inline double max3(const glm::dvec3& v) { return std::max({v.x, v.y, v.z}); }
+
+// a + b, held at UINT64_MAX instead of wrapping (voxel counts of huge tiles).
+inline uint64_t saturating_add(uint64_t a, uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
 
 // A row-major 3×3 matrix (a colour-space table as published) times v.
 inline glm::dvec3 mul(const double (&m)[3][3], const glm::dvec3& v) {

@@ -21,6 +21,7 @@
 #include <nanovdb/util/IO.h>
 
 #include "util/Error.h"
+#include "util/Math.h"
 
 namespace pyrolume {
 
@@ -41,7 +42,7 @@ struct ActiveVoxels {
 
   void add_box(const Coord& o, int64_t dim) {
     const uint64_t n = uint64_t(dim) * uint64_t(dim) * uint64_t(dim);
-    count = count > UINT64_MAX - n ? UINT64_MAX : count + n;
+    count = saturating_add(count, n);
     for (int a = 0; a < 3; ++a) {
       lo[a] = std::min(lo[a], int64_t(o[a]));
       hi[a] = std::max(hi[a], int64_t(o[a]) + dim - 1);

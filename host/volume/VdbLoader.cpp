@@ -29,6 +29,7 @@
 #include <openvdb/openvdb.h>
 
 #include "util/Error.h"
+#include "util/Math.h"
 #include "util/Memory.h"
 #include "volume/DenseBuilder.h"
 #include "volume/NanoVdbValidate.h"
@@ -197,8 +198,6 @@ void require_sparse_memory(uint64_t leaf_count, uint64_t tile_voxels, const std:
                       what.str() + " takes more than the " + std::to_string(max_sparse_leaves) + " leaves a sparse grid may have; " + hint);
   require_memory(file, role_key(role, name), what.str(), leaves * kSparseLeafBytes, hint);
 }
-
-uint64_t saturating_add(uint64_t a, uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
 
 // The active box of a grid about to be kept sparse, within the index range
 // the sparse walk can step through (one voxel of padding each side).
@@ -492,8 +491,15 @@ DenseGrid sparse_from_nanovdb(const nanovdb::NanoGrid<BuildT>& grid, const Volum
     hi = glm::max(hi, glm::i64vec3(b.x(), b.y(), b.z()));
   };
   for_each_active_value(
-      grid, [&](const openvdb::Coord& c, double) { ++voxels, extend(c, c); },
-      [&](const openvdb::CoordBBox& box, double) { tile_voxels = saturating_add(tile_voxels, box.volume()), extend(box.min(), box.max()); });
+      grid,
+      [&](const openvdb::Coord& c, double) {
+        ++voxels;
+        extend(c, c);
+      },
+      [&](const openvdb::CoordBBox& box, double) {
+        tile_voxels = saturating_add(tile_voxels, box.volume());
+        extend(box.min(), box.max());
+      });
   if (voxels == 0 && tile_voxels == 0) return empty_grid(out.name, grid_to_world, m, role, file, warnings);
   require_sparse_box(lo, hi, file, role, out.name);
   require_sparse_memory(grid.tree().nodeCount(0), tile_voxels, file, role, out.name);
