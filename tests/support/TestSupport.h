@@ -43,6 +43,6 @@ std::filesystem::path shared_data_dir();
 // empty if absent; a test then skips with kRealVdbAbsent.
 std::filesystem::path real_vdb_dir();
 inline constexpr const char* kRealVdbAbsent =
-    "../shared/data/vdb is absent (set PYROLUME_SHARED_DATA to the data folder to run these)";
+    "the shared data folder's vdb/ is absent (set PYROLUME_SHARED_DATA to the data folder to run these)";
 
 }  // namespace pyrolume::test
