@@ -220,7 +220,8 @@ TEST_F(VulkanLights, DeltaLightRaysAreAttenuatedByTheMedia) {
 // independently written CPU reference.
 TEST_F(VulkanLights, EveryKindOfLightWithFireAndSkyMatchesCpu) {
   const auto dir = test::temp_dir("vk_lights_fire");
-  Scene s = test::fire_over_plane_scene(dir, test::Strategy::Mis, true, true, 24, 18, 512);
+  // 256 spp: the pooled bias's SE is ~0.3 %, under a sixth of the 2 % tolerance.
+  Scene s = test::fire_over_plane_scene(dir, test::Strategy::Mis, true, true, 24, 18, 256);
   s.lights.push_back(distant_light({-0.5, 1.0, -0.4}, 1.5, 5.0));
   s.lights.push_back(point_light({0.8, 0.6, -0.2}, 0.6));
   s.lights.push_back(test::spot_light({-0.6, 1.2, 0.3}, {0.3, -1.0, -0.2}, 2.0 * kPointTint, 40.0, 10.0));
