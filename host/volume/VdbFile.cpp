@@ -345,6 +345,21 @@ void check_map(LayoutReader& r, const std::string& key, int depth = 0) {
   r.fail(key + ": unknown transform type \"" + type + "\"");
 }
 
+// Archive::readHeader reads the file's UUID with boost's `operator>>`: 36
+// characters, hex digits with dashes at 8, 13, 18 and 23 (8-4-4-4-12). Any
+// other character there (a space, a tab) fails the stream, and every later
+// read of OpenVDB's then leaves its value unset: a string length taken from
+// uninitialised memory asked a fuzzed file for 4 GiB.
+void check_uuid(LayoutReader& r) {
+  char uuid[36];
+  r.bytes(uuid, sizeof uuid, "file UUID");
+  for (int i = 0; i < 36; ++i) {
+    const bool dash = i == 8 || i == 13 || i == 18 || i == 23;
+    if (dash ? uuid[i] != '-' : !std::isxdigit(static_cast<unsigned char>(uuid[i])))
+      r.fail("file UUID is not 32 hex digits in the 8-4-4-4-12 form (byte " + std::to_string(i) + ")");
+  }
+}
+
 // GridDescriptor::stripSuffix, and File::findDescriptor's "name[N]" form.
 std::string base_grid_name(const std::string& name) {
   std::string s = name.substr(0, name.find('\x1e'));
@@ -378,7 +393,7 @@ std::vector<std::string> validate_openvdb_file(const std::filesystem::path& file
   const char offsets = r.value<char>("grid-offsets flag");
   if (!offsets)
     throw input_error(file.string(), "", "written as a stream without grid offsets; save it with openvdb::io::File");
-  r.skip(36, "file UUID");  // ASCII with dashes
+  check_uuid(r);
   check_meta_map(r, "file");
   // File::readGridDescriptors.
   const int32_t grids = r.value<int32_t>("grid count");

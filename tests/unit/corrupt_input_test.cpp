@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cctype>
 #include <cstring>
 #include <future>
 #include <fstream>
@@ -118,6 +119,35 @@ TEST(CorruptVdb, HugeMetadataStringLengthIsAnInputError) {
   write_bytes(p, b, b.size());
   const std::string msg = vdb_outcome(p);
   EXPECT_NE(msg.find("metadata name claims 2147483632 bytes"), std::string::npos) << msg;
+}
+
+// Found by fuzz_vdb: a tab inside the file's UUID failed OpenVDB's stream
+// (boost reads the UUID with operator>>), and its later reads left their
+// values unset: a transform name's length from uninitialised memory asked for
+// 4 GiB. Every byte of the UUID is checked; a damaged one is refused, naming
+// the byte, and an undamaged UUID in capitals (OpenVDB 11 writes those) loads.
+TEST(CorruptVdb, AUuidOpenVdbCannotParseIsAnInputError) {
+  const auto dir = test::temp_dir("vdbuuid");
+  const fs::path p = small_vdb(dir, test::VdbCompression::None);
+  const Bytes good = read_bytes(p);
+  const size_t at = 8 + 4 + 8 + 1;  // magic, version, library version, offsets flag
+  Bytes upper = good;
+  for (size_t i = at; i < at + 36; ++i) upper[i] = char(std::toupper(static_cast<unsigned char>(upper[i])));
+  write_bytes(p, upper, upper.size());
+  EXPECT_EQ(vdb_outcome(p), "");
+  for (size_t i = 0; i < 36; ++i) {
+    const bool dash = i == 8 || i == 13 || i == 18 || i == 23;
+    for (char v : {'\t', ' ', dash ? 'a' : '-', dash ? '-' : 'g'}) {
+      if (v == good[at + i]) continue;
+      Bytes b = good;
+      b[at + i] = v;
+      write_bytes(p, b, b.size());
+      const std::string msg = vdb_outcome(p);
+      EXPECT_NE(msg.find("file UUID is not 32 hex digits in the 8-4-4-4-12 form (byte " + std::to_string(i) + ")"),
+                std::string::npos)
+          << "byte " << i << " = " << int(v) << ": " << msg;
+    }
+  }
 }
 
 TEST(CorruptVdb, EveryTruncationIsAnInputError) {
