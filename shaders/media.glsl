@@ -50,8 +50,8 @@ float stochastic_density(uint slot, vec3 u, inout uint rng) {
   RETURN_GRID_SLOT(slot, TEXEL_LOOKUP)
 #undef TEXEL_LOOKUP
 }
-// The temperature grid's stored value at index-space u, before the mapping
-// T = (value - offset) * scale turns it into kelvin (emission_at below).
+// The temperature grid's stored value at index-space u, before
+// temperature_kelvin turns it into kelvin (grid_le below).
 float temperature_value_at(uint slot, vec3 u) {
   if (GRID_COUNT <= 1u) slot = 0u;
   if (SPARSE_GRIDS && grids[slot].temperature.tree != 0u)
@@ -78,10 +78,10 @@ vec3 density_texel_dir(uint slot, vec3 d) {
   return vec3(dot(grids[slot].density.row0, d0), dot(grids[slot].density.row1, d0), dot(grids[slot].density.row2, d0));
 }
 
-// A grid's stored temperature value in kelvin, T = (value − offset)·scale: the
-// one GLSL copy of the mapping (the host's is TemperatureMapping::kelvin).
+// Grid slot `slot`'s stored temperature value in kelvin (grid_kelvin,
+// shaders/shared/gpu_types.h).
 float temperature_kelvin(uint slot, float value) {
-  return (value - grids[slot].temperature_offset) * grids[slot].temperature_scale;
+  return grid_kelvin(value, grids[slot].temperature_offset, grids[slot].temperature_scale);
 }
 
 // Emitted radiance Le of grid medium m at world point x (docs/scene-format.md "media": T = (v − offset)·scale,

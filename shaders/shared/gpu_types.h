@@ -298,6 +298,15 @@ struct AovFeatureTexel {
   float guide_alpha;
 };
 
+#ifndef __cplusplus
+// A grid's stored temperature value in kelvin, T = (value − offset)·scale: the
+// shaders' one copy of the mapping (the host's, in double, is
+// TemperatureMapping::kelvin, host/volume/VolumeOptions.h).
+float grid_kelvin(float value, float temperature_offset, float temperature_scale) {
+  return (value - temperature_offset) * temperature_scale;
+}
+#endif
+
 #ifdef __cplusplus
 // Every field where std140/std430 put it (a vec3 ends 4 bytes before the next 16).
 static_assert(sizeof(GpuMedium) == 96);
