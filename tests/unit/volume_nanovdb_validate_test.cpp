@@ -122,6 +122,32 @@ TEST(NanoVdbValidate, TheUnforgedFileIsReadByEveryReader) {
   fs::remove_all(dir);
 }
 
+// Found by fuzz_nvdb: in a grid without leaves the first-leaf offset means
+// nothing and may hold anything, but the sparse loader took the first leaf's
+// address from it all the same (a pointer overflow, UBSan's
+// pointer-overflow in the sanitized build, though nothing was read there).
+// Every reader loads such a grid: here an active 8³ tile of a lower node.
+TEST(NanoVdbValidate, ALeaflessGridsFirstLeafOffsetIsNeverFollowed) {
+  const fs::path dir = test::temp_dir("nvdb-leafless");
+  openvdb::initialize();
+  auto g = openvdb::FloatGrid::create(0.0f);
+  g->setName("density");
+  g->tree().addTile(1, openvdb::Coord(16, 0, 0), 1.5f, true);
+  openvdb::io::File(((dir / "leafless.vdb").string())).write({g});
+  test::write_nanovdb_copy(dir / "leafless.vdb", dir / "leafless.nvdb");
+  std::ifstream in(dir / "leafless.nvdb", std::ios::binary);
+  Bytes b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t g0 = grid_start(b);
+  ASSERT_EQ(get<uint32_t>(b, g0 + kNodeCount), 0u);
+  put<uint64_t>(b, g0 + kNodeOffset, uint64_t(0xfff4000000000000));
+  const fs::path p = write(dir / "forged.nvdb", b);
+  for (const char* reader : {"dense", "sparse", "info --values"}) EXPECT_EQ(read_error(p, reader), "") << reader;
+  Medium m = test::vdb_density_medium("leafless", p, {1, 1, 1}, {0, 0, 0});
+  m.texture_format = TextureFormat::Sparse;
+  EXPECT_EQ(load_volume(m, false).density.sparse->active_voxels(), 512u);
+  fs::remove_all(dir);
+}
+
 TEST(NanoVdbValidate, EachForgedFieldIsRefusedByEveryReaderInOneLine) {
   const fs::path dir = test::temp_dir("nvdb-forged");
   const Bytes valid = small_nvdb(dir);
