@@ -425,8 +425,8 @@ std::optional<DenseGrid> sparse_in_place(nanovdb::GridHandle<nanovdb::HostBuffer
   if (tree.nodeCount(1)) tiles(tree.getFirstNode<1>(), tree.nodeCount(1));
   if (tree.nodeCount(2)) tiles(tree.getFirstNode<2>(), tree.nodeCount(2));
   // NanoVDB's first-node pointer adds the tree's stored offset: taken only
-  // where there are nodes (the validator checks offsets of levels that have
-  // some; an empty level's may be anything, and the sum overflow).
+  // where there are leaves (the validator checks the offsets of levels that
+  // have nodes; an empty level's may hold anything, and adding it can overflow).
   auto* leaf = tree.nodeCount(0) ? tree.getFirstNode<0>() : nullptr;
   for (uint64_t l = 0; l < tree.nodeCount(0); ++l, ++leaf) {
     const nanovdb::Coord o = leaf->origin();
