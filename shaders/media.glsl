@@ -50,8 +50,8 @@ float stochastic_density(uint slot, vec3 u, inout uint rng) {
   RETURN_GRID_SLOT(slot, TEXEL_LOOKUP)
 #undef TEXEL_LOOKUP
 }
-// The temperature grid's stored value at index-space u, before
-// temperature_kelvin turns it into kelvin (grid_le below).
+// The temperature grid's stored value at index-space u, before grid_kelvin
+// (shaders/shared/gpu_types.h) turns it into kelvin (grid_le below).
 float temperature_value_at(uint slot, vec3 u) {
   if (GRID_COUNT <= 1u) slot = 0u;
   if (SPARSE_GRIDS && grids[slot].temperature.tree != 0u)
@@ -78,12 +78,6 @@ vec3 density_texel_dir(uint slot, vec3 d) {
   return vec3(dot(grids[slot].density.row0, d0), dot(grids[slot].density.row1, d0), dot(grids[slot].density.row2, d0));
 }
 
-// Grid slot `slot`'s stored temperature value in kelvin (grid_kelvin,
-// shaders/shared/gpu_types.h).
-float temperature_kelvin(uint slot, float value) {
-  return grid_kelvin(value, grids[slot].temperature_offset, grids[slot].temperature_scale);
-}
-
 // Emitted radiance Le of grid medium m at world point x (docs/scene-format.md "media": T = (v − offset)·scale,
 // no emission at or below cutoff_k; the LUT is uniform in ln T). With
 // TEMPERATURE_IN_DENSITY the grid's value v was read with the density at x.
@@ -98,7 +92,7 @@ vec3 grid_le(GpuMedium m, uint slot, vec3 x, float value_read) {
                   dot(grids[slot].temperature.row2, p1));
     value = temperature_value_at(slot, u);
   }
-  const float T = temperature_kelvin(slot, value);
+  const float T = grid_kelvin(value, grids[slot].temperature_offset, grids[slot].temperature_scale);
   if (!(T > grids[slot].cutoff_k) || !(T >= grids[slot].t_min_k)) return vec3(0.0);
   return m.emission * blackbody_at(slot, log(T) * grids[slot].lut_scale + grids[slot].lut_offset);
 }
