@@ -1,5 +1,5 @@
-// The real exports (read in place from ../shared/data/vdb; skipped when that
-// folder is absent): the source each is detected as, and the first-try check
+// The real exports (read in place from the shared data folder's vdb/,
+// test::real_vdb_dir; skipped when that folder is absent): the source each is detected as, and the first-try check
 // of issue 22 on the fire: a scene that names only the file shows a visible,
 // unclipped fire coloured by temperature (docs/sources.md).
 #include <gtest/gtest.h>

@@ -79,16 +79,16 @@ Measurement measure_in_child(const Medium& m, const Medium* warmup) {
 }
 
 TEST(RealVdbMemory, PeakRssGrowthWhileLoadingHoudiniSmoke) {
-  const fs::path data = test::shared_data_dir();
-  if (data.empty() || !fs::exists(data / "vdb" / "openvdb_smoke1_houdini.vdb"))
-    GTEST_SKIP() << "../shared/data/vdb/openvdb_smoke1_houdini.vdb is absent";
+  const fs::path vdb = test::real_vdb_dir();
+  if (vdb.empty() || !fs::exists(vdb / "openvdb_smoke1_houdini.vdb"))
+    GTEST_SKIP() << test::kRealVdbAbsent << " (or lacks openvdb_smoke1_houdini.vdb)";
   if (!fs::exists("/proc/self/clear_refs") || status_bytes("VmHWM") == 0)
     GTEST_SKIP() << "needs Linux /proc/self/clear_refs and VmHWM to measure peak RSS";
   Medium m;
   m.type = Medium::Type::Vdb;
-  m.file = data / "vdb" / "openvdb_smoke1_houdini.vdb";
+  m.file = vdb / "openvdb_smoke1_houdini.vdb";
   Medium small = m;
-  small.file = data / "vdb" / "blender50_mantaflow_smoke_frame0001.vdb";
+  small.file = vdb / "blender50_mantaflow_smoke_frame0001.vdb";
   // The first load in a process also pages in code: report it, but bound the
   // load after a warm-up on another (tiny) file, which is data only.
   const Measurement cold = measure_in_child(m, nullptr);

@@ -36,7 +36,8 @@ std::filesystem::path temp_dir(const std::string& tag);
 void write_file(const std::filesystem::path& p, const std::string& text);
 std::string read_file(const std::filesystem::path& p);
 
-// ../shared/data, or empty if absent.
+// The shared data folder (PYROLUME_SHARED_DATA, else the one beside the
+// checkout), or empty if absent.
 std::filesystem::path shared_data_dir();
 
 // Its vdb/ folder (the real exports the realdata tests read in place), or

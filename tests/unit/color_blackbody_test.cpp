@@ -60,7 +60,7 @@ TEST(Blackbody, LocusMatchesCharity10degTable) {
   // Mitchell Charity's bbr_color.txt `10deg` rows use the plain CIE 1964 10°
   // observer (its ` 2deg` rows use Judd–Vos CMFs, so they are not compared).
   const auto data = test::shared_data_dir();
-  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: bbr_color.txt comparison skipped";
+  if (data.empty()) GTEST_SKIP() << "the shared data folder is absent (set PYROLUME_SHARED_DATA): bbr_color.txt comparison skipped";
   std::ifstream f(data / "color" / "bbr_color.txt");
   if (!f) GTEST_SKIP() << "bbr_color.txt not found under " << (data / "color").string();
   std::string line;

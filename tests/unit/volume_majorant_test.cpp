@@ -61,10 +61,10 @@ TEST(MajorantGrid, BoundsEveryTrilinearLookupOfTheProceduralFire) {
 }
 
 TEST(MajorantGrid, BoundsEveryTrilinearLookupOfARealVdb) {
-  auto data = test::shared_data_dir();
-  if (data.empty() || !std::filesystem::exists(data / "vdb/openvdb_smoke1_houdini.vdb"))
-    GTEST_SKIP() << "../shared/data/vdb is absent: real-data majorant check skipped";
-  Medium m = test::vdb_file_medium(data / "vdb/openvdb_smoke1_houdini.vdb");
+  const std::filesystem::path vdb = test::real_vdb_dir();
+  if (vdb.empty() || !std::filesystem::exists(vdb / "openvdb_smoke1_houdini.vdb"))
+    GTEST_SKIP() << test::kRealVdbAbsent << ": real-data majorant check skipped";
+  Medium m = test::vdb_file_medium(vdb / "openvdb_smoke1_houdini.vdb");
   StoredVolume v = load_stored_volume(m);
   MajorantGrid grid = build_majorant_grid(v.density.grid, default_majorant_resolution(v.density.grid.dims));
   check_bound(v.density.grid, grid, 300000, 42);
